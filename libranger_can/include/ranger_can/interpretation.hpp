@@ -1,0 +1,76 @@
+// The manual's open points, decided once.
+//
+// shared/reference/PROTOCOL.md lists six places where the RANGER manual is cut off or silent.
+// Each decision below is the only place in the code base that encodes it: every other file calls
+// these names, so a test on a real chassis that disproves one reading is a one-line change here
+// (and docs/PROTOCOL_INTERPRETATIONS.md says why each reading was chosen).
+#pragma once
+
+#include <cmath>
+
+namespace ranger::interpretation {
+
+// Open point 1 — 0x111 linear-speed valid range. The manual's sentence is cut off; the spec
+// sheet gives 2.6 m/s as the top speed. The encoder saturates to this; kinematics clamps earlier
+// to the user's configurable limit. (The manual mentions a different limit when the steering
+// angle exceeds 20 degrees, without giving it: the kinematics' configurable
+// `max_speed_at_large_steering` covers it.)
+inline constexpr double kMaxLinearSpeedMps = 2.6;
+inline constexpr double kLargeSteeringThresholdRad = 20.0 * M_PI / 180.0;
+
+// Open point 2 — 0x111 steering sign. 0x221 says negative = left, positive = right; the command
+// is read as using the same convention. REP-103 is the opposite (positive = left, towards +y).
+inline constexpr double kManualSteeringSignVsRep103 = -1.0;
+// Open point 3 — 0x271 per-wheel angle sign: read as the same as 0x221 (positive = right).
+inline constexpr double kManualWheelAngleSignVsRep103 = -1.0;
+
+// Converts a steering/wheel angle between the manual's convention and REP-103's (an involution).
+inline double rep103_from_manual_steering(double manual_rad) {
+  return kManualSteeringSignVsRep103 * manual_rad;
+}
+inline double manual_from_rep103_steering(double rep103_rad) {
+  return kManualSteeringSignVsRep103 * rep103_rad;
+}
+inline double rep103_from_manual_wheel_angle(double manual_rad) {
+  return kManualWheelAngleSignVsRep103 * manual_rad;
+}
+inline double manual_from_rep103_wheel_angle(double rep103_rad) {
+  return kManualWheelAngleSignVsRep103 * rep103_rad;
+}
+
+// Open point 4 — 0x211 byte 0 = 0x01 is absent from this manual's table; another printing of the
+// manual lists it as emergency shut-down. Decoded as VehicleStatus::kEmergencyStop.
+inline constexpr bool kVehicleStatus1IsEmergencyStop = true;
+
+// Open point 5 — spin speed (0x111 bytes 4-5, mm/s, counter-clockwise positive) is the wheels'
+// tangential speed, so the body yaw rate is omega = v / hypot(wheelbase/2, track/2).
+inline double spin_yaw_rate_from_wheel_speed(double wheel_speed_mps, double wheelbase_m,
+                                             double track_m) {
+  return wheel_speed_mps / std::hypot(wheelbase_m / 2.0, track_m / 2.0);
+}
+inline double spin_wheel_speed_from_yaw_rate(double yaw_rate_rps, double wheelbase_m,
+                                             double track_m) {
+  return yaw_rate_rps * std::hypot(wheelbase_m / 2.0, track_m / 2.0);
+}
+
+// Open point 6 — in Ackermann mode 0x111 steers the same quantity that 0x221 reports: the mean
+// (alpha + beta) / 2 of the two front wheels' angles. In dual Ackermann the centre of rotation
+// lies on the body's y axis (x = 0), so with R the turn radius of the body centre (signed,
+// positive = turning left) the front wheels need tan(alpha) = (L/2) / (R - W/2) and
+// tan(beta) = (L/2) / (R + W/2). These two functions are that reading and its inverse
+// (REP-103 signs: positive angle = left turn = positive curvature).
+inline double ackermann_mean_front_angle(double curvature, double wheelbase_m, double track_m) {
+  if (curvature == 0.0) return 0.0;
+  const double half_l = wheelbase_m / 2.0;
+  const double radius = 1.0 / curvature;
+  const double inner = std::atan2(half_l, radius - track_m / 2.0 * (radius > 0 ? 1.0 : -1.0));
+  const double outer = std::atan2(half_l, radius + track_m / 2.0 * (radius > 0 ? 1.0 : -1.0));
+  // atan2 with a negative radius yields angles near +-pi; fold them into (-pi/2, pi/2].
+  auto fold = [](double a) { return a > M_PI / 2 ? a - M_PI : (a < -M_PI / 2 ? a + M_PI : a); };
+  return (fold(inner) + fold(outer)) / 2.0;
+}
+// Inverse of ackermann_mean_front_angle (monotonic in curvature), solved by bisection; the
+// result has the sign of `mean_angle`. |mean_angle| must be < pi/2.
+double ackermann_curvature_from_mean_angle(double mean_angle, double wheelbase_m, double track_m);
+
+}  // namespace ranger::interpretation

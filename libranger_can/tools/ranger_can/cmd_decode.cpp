@@ -1,0 +1,13 @@
+// Placeholder until the sub-command is implemented.
+#include <ostream>
+
+#include "cli_commands.hpp"
+
+namespace ranger::cli {
+
+int run_decode(const Args&, Io io) {
+  io.err << "ranger_can decode: not implemented yet\n";
+  return 2;
+}
+
+}  // namespace ranger::cli

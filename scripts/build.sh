@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Builds everything: libranger_can with its tool, unit tests and system suites (plain CMake, in
+# build/lib), then the ROS packages with colcon (build/ws, install/).
+# Usage: scripts/build.sh [lib|all]        (default all)
+# Environment: RANGER_BUILD_TYPE (default RelWithDebInfo), RANGER_JOBS (default nproc).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+what=${1:-all}
+build_type=${RANGER_BUILD_TYPE:-RelWithDebInfo}
+jobs=${RANGER_JOBS:-$(nproc)}
+generator=()
+command -v ninja >/dev/null && generator=(-G Ninja)
+
+mkdir -p build && touch build/COLCON_IGNORE   # keep colcon from descending into build trees
+echo "== build: libranger_can + tests (build/lib)"
+[ -f build/lib/CMakeCache.txt ] || cmake -S . -B build/lib "${generator[@]}" \
+  -DCMAKE_BUILD_TYPE="$build_type" >/dev/null
+cmake --build build/lib -j "$jobs"
+
+[ "$what" = lib ] && exit 0
+
+echo "== build: ROS packages (colcon -> install/)"
+# The ROS build must use the system Python (python3 on PATH may be a pyenv without ROS modules).
+export PATH=/usr/bin:$PATH
+if [ -f /opt/ros/noetic/setup.bash ]; then set +u; source /opt/ros/noetic/setup.bash; set -u; fi
+colcon --log-base build/log build --base-paths . --build-base build/ws --install-base install \
+  --event-handlers console_cohesion- summary+ status- \
+  --parallel-workers "$jobs" \
+  --cmake-args -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE="$build_type" \
+  -DRANGER_BUILD_TESTS=OFF -DRANGER_BUILD_BENCHMARKS=OFF

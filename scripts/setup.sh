@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# Installs the system packages the project needs, idempotently (nothing is fetched when all are
+# present). Usage: scripts/setup.sh [lib|ros|test]
+#   lib   compiler, CMake, GoogleTest, Google Benchmark: enough for libranger_can and its tool
+#   ros   lib + ROS 1 (distribution packages on Debian 12 / Ubuntu 22.04+, Noetic on Ubuntu 20.04)
+#   test  ros + what the full test suite needs: can-utils, qemu + a kernel with vcan (for hosts
+#         without CAN support), Xvfb for the rviz test, clang for fuzzing, valgrind
+set -euo pipefail
+profile=${1:-test}
+
+lib_pkgs=(build-essential cmake ninja-build pkg-config git libgtest-dev libbenchmark-dev
+  python3 python3-venv)
+# ROS 1 as Debian 12 / Ubuntu 22.04+ package it (installed under /usr).
+ros_pkgs=(ros-base-dev libroscpp-dev librostest-dev python3-rostest python3-roslaunch
+  python3-rosnode python3-rostopic ros-message-generation python3-genmsg libstd-msgs-dev
+  libgeometry-msgs-dev libsensor-msgs-dev libnav-msgs-dev libtf2-ros-dev libtf2-geometry-msgs-dev
+  libdiagnostic-updater-dev libdiagnostic-aggregator-dev libdiagnostic-aggregator-tools
+  ros-robot-state-publisher rviz liburdfdom-tools libeigen3-dev catkin colcon python3-colcon-ros
+  python3-colcon-cmake python3-matplotlib python3-numpy)
+# ROS Noetic from packages.ros.org (Ubuntu 20.04), for users who already have /opt/ros/noetic.
+noetic_pkgs=(ros-noetic-ros-base ros-noetic-rostest ros-noetic-tf2-ros ros-noetic-tf2-geometry-msgs
+  ros-noetic-nav-msgs ros-noetic-sensor-msgs ros-noetic-diagnostic-updater
+  ros-noetic-diagnostic-aggregator ros-noetic-robot-state-publisher ros-noetic-rviz
+  liburdfdom-tools libeigen3-dev python3-colcon-common-extensions python3-matplotlib)
+test_pkgs=(can-utils iproute2 kmod qemu-system-x86 linux-image-amd64 busybox-static cpio gzip
+  xvfb xauth imagemagick clang libclang-rt-14-dev valgrind)
+
+pkgs=("${lib_pkgs[@]}")
+case "$profile" in
+  lib) ;;
+  ros | test)
+    if [ -d /opt/ros/noetic ]; then pkgs+=("${noetic_pkgs[@]}"); else pkgs+=("${ros_pkgs[@]}"); fi
+    [ "$profile" = test ] && pkgs+=("${test_pkgs[@]}")
+    ;;
+  *) echo "setup.sh: unknown profile '$profile' (expected lib, ros or test)" >&2; exit 2 ;;
+esac
+
+missing=()
+for p in "${pkgs[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "setup: all ${#pkgs[@]} packages for profile '$profile' are installed"
+  exit 0
+fi
+
+sudo=()
+[ "$(id -u)" -eq 0 ] || sudo=(sudo)
+echo "setup: installing ${#missing[@]} packages: ${missing[*]}"
+"${sudo[@]}" apt-get update -qq
+DEBIAN_FRONTEND=noninteractive "${sudo[@]}" apt-get install -y -qq --no-install-recommends \
+  "${missing[@]}" >/dev/null
+echo "setup: done"

@@ -1,0 +1,85 @@
+#!/usr/bin/env bash
+# The project's one test command (README, CI): installs what is missing, builds, and runs every
+# suite. Stages run in order; a failing stage does not stop the later ones, and the exit status
+# is non-zero when any stage failed. The last line counts every test case from the JUnit reports.
+#
+#   unit      libranger_can unit tests and the in-process system suites (CTest, label != vcan)
+#   dbc       (part of unit) the DBC file cross-checked against the C++ codec with cantools
+#   vcan      suites on real SocketCAN vcan0: natively where the kernel has vcan, else in a qemu VM
+#   ros       the ROS packages' tests (rostest + gtest, launch-file checks) via colcon test
+#   sanitize  ASan+UBSan and TSan builds of the library and its tests
+#   fuzz      every libFuzzer target for a bounded time (RANGER_FUZZ_SECONDS, default 60)
+#
+# RANGER_STAGES="unit ros" runs a subset (default: all of the above, in that order).
+set -uo pipefail
+cd "$(dirname "$0")/.."
+root=$(pwd)
+results=$root/build/test-results
+stages=${RANGER_STAGES:-unit vcan ros sanitize fuzz}
+failed=()
+passed=()
+
+run_stage() {  # name command...
+  local name=$1
+  shift
+  echo
+  echo "==================== stage: $name ===================="
+  local start=$SECONDS
+  if "$@"; then
+    passed+=("$name")
+    echo "== stage $name: ok ($((SECONDS - start)) s)"
+  else
+    failed+=("$name")
+    echo "== stage $name: FAILED ($((SECONDS - start)) s)"
+  fi
+}
+
+stage_unit() {
+  ctest --test-dir build/lib -LE vcan --output-on-failure -j "$(nproc)" \
+    --output-junit "$results/unit.xml"
+}
+stage_vcan() { scripts/run_vcan_tests.sh build/lib "$results/vcan.xml"; }
+stage_ros() {
+  (
+    export PATH=/usr/bin:$PATH
+    if [ -f /opt/ros/noetic/setup.bash ]; then set +u; source /opt/ros/noetic/setup.bash; set -u; fi
+    set +u; source install/setup.bash; set -u
+    export ROS_HOME=${ROS_HOME:-$root/build/ros_home} ROS_HOSTNAME=localhost
+    export ROS_MASTER_URI=http://localhost:11311
+    colcon --log-base build/log test --base-paths . --build-base build/ws --install-base install \
+      --event-handlers console_direct+ --executor sequential --return-code-on-test-failure
+    local rc=$?
+    colcon test-result --test-result-base build/ws --verbose
+    rm -rf "$results/ros" && mkdir -p "$results/ros"
+    find build/ws -path '*test_results*' -name '*.xml' -exec cp {} "$results/ros/" \;
+    exit $rc
+  )
+}
+stage_sanitize() { scripts/test_sanitizers.sh; }
+stage_fuzz() { scripts/fuzz.sh "${RANGER_FUZZ_SECONDS:-60}"; }
+
+echo "== setup"
+scripts/setup.sh test || { echo "setup failed: cannot install the system packages" >&2; exit 1; }
+rm -rf "$results" && mkdir -p "$results"
+echo "== build"
+scripts/build.sh all || { echo "build failed" >&2; exit 1; }
+
+for s in $stages; do
+  if [ "$(type -t "stage_$s")" != function ]; then
+    echo "unknown stage '$s'" >&2
+    failed+=("$s")
+    continue
+  fi
+  case $s in
+    sanitize) [ -x scripts/test_sanitizers.sh ] || { echo "(no sanitizer script yet)"; continue; } ;;
+    fuzz) [ -x scripts/fuzz.sh ] || { echo "(no fuzz script yet)"; continue; } ;;
+  esac
+  run_stage "$s" "stage_$s"
+done
+
+echo
+echo "==================== summary ===================="
+echo "stages passed: ${passed[*]:-none}"
+echo "stages failed: ${failed[*]:-none}"
+python3 scripts/junit_summary.py "$results"
+[ ${#failed[@]} -eq 0 ]
