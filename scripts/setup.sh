@@ -16,14 +16,16 @@ ros_pkgs=(ros-base-dev libroscpp-dev librostest-dev python3-rostest python3-rosl
   libgeometry-msgs-dev libsensor-msgs-dev libnav-msgs-dev libtf2-ros-dev libtf2-geometry-msgs-dev
   libdiagnostic-updater-dev libdiagnostic-aggregator-dev libdiagnostic-aggregator-tools
   ros-robot-state-publisher rviz liburdfdom-tools libeigen3-dev catkin colcon python3-colcon-ros
-  python3-colcon-cmake python3-matplotlib python3-numpy)
+  python3-colcon-cmake python3-matplotlib python3-numpy
+  python3-yaml python3-pytest python3-geometry-msgs python3-nav-msgs python3-sensor-msgs
+  python3-diagnostic-msgs python3-tf2-msgs)
 # ROS Noetic from packages.ros.org (Ubuntu 20.04), for users who already have /opt/ros/noetic.
 noetic_pkgs=(ros-noetic-ros-base ros-noetic-rostest ros-noetic-tf2-ros ros-noetic-tf2-geometry-msgs
   ros-noetic-nav-msgs ros-noetic-sensor-msgs ros-noetic-diagnostic-updater
   ros-noetic-diagnostic-aggregator ros-noetic-robot-state-publisher ros-noetic-rviz
   liburdfdom-tools libeigen3-dev python3-colcon-common-extensions python3-matplotlib)
 test_pkgs=(can-utils iproute2 kmod qemu-system-x86 linux-image-amd64 busybox-static cpio gzip
-  xvfb xauth imagemagick clang libclang-rt-14-dev valgrind)
+  xvfb xauth imagemagick clang libclang-rt-14-dev valgrind clang-format)
 
 pkgs=("${lib_pkgs[@]}")
 case "$profile" in

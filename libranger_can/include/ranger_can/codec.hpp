@@ -35,7 +35,7 @@ struct ControlModeCommand {  // 0x421; the only host-settable modes are standby 
   protocol::ControlMode mode = protocol::ControlMode::kCan;
 };
 struct ErrorClearCommand {  // 0x441
-  std::uint8_t code = 0;  // protocol::ErrorClearCode, 0x00..0x10
+  std::uint8_t code = 0;    // protocol::ErrorClearCode, 0x00..0x10
 };
 struct UltrasonicSettingCommand {  // 0x451
   bool enable = false;
@@ -51,7 +51,7 @@ struct SystemStatus {  // 0x211
   double battery_voltage = 0.0;  // V (wire: uint16 0.1 V)
   std::uint32_t error_bits = 0;  // byte 4 most significant; names via protocol::error_bit_names
 };
-struct MotionFeedback {  // 0x221
+struct MotionFeedback {         // 0x221
   double speed = 0.0;           // m/s, reversing negative
   double steering_angle = 0.0;  // rad, manual sign: negative left, positive right
 };
@@ -68,10 +68,10 @@ struct MotorLowSpeedFeedback {  // 0x261..0x268
   double motor_temperature = 0.0;   // degC (wire: int8 1 degC)
   std::uint8_t driver_status = 0;   // bits: protocol::driver_status_bits()
 };
-struct SteeringAnglesFeedback {  // 0x271, motors 5,6,7,8 = RF, RR, LR, LF
+struct SteeringAnglesFeedback {    // 0x271, motors 5,6,7,8 = RF, RR, LR, LF
   std::array<double, 4> angles{};  // rad, manual sign (interpretation.hpp, open point 3)
 };
-struct WheelSpeedsFeedback {  // 0x281, motors 1,2,3,4 = RF, RR, LR, LF
+struct WheelSpeedsFeedback {       // 0x281, motors 1,2,3,4 = RF, RR, LR, LF
   std::array<double, 4> speeds{};  // m/s
 };
 struct MotionModeFeedback {  // 0x291
@@ -79,14 +79,14 @@ struct MotionModeFeedback {  // 0x291
   std::uint8_t mode_raw = 0;
   bool switching = false;
 };
-struct UltrasonicFeedback {  // 0x342 (sensors 1-4) / 0x343 (sensors 5-8)
-  int first_sensor = 1;          // 1 or 5
+struct UltrasonicFeedback {           // 0x342 (sensors 1-4) / 0x343 (sensors 5-8)
+  int first_sensor = 1;               // 1 or 5
   std::array<std::int16_t, 4> raw{};  // >= 0: distance in mm; < 0: protocol::UltrasonicCode
 };
 struct UltrasonicSettingFeedback {  // 0x45A
   bool enabled = false;
 };
-struct BmsData {  // 0x361 / 0x363 / 0x365 / 0x367 / 0x369
+struct BmsData {             // 0x361 / 0x363 / 0x365 / 0x367 / 0x369
   int battery = 0;           // 0 = whole pack, 1..4 = battery slot
   double soc = 0.0;          // % 0..100
   double soh = 0.0;          // % 0..100
@@ -103,20 +103,26 @@ struct BmsAlarm {  // 0x362 / 0x364 / 0x366 / 0x368 / 0x36A
 };
 
 // Any RANGER message.
-using Message =
-    std::variant<MotionCommand, MotionModeCommand, ControlModeCommand, ErrorClearCommand,
-                 UltrasonicSettingCommand, SystemStatus, MotionFeedback, MotorHighSpeedFeedback,
-                 MotorLowSpeedFeedback, SteeringAnglesFeedback, WheelSpeedsFeedback,
-                 MotionModeFeedback, UltrasonicFeedback, UltrasonicSettingFeedback, BmsData,
-                 BmsAlarm>;
+using Message = std::variant<MotionCommand, MotionModeCommand, ControlModeCommand,
+                             ErrorClearCommand, UltrasonicSettingCommand, SystemStatus,
+                             MotionFeedback, MotorHighSpeedFeedback, MotorLowSpeedFeedback,
+                             SteeringAnglesFeedback, WheelSpeedsFeedback, MotionModeFeedback,
+                             UltrasonicFeedback, UltrasonicSettingFeedback, BmsData, BmsAlarm>;
 
 // Decodes a frame of any RANGER ID. Errors: kUnknownId, kBadDlc (message names ID and DLCs),
-// kInvalidArgument for an error frame. Unknown enum values decode (raw kept), they are not errors.
+// kInvalidArgument for an error frame. Unknown enum values decode (raw kept), they are not errors:
+// an undefined vehicle status reads as kAbnormal, never kNormal; a boolean byte (0x451, 0x45A,
+// 0x291 byte 1) is true when non-zero. Does not allocate on success.
 Result<Message> decode(const CanFrame& frame);
 
-// Encodes a message. Values outside the protocol's range saturate (never wrap); NaN/inf give
-// kNotFinite naming the field; out-of-range indices (motor 9, battery 5, 0x441 code 0x11) give
-// kInvalidArgument. The returned frame has stamp 0.
+// Encodes a message. Values outside the protocol's range saturate (never wrap): 0x111 to its
+// valid ranges (+-interpretation::kMaxLinearSpeedMps, spin +-1 m/s, steering +-90 deg), BMS
+// SOC/SOH to 0..100 %, everything else to its wire type. NaN/inf give kNotFinite naming the field
+// ("motion_command.linear_speed is NaN ..."); out-of-range indices (motor 9, battery 5, sensor
+// group 3) and command values a host may not send (0x441 code 0x11, motion mode 3, control mode
+// remote) give kInvalidArgument. Feedback enums are written as they are, and SystemStatus writes
+// vehicle_status_raw when it decodes to vehicle_status (else the enum's value), so decoding then
+// encoding any valid feedback frame is byte-exact up to reserved bytes. The frame has stamp 0.
 Result<CanFrame> encode(const Message& message);
 
 // The frame ID a message encodes to (for a valid message).

@@ -18,19 +18,32 @@ namespace ranger::interpretation {
 inline constexpr double kMaxLinearSpeedMps = 2.6;
 inline constexpr double kLargeSteeringThresholdRad = 20.0 * M_PI / 180.0;
 
-// Open point 2 — 0x111 steering sign. 0x221 says negative = left, positive = right; the command
-// is read as using the same convention. REP-103 is the opposite (positive = left, towards +y).
+// 0x221 steering feedback: the manual states negative = left, positive = right. REP-103 is the
+// opposite (positive = left, towards +y).
 inline constexpr double kManualSteeringSignVsRep103 = -1.0;
+// Open point 2 — 0x111 steering sign: not stated; read as the same convention as 0x221. Kept as a
+// constant of its own so that a chassis turning the other way flips the command only, not the
+// feedback: code that produces or reads a 0x111 angle uses the *_command_steering functions.
+inline constexpr double kCommandSteeringSignVsRep103 = kManualSteeringSignVsRep103;
 // Open point 3 — 0x271 per-wheel angle sign: read as the same as 0x221 (positive = right).
 inline constexpr double kManualWheelAngleSignVsRep103 = -1.0;
 
-// Converts a steering/wheel angle between the manual's convention and REP-103's (an involution).
+// Converts a steering/wheel angle between the manual's convention and REP-103's (involutions).
+// 0x221 (feedback) steering:
 inline double rep103_from_manual_steering(double manual_rad) {
   return kManualSteeringSignVsRep103 * manual_rad;
 }
 inline double manual_from_rep103_steering(double rep103_rad) {
   return kManualSteeringSignVsRep103 * rep103_rad;
 }
+// 0x111 (command) steering:
+inline double rep103_from_manual_command_steering(double manual_rad) {
+  return kCommandSteeringSignVsRep103 * manual_rad;
+}
+inline double manual_from_rep103_command_steering(double rep103_rad) {
+  return kCommandSteeringSignVsRep103 * rep103_rad;
+}
+// 0x271 per-wheel angles:
 inline double rep103_from_manual_wheel_angle(double manual_rad) {
   return kManualWheelAngleSignVsRep103 * manual_rad;
 }
@@ -55,22 +68,27 @@ inline double spin_wheel_speed_from_yaw_rate(double yaw_rate_rps, double wheelba
 
 // Open point 6 — in Ackermann mode 0x111 steers the same quantity that 0x221 reports: the mean
 // (alpha + beta) / 2 of the two front wheels' angles. In dual Ackermann the centre of rotation
-// lies on the body's y axis (x = 0), so with R the turn radius of the body centre (signed,
-// positive = turning left) the front wheels need tan(alpha) = (L/2) / (R - W/2) and
-// tan(beta) = (L/2) / (R + W/2). These two functions are that reading and its inverse
-// (REP-103 signs: positive angle = left turn = positive curvature).
+// lies on the body's y axis (x = 0), so with R the turn radius of the body centre the front
+// wheels need tan(alpha) = (L/2) / (R - W/2) and tan(beta) = (L/2) / (R + W/2). These two
+// functions are that reading and its inverse (REP-103 signs: positive angle = left turn =
+// positive curvature).
+//
+// Written in curvature k = 1/R so that k = 0 (straight) and |k| -> inf (turning about the body
+// centre) need no special case: the inner wheel's angle passes 90 degrees when R < W/2, and the
+// mean rises strictly from 0 (k = 0) to pi/2 (|k| = inf), odd in k. The RANGER's +-40 degree
+// Ackermann limit is far inside that range.
 inline double ackermann_mean_front_angle(double curvature, double wheelbase_m, double track_m) {
   if (curvature == 0.0) return 0.0;
-  const double half_l = wheelbase_m / 2.0;
-  const double radius = 1.0 / curvature;
-  const double inner = std::atan2(half_l, radius - track_m / 2.0 * (radius > 0 ? 1.0 : -1.0));
-  const double outer = std::atan2(half_l, radius + track_m / 2.0 * (radius > 0 ? 1.0 : -1.0));
-  // atan2 with a negative radius yields angles near +-pi; fold them into (-pi/2, pi/2].
-  auto fold = [](double a) { return a > M_PI / 2 ? a - M_PI : (a < -M_PI / 2 ? a + M_PI : a); };
-  return (fold(inner) + fold(outer)) / 2.0;
+  const double k = std::fabs(curvature);
+  const double inner = std::atan2(wheelbase_m / 2.0 * k, 1.0 - track_m / 2.0 * k);
+  const double outer = std::atan2(wheelbase_m / 2.0 * k, 1.0 + track_m / 2.0 * k);
+  return std::copysign((inner + outer) / 2.0, curvature);
 }
-// Inverse of ackermann_mean_front_angle (monotonic in curvature), solved by bisection; the
-// result has the sign of `mean_angle`. |mean_angle| must be < pi/2.
+// Inverse of ackermann_mean_front_angle, in closed form: with m the mean angle, tan(2m) =
+// tan(alpha + beta) gives (L/2)^2+(W/2)^2 = D, D k^2 sin2m + L k cos2m - sin2m = 0, whose positive
+// root is taken in the cancellation-free form for each sign of cos 2m. The result has the sign of
+// `mean_angle`; |mean_angle| >= pi/2 gives +-infinity (turning about the body centre); NaN or a
+// non-positive/non-finite wheelbase or track gives NaN.
 double ackermann_curvature_from_mean_angle(double mean_angle, double wheelbase_m, double track_m);
 
 }  // namespace ranger::interpretation

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -81,7 +82,9 @@ std::string error_clear_description(std::uint8_t code);
 // ---- 0x211 error bits -------------------------------------------------------------------------
 // The four error bytes form one big-endian uint32 (byte 4 is the most significant), so a bit's
 // position in the word is (7 - byte) * 8 + bit.
-constexpr int error_bit_index(int byte, int bit) { return (7 - byte) * 8 + bit; }
+constexpr int error_bit_index(int byte, int bit) {
+  return (7 - byte) * 8 + bit;
+}
 
 struct NamedBit {
   int index;              // bit position in the word (or byte) it belongs to
@@ -105,6 +108,9 @@ std::vector<std::string> driver_status_names(std::uint8_t status);
 // Status byte 1 (alarm and warning use the same layout) and status byte 2.
 const std::vector<NamedBit>& bms_status1_bits();
 const std::vector<NamedBit>& bms_status2_bits();
+// Names of the bits set in one status pair (alarm1/alarm2 or warning1/warning2); reserved bits
+// appear as "reserved_bit_N" (status byte 1) or "status2_reserved_bit_N" (status byte 2).
+std::vector<std::string> bms_status_names(std::uint8_t status1, std::uint8_t status2);
 
 // ---- Ultrasonic negative distance codes -------------------------------------------------------
 enum class UltrasonicCode : std::int16_t {

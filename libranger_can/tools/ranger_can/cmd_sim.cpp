@@ -1,13 +1,508 @@
-// Placeholder until the sub-command is implemented.
-#include <ostream>
+// `ranger_can sim IFACE`: the virtual RANGER chassis on a CAN interface until SIGINT/SIGTERM.
+//
+// The chassis runs on its own thread (VirtualChassisRunner); this thread reads control commands
+// (stdin and an optional FIFO), prints the chassis's state changes and writes the ground-truth
+// pose. Everything the chassis does lives in libranger_can (virtual_chassis.hpp): this file is
+// only the command line around it.
+#include <fcntl.h>
+#include <poll.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
+#include <cerrno>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <deque>
+#include <fstream>
+#include <iostream>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cli_args.hpp"
+#include "cli_bus.hpp"
 #include "cli_commands.hpp"
+#include "cli_json.hpp"
+#include "cli_signals.hpp"
+#include "cli_sim_control.hpp"
+#include "ranger_can/clock.hpp"
+#include "ranger_can/virtual_chassis_runner.hpp"
 
 namespace ranger::cli {
 
-int run_sim(const Args&, Io io) {
-  io.err << "ranger_can sim: not implemented yet\n";
-  return 2;
+namespace {
+
+using namespace std::chrono_literals;
+
+constexpr const char* kUsageHead =
+    "usage: ranger_can sim IFACE [options]\n"
+    "\n"
+    "Runs a virtual RANGER chassis on IFACE (e.g. vcan0) until SIGINT/SIGTERM, 'quit' or\n"
+    "--duration: it speaks the chassis side of the whole protocol (boots in standby, obeys 0x421,\n"
+    "0x111 per motion mode, 0x141 with a timed switch, 0x441, 0x451; sends every feedback frame\n"
+    "at the manual's period) and stops by itself 500 ms after the last 0x111. State changes are\n"
+    "printed as '[seconds since boot] what happened'. Faults are injected with the options below\n"
+    "or with control commands read from standard input and/or a FIFO (--control).\n"
+    "\n"
+    "Try it:  ranger_can sim vcan0 &   ranger_can monitor vcan0   ranger_can send vcan0 control "
+    "can\n"
+    "\n"
+    "options:\n"
+    "  --mode-switch-time SEC   time a motion-mode switch takes once at rest (default 0.5)\n"
+    "  --soc PCT                initial battery state of charge, 0-100 (default 90)\n"
+    "  --batteries N            batteries fitted, 1-4 (default 2)\n"
+    "  --ultrasonic MM[,MM..]   sensor distances in mm: one value for all 8, or 8 values\n"
+    "                           (negative: -1 offline, -2 checksum, -3 abnormal, -4 exception)\n"
+    "  --avoidance              start with ultrasonic obstacle avoidance enabled\n"
+    "  --remote                 boot with the remote control in charge (remote mode)\n"
+    "  --estop                  boot with the emergency stop pressed\n"
+    "  --error BIT|NAME         boot with this 0x211 error bit raised (repeatable)\n"
+    "  --stuck-mode-switch      motion-mode switches never complete\n"
+    "  --accel M/S2             acceleration limit (default 1.0)\n"
+    "  --steering-rate DEG/S    steering slew rate (default 90)\n"
+    "  --seed N                 seed of the garbage-frame generator (default 1)\n"
+    "  --pose-out FILE          write the ground-truth pose as JSON lines:\n"
+    "                           {\"t\":unix s,\"sim_t\":s since boot,\"x\":m,\"y\":m,\"yaw\":rad,\n"
+    "                            \"vx\":m/s,\"vy\":m/s,\"wz\":rad/s,\"distance\":m}\n"
+    "  --pose-rate HZ           pose lines per second (default 50)\n"
+    "  --control FIFO           also read control commands from FIFO (created if missing)\n"
+    "  --no-stdin               do not read control commands from standard input\n"
+    "  --duration SEC           stop after SEC seconds\n"
+    "  --quiet                  do not print state changes\n"
+    "  -h, --help               this text\n"
+    "\n";
+
+struct SimOptions {
+  std::string iface;
+  sim::VirtualChassisConfig config;
+  bool estop = false;
+  bool stuck = false;
+  std::vector<int> errors;
+  std::string pose_out;
+  double pose_rate = 50.0;
+  std::string control_fifo;
+  bool read_stdin = true;
+  std::optional<double> duration;
+  bool quiet = false;
+};
+
+Error usage_error(const std::string& what) {
+  return Error{Errc::kInvalidArgument, what};
+}
+
+Result<SimOptions> parse_options(const Args& args) {
+  SimOptions o;
+  std::vector<std::string> positional;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    std::string arg = args[i];
+    std::optional<std::string> inline_value;
+    if (arg.rfind("--", 0) == 0) {
+      const auto eq = arg.find('=');
+      if (eq != std::string::npos) {
+        inline_value = arg.substr(eq + 1);
+        arg = arg.substr(0, eq);
+      }
+    }
+    auto value = [&]() -> Result<std::string> {
+      if (inline_value) return *inline_value;
+      if (i + 1 >= args.size()) return usage_error(arg + " needs a value");
+      return args[++i];
+    };
+    auto number = [&](double min, double max) -> Result<double> {
+      auto v = value();
+      if (!v) return v.error();
+      return parse_double_in(arg, *v, min, max);
+    };
+    auto flag = [&]() -> Status {
+      if (inline_value) return usage_error(arg + " takes no value");
+      return ok_status();
+    };
+
+    if (arg == "--mode-switch-time") {
+      auto v = number(0.0, 60.0);
+      if (!v) return v.error();
+      o.config.mode_switch_duration =
+          std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::duration<double>(*v));
+    } else if (arg == "--soc") {
+      auto v = number(0.0, 100.0);
+      if (!v) return v.error();
+      o.config.initial_soc = *v;
+    } else if (arg == "--batteries") {
+      auto v = value();
+      if (!v) return v.error();
+      auto n = parse_integer(arg, *v, 1, protocol::kBatteryCount);
+      if (!n) return n.error();
+      o.config.drivetrain.batteries = static_cast<int>(*n);
+    } else if (arg == "--ultrasonic") {
+      auto v = value();
+      if (!v) return v.error();
+      std::vector<std::int16_t> mm;
+      std::stringstream ss(*v);
+      std::string item;
+      while (std::getline(ss, item, ',')) {
+        auto d = parse_integer(arg, item, -4, 32767);
+        if (!d) return d.error();
+        mm.push_back(static_cast<std::int16_t>(*d));
+      }
+      if (mm.size() == 1) {
+        o.config.ultrasonic.fill(mm[0]);
+      } else if (mm.size() == protocol::kUltrasonicCount) {
+        std::copy(mm.begin(), mm.end(), o.config.ultrasonic.begin());
+      } else {
+        return usage_error(arg + ": give 1 or 8 comma-separated distances, got " +
+                           std::to_string(mm.size()));
+      }
+    } else if (arg == "--avoidance") {
+      if (auto s = flag(); !s) return s.error();
+      o.config.ultrasonic_enabled = true;
+    } else if (arg == "--remote") {
+      if (auto s = flag(); !s) return s.error();
+      o.config.boot_in_remote_mode = true;
+    } else if (arg == "--estop") {
+      if (auto s = flag(); !s) return s.error();
+      o.estop = true;
+    } else if (arg == "--error") {
+      auto v = value();
+      if (!v) return v.error();
+      auto b = parse_error_bit(*v);
+      if (!b) return Error{Errc::kInvalidArgument, "--error: " + b.error().message};
+      o.errors.push_back(*b);
+    } else if (arg == "--stuck-mode-switch") {
+      if (auto s = flag(); !s) return s.error();
+      o.stuck = true;
+    } else if (arg == "--accel") {
+      auto v = number(0.01, 20.0);
+      if (!v) return v.error();
+      o.config.limits.acceleration = *v;
+    } else if (arg == "--steering-rate") {
+      auto v = number(1.0, 3600.0);
+      if (!v) return v.error();
+      o.config.limits.steering_rate = *v * M_PI / 180.0;
+    } else if (arg == "--seed") {
+      auto v = value();
+      if (!v) return v.error();
+      auto n = parse_integer(arg, *v, 0, 0xFFFFFFFFLL);
+      if (!n) return n.error();
+      o.config.garbage_seed = static_cast<std::uint32_t>(*n);
+    } else if (arg == "--pose-out") {
+      auto v = value();
+      if (!v) return v.error();
+      if (v->empty()) return usage_error("--pose-out needs a file name");
+      o.pose_out = *v;
+    } else if (arg == "--pose-rate") {
+      auto v = number(0.1, 1000.0);
+      if (!v) return v.error();
+      o.pose_rate = *v;
+    } else if (arg == "--control") {
+      auto v = value();
+      if (!v) return v.error();
+      if (v->empty()) return usage_error("--control needs a FIFO path");
+      o.control_fifo = *v;
+    } else if (arg == "--no-stdin") {
+      if (auto s = flag(); !s) return s.error();
+      o.read_stdin = false;
+    } else if (arg == "--duration") {
+      auto v = number(0.0, 1e7);
+      if (!v) return v.error();
+      o.duration = *v;
+    } else if (arg == "--quiet") {
+      if (auto s = flag(); !s) return s.error();
+      o.quiet = true;
+    } else if (arg.size() > 1 && arg[0] == '-') {
+      return usage_error("unknown option '" + arg + "'");
+    } else {
+      positional.push_back(arg);
+    }
+  }
+  if (positional.empty()) return usage_error("missing IFACE (e.g. vcan0)");
+  if (positional.size() > 1) return usage_error("unexpected argument '" + positional[1] + "'");
+  o.iface = positional[0];
+  return o;
+}
+
+// Control lines from standard input (or the Io stream in tests) and an optional FIFO.
+class ControlInput {
+ public:
+  ControlInput(std::istream& in, bool read_in, int fifo_fd)
+      : in_(in), use_stdin_fd_(&in == &std::cin), read_in_(read_in), fifo_fd_(fifo_fd) {}
+
+  // Waits up to `timeout` for input and appends every complete line that arrived.
+  void poll_lines(std::chrono::milliseconds timeout, std::vector<std::string>& lines) {
+    if (read_in_ && !use_stdin_fd_) {  // an in-memory stream never blocks: take what it has
+      std::string line;
+      while (std::getline(in_, line))
+        lines.push_back(line);
+      read_in_ = false;
+    }
+    std::vector<pollfd> fds;
+    const bool stdin_ok = read_in_ && use_stdin_fd_ && stdin_readable_without_stopping();
+    if (stdin_ok) fds.push_back({STDIN_FILENO, POLLIN, 0});
+    if (fifo_fd_ >= 0) fds.push_back({fifo_fd_, POLLIN, 0});
+    if (fds.empty()) {
+      ::poll(nullptr, 0, static_cast<int>(timeout.count()));
+      return;
+    }
+    if (::poll(fds.data(), fds.size(), static_cast<int>(timeout.count())) <= 0) return;
+    for (const auto& p : fds) {
+      if ((p.revents & (POLLIN | POLLHUP)) == 0) continue;
+      std::string& buffer = p.fd == STDIN_FILENO ? stdin_buffer_ : fifo_buffer_;
+      char chunk[4096];
+      const ssize_t n = ::read(p.fd, chunk, sizeof chunk);
+      if (n == 0 && p.fd == STDIN_FILENO) read_in_ = false;  // EOF: keep running, stop reading
+      if (n <= 0) continue;
+      buffer.append(chunk, static_cast<std::size_t>(n));
+      std::size_t nl;
+      while ((nl = buffer.find('\n')) != std::string::npos) {
+        lines.push_back(buffer.substr(0, nl));
+        buffer.erase(0, nl + 1);
+      }
+      if (buffer.size() > 65536) buffer.clear();  // no newline in sight: not a command stream
+    }
+  }
+
+ private:
+  // A background job reading its terminal would be stopped by SIGTTIN: only read a terminal
+  // while we are its foreground process group.
+  static bool stdin_readable_without_stopping() {
+    if (::isatty(STDIN_FILENO) == 0) return true;
+    return ::tcgetpgrp(STDIN_FILENO) == ::getpgrp();
+  }
+
+  std::istream& in_;
+  bool use_stdin_fd_;
+  bool read_in_;
+  int fifo_fd_;
+  std::string stdin_buffer_;
+  std::string fifo_buffer_;
+};
+
+// Opens (creating if needed) the control FIFO. O_RDWR keeps a writer open ourselves, so the FIFO
+// never reports end-of-file between two `echo cmd > FIFO`.
+Result<int> open_fifo(const std::string& path, bool& created) {
+  created = false;
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) {
+    if (::mkfifo(path.c_str(), 0600) != 0) {
+      return Error{Errc::kIoError,
+                   "--control: cannot create FIFO '" + path + "': " + std::strerror(errno)};
+    }
+    created = true;
+  } else if (!S_ISFIFO(st.st_mode)) {
+    return Error{Errc::kInvalidArgument, "--control: '" + path + "' exists and is not a FIFO"};
+  }
+  const int fd = ::open(path.c_str(), O_RDWR | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) {
+    return Error{Errc::kIoError,
+                 "--control: cannot open FIFO '" + path + "': " + std::strerror(errno)};
+  }
+  return fd;
+}
+
+std::string stamp_prefix(Timestamp since_boot) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "[%9.3f] ", std::chrono::duration<double>(since_boot).count());
+  return buf;
+}
+
+}  // namespace
+
+int run_sim(const Args& args, Io io) {
+  for (const auto& a : args) {
+    if (a == "-h" || a == "--help") {
+      io.out << kUsageHead << kSimControlHelp;
+      return 0;
+    }
+  }
+  auto parsed = parse_options(args);
+  if (!parsed) {
+    io.err << "ranger_can sim: " << parsed.error().message << "\n"
+           << "usage: ranger_can sim IFACE [options]   ('ranger_can sim --help' for more)\n";
+    return 2;
+  }
+  const SimOptions& o = *parsed;
+
+  std::ofstream pose_file;
+  if (!o.pose_out.empty()) {
+    pose_file.open(o.pose_out, std::ios::out | std::ios::trunc);
+    if (!pose_file) {
+      io.err << "ranger_can sim: cannot write --pose-out '" << o.pose_out
+             << "': " << std::strerror(errno) << "\n";
+      return 1;
+    }
+  }
+  int fifo_fd = -1;
+  bool fifo_created = false;
+  if (!o.control_fifo.empty()) {
+    auto fd = open_fifo(o.control_fifo, fifo_created);
+    if (!fd) {
+      io.err << "ranger_can sim: " << fd.error().message << "\n";
+      return 1;
+    }
+    fifo_fd = *fd;
+  }
+  struct FifoCleanup {
+    int fd;
+    bool created;
+    std::string path;
+    ~FifoCleanup() {
+      if (fd >= 0) ::close(fd);
+      if (created) ::unlink(path.c_str());
+    }
+  } fifo_cleanup{fifo_fd, fifo_created, o.control_fifo};
+
+  auto bus = open_interface(o.iface);
+  if (!bus) {
+    io.err << "ranger_can sim: " << bus.error().message << "\n";
+    return 1;
+  }
+
+  StopSignals signals;
+  SteadyClock clock;
+  SystemClock wall;
+  sim::VirtualChassisRunner runner(**bus, o.config, clock);
+  const Timestamp boot = clock.now();
+  runner.with_chassis([&](sim::VirtualChassis& c) {
+    if (o.estop) c.set_emergency_stop(true);
+    if (o.stuck) c.set_mode_switch_stuck(true);
+    for (int b : o.errors)
+      c.set_error_bit(b, true);
+  });
+  if (!o.quiet) {
+    io.out << "ranger_can sim: virtual RANGER on " << (*bus)->name()
+           << " (Ctrl-C to stop; 'help' lists control commands)\n";
+    io.out.flush();
+  }
+
+  ControlInput input(io.in, o.read_stdin, fifo_fd);
+  std::deque<std::string> held;  // lines waiting behind a `wait`
+  Timestamp hold_until{0};
+  const auto pose_period = std::chrono::duration_cast<std::chrono::nanoseconds>(
+      std::chrono::duration<double>(1.0 / o.pose_rate));
+  Timestamp next_pose = boot;
+  bool quit = false;
+  int exit_code = 0;
+  std::string out;
+
+  auto print_events = [&] {
+    auto events = runner.with_chassis([](sim::VirtualChassis& c) { return c.take_events(); });
+    if (o.quiet) return;
+    out.clear();
+    for (const auto& e : events)
+      out += stamp_prefix(e.time - boot) + e.text + "\n";
+    if (!out.empty()) {
+      io.out << out;
+      io.out.flush();
+    }
+  };
+
+  auto execute = [&](const std::string& line) {
+    std::istringstream words(line);
+    std::string first;
+    words >> first;
+    if (first == "quit" || first == "exit") {
+      quit = true;
+      return;
+    }
+    if (first == "help") {
+      io.out << kSimControlHelp;
+      io.out.flush();
+      return;
+    }
+    if (first == "wait") {
+      std::string sec, extra;
+      words >> sec >> extra;
+      auto v = parse_double_in("wait SEC", sec, 0.0, 1e6);
+      if (!v || !extra.empty()) {
+        io.err << "ranger_can sim: " << (v ? "usage: wait SEC" : v.error().message) << "\n";
+        return;
+      }
+      hold_until = clock.now() + std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                     std::chrono::duration<double>(*v));
+      return;
+    }
+    auto r =
+        runner.with_chassis([&](sim::VirtualChassis& c) { return apply_sim_command(line, c); });
+    if (!r) {
+      io.err << "ranger_can sim: " << r.error().message << "\n";
+    } else if (!r->empty()) {
+      io.out << *r << "\n";
+      io.out.flush();
+    }
+  };
+
+  std::vector<std::string> lines;
+  while (!quit) {
+    if (StopSignals::requested()) {
+      if (!o.quiet) {
+        io.out << "ranger_can sim: "
+               << (StopSignals::signal_number() == SIGTERM ? "SIGTERM" : "SIGINT")
+               << ", stopping\n";
+      }
+      break;
+    }
+    const Timestamp now = clock.now();
+    if (o.duration && now - boot >= std::chrono::duration<double>(*o.duration)) break;
+    if (!runner.running()) {
+      io.err << "ranger_can sim: " << runner.failure() << "\n";
+      exit_code = 1;
+      break;
+    }
+
+    lines.clear();
+    input.poll_lines(10ms, lines);
+    for (auto& l : lines)
+      held.push_back(std::move(l));
+    while (!held.empty() && clock.now() >= hold_until && !quit) {
+      const std::string line = held.front();
+      held.pop_front();
+      execute(line);
+    }
+    print_events();
+
+    if (pose_file.is_open() && clock.now() >= next_pose) {
+      const auto s = runner.with_chassis([](sim::VirtualChassis& c) { return c.snapshot(); });
+      out.clear();
+      JsonWriter w(out);
+      w.begin_object()
+          .key("t")
+          .seconds(wall.now())
+          .key("sim_t")
+          .number(std::chrono::duration<double>(s.time - boot).count())
+          .key("x")
+          .number(s.pose.x)
+          .key("y")
+          .number(s.pose.y)
+          .key("yaw")
+          .number(s.pose.yaw)
+          .key("vx")
+          .number(s.twist.vx)
+          .key("vy")
+          .number(s.twist.vy)
+          .key("wz")
+          .number(s.twist.wz)
+          .key("distance")
+          .number(s.distance_travelled)
+          .end_object();
+      pose_file << out << "\n";
+      pose_file.flush();
+      next_pose += pose_period;
+      if (next_pose < clock.now()) next_pose = clock.now() + pose_period;
+    }
+  }
+  runner.stop();
+  print_events();
+  if (!o.quiet) {
+    const auto c = runner.with_chassis([](sim::VirtualChassis& ch) { return ch.counters(); });
+    io.out << "ranger_can sim: stopped; " << c.frames_sent << " frames sent, " << c.frames_received
+           << " received (" << c.frames_rejected << " rejected, " << c.frames_ignored
+           << " ignored)";
+    if (c.send_failures > 0) io.out << ", " << c.send_failures << " send failures";
+    io.out << "\n";
+    io.out.flush();
+  }
+  return exit_code;
 }
 
 }  // namespace ranger::cli

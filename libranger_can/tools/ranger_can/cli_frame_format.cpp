@@ -1,0 +1,299 @@
+#include "cli_frame_format.hpp"
+
+#include <cstdarg>
+#include <cstdio>
+#include <vector>
+
+#include "ranger_can/protocol.hpp"
+
+namespace ranger::cli {
+
+namespace {
+
+namespace proto = ranger::protocol;
+
+constexpr double kDegPerRad = 57.29577951308232;  // display only: text lines show degrees
+constexpr const char* kWheelTags[4] = {"rf", "rr", "lr", "lf"};  // manual order RF, RR, LR, LF
+
+void appendf(std::string& out, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
+void appendf(std::string& out, const char* fmt, ...) {
+  char buf[256];
+  va_list ap;
+  va_start(ap, fmt);
+  const int n = std::vsnprintf(buf, sizeof buf, fmt, ap);
+  va_end(ap);
+  if (n > 0)
+    out.append(buf, static_cast<std::size_t>(n) < sizeof buf ? static_cast<std::size_t>(n)
+                                                             : sizeof buf - 1);
+}
+
+void append_hex_data(std::string& out, const CanFrame& f, char separator) {
+  static constexpr char kHex[] = "0123456789ABCDEF";
+  const std::size_t n = f.dlc < CanFrame::kMaxDlc ? f.dlc : CanFrame::kMaxDlc;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (separator != '\0' && i > 0) out += separator;
+    out += kHex[f.data[i] >> 4];
+    out += kHex[f.data[i] & 0x0F];
+  }
+}
+
+void write_names(JsonWriter& w, std::string_view key, const std::vector<std::string>& names) {
+  w.key(key).begin_array();
+  for (const auto& n : names)
+    w.string(n);
+  w.end_array();
+}
+
+void append_names(std::string& out, const std::vector<std::string>& names) {
+  if (names.empty()) {
+    out += "none";
+    return;
+  }
+  out += '[';
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (i > 0) out += ',';
+    out += names[i];
+  }
+  out += ']';
+}
+
+std::string bms_slot(int battery) {
+  return battery == 0 ? "pack" : std::to_string(battery);
+}
+
+// ---- JSON -------------------------------------------------------------------------------------
+
+struct JsonFields {
+  JsonWriter& w;
+
+  void operator()(const MotionCommand& m) const {
+    w.key("linear_speed").number(m.linear_speed);
+    w.key("spin_speed").number(m.spin_speed);
+    w.key("steering_angle").number(m.steering_angle);
+  }
+  void operator()(const MotionModeCommand& m) const {
+    w.key("mode").integer(static_cast<int>(m.mode));
+    w.key("mode_name").string(proto::to_string(m.mode));
+  }
+  void operator()(const ControlModeCommand& m) const {
+    w.key("mode").integer(static_cast<int>(m.mode));
+    w.key("mode_name").string(proto::to_string(m.mode));
+  }
+  void operator()(const ErrorClearCommand& m) const {
+    w.key("code").integer(m.code);
+    w.key("description").string(proto::error_clear_description(m.code));
+  }
+  void operator()(const UltrasonicSettingCommand& m) const { w.key("enable").boolean(m.enable); }
+  void operator()(const SystemStatus& s) const {
+    w.key("vehicle_status").integer(s.vehicle_status_raw);
+    w.key("vehicle_status_name").string(proto::to_string(s.vehicle_status));
+    w.key("control_mode").integer(s.control_mode_raw);
+    w.key("control_mode_name").string(proto::to_string(s.control_mode));
+    w.key("battery_voltage").number(s.battery_voltage);
+    w.key("error_bits").unsigned_integer(s.error_bits);
+    write_names(w, "errors", proto::error_bit_names(s.error_bits));
+    w.key("critical").boolean(proto::is_critical_error(s.error_bits));
+  }
+  void operator()(const MotionFeedback& m) const {
+    w.key("speed").number(m.speed);
+    w.key("steering_angle").number(m.steering_angle);
+  }
+  void operator()(const MotorHighSpeedFeedback& m) const {
+    w.key("motor").integer(m.motor);
+    w.key("rpm").number(m.rpm);
+    w.key("current").number(m.current);
+    w.key("position").integer(m.position);
+  }
+  void operator()(const MotorLowSpeedFeedback& m) const {
+    w.key("motor").integer(m.motor);
+    w.key("driver_voltage").number(m.driver_voltage);
+    w.key("driver_temperature").number(m.driver_temperature);
+    w.key("motor_temperature").number(m.motor_temperature);
+    w.key("driver_status").integer(m.driver_status);
+    write_names(w, "driver_status_names", proto::driver_status_names(m.driver_status));
+  }
+  void operator()(const SteeringAnglesFeedback& m) const {
+    w.key("angles").begin_array();
+    for (double a : m.angles)
+      w.number(a);
+    w.end_array();
+  }
+  void operator()(const WheelSpeedsFeedback& m) const {
+    w.key("speeds").begin_array();
+    for (double s : m.speeds)
+      w.number(s);
+    w.end_array();
+  }
+  void operator()(const MotionModeFeedback& m) const {
+    w.key("mode").integer(m.mode_raw);
+    w.key("mode_name").string(proto::to_string(m.mode));
+    w.key("switching").boolean(m.switching);
+  }
+  void operator()(const UltrasonicFeedback& m) const {
+    w.key("first_sensor").integer(m.first_sensor);
+    w.key("raw").begin_array();
+    for (auto r : m.raw)
+      w.integer(r);
+    w.end_array();
+    w.key("status").begin_array();
+    for (auto r : m.raw)
+      w.string(proto::ultrasonic_status_name(r));
+    w.end_array();
+  }
+  void operator()(const UltrasonicSettingFeedback& m) const { w.key("enabled").boolean(m.enabled); }
+  void operator()(const BmsData& b) const {
+    w.key("battery").integer(b.battery);
+    w.key("soc").number(b.soc);
+    w.key("soh").number(b.soh);
+    w.key("voltage").number(b.voltage);
+    w.key("current").number(b.current);
+    w.key("temperature").number(b.temperature);
+  }
+  void operator()(const BmsAlarm& a) const {
+    w.key("battery").integer(a.battery);
+    w.key("alarm1").integer(a.alarm1);
+    w.key("alarm2").integer(a.alarm2);
+    w.key("warning1").integer(a.warning1);
+    w.key("warning2").integer(a.warning2);
+    write_names(w, "alarms", proto::bms_status_names(a.alarm1, a.alarm2));
+    write_names(w, "warnings", proto::bms_status_names(a.warning1, a.warning2));
+  }
+};
+
+// ---- Text -------------------------------------------------------------------------------------
+
+struct TextFields {
+  std::string& out;
+
+  void operator()(const MotionCommand& m) const {
+    appendf(out, "linear=%.3f m/s spin=%.3f m/s steering=%.2f deg", m.linear_speed, m.spin_speed,
+            m.steering_angle * kDegPerRad);
+  }
+  void operator()(const MotionModeCommand& m) const {
+    appendf(out, "mode=%d (%s)", static_cast<int>(m.mode), proto::to_string(m.mode).data());
+  }
+  void operator()(const ControlModeCommand& m) const {
+    appendf(out, "mode=%d (%s)", static_cast<int>(m.mode), proto::to_string(m.mode).data());
+  }
+  void operator()(const ErrorClearCommand& m) const {
+    appendf(out, "code=0x%02X (%s)", m.code, proto::error_clear_description(m.code).c_str());
+  }
+  void operator()(const UltrasonicSettingCommand& m) const {
+    out += m.enable ? "enable=yes" : "enable=no";
+  }
+  void operator()(const SystemStatus& s) const {
+    appendf(out, "vehicle=%s control=%s battery=%.1f V errors=0x%08X ",
+            proto::to_string(s.vehicle_status).data(), proto::to_string(s.control_mode).data(),
+            s.battery_voltage, s.error_bits);
+    append_names(out, proto::error_bit_names(s.error_bits));
+    if (proto::is_critical_error(s.error_bits)) out += " CRITICAL";
+  }
+  void operator()(const MotionFeedback& m) const {
+    appendf(out, "speed=%.3f m/s steering=%.2f deg", m.speed, m.steering_angle * kDegPerRad);
+  }
+  void operator()(const MotorHighSpeedFeedback& m) const {
+    appendf(out, "motor=%d rpm=%.0f current=%.1f A position=%d", m.motor, m.rpm, m.current,
+            static_cast<int>(m.position));
+  }
+  void operator()(const MotorLowSpeedFeedback& m) const {
+    appendf(out, "motor=%d voltage=%.1f V driver=%.0f degC motor=%.0f degC status=", m.motor,
+            m.driver_voltage, m.driver_temperature, m.motor_temperature);
+    append_names(out, proto::driver_status_names(m.driver_status));
+  }
+  void operator()(const SteeringAnglesFeedback& m) const {
+    for (int i = 0; i < 4; ++i)
+      appendf(out, "%s=%.2f ", kWheelTags[i], m.angles[i] * kDegPerRad);
+    out += "deg";
+  }
+  void operator()(const WheelSpeedsFeedback& m) const {
+    for (int i = 0; i < 4; ++i)
+      appendf(out, "%s=%.3f ", kWheelTags[i], m.speeds[i]);
+    out += "m/s";
+  }
+  void operator()(const MotionModeFeedback& m) const {
+    appendf(out, "mode=%d (%s) switching=%s", m.mode_raw, proto::to_string(m.mode).data(),
+            m.switching ? "yes" : "no");
+  }
+  void operator()(const UltrasonicFeedback& m) const {
+    for (int i = 0; i < 4; ++i) {
+      if (i > 0) out += ' ';
+      if (m.raw[i] >= 0) {
+        appendf(out, "s%d=%d mm", m.first_sensor + i, m.raw[i]);
+      } else {
+        appendf(out, "s%d=%s", m.first_sensor + i, proto::ultrasonic_status_name(m.raw[i]).data());
+      }
+    }
+  }
+  void operator()(const UltrasonicSettingFeedback& m) const {
+    out += m.enabled ? "enabled=yes" : "enabled=no";
+  }
+  void operator()(const BmsData& b) const {
+    appendf(out,
+            "battery=%s soc=%.0f%% soh=%.0f%% voltage=%.2f V current=%.1f A temperature=%.1f degC",
+            bms_slot(b.battery).c_str(), b.soc, b.soh, b.voltage, b.current, b.temperature);
+  }
+  void operator()(const BmsAlarm& a) const {
+    appendf(out, "battery=%s alarms=", bms_slot(a.battery).c_str());
+    append_names(out, proto::bms_status_names(a.alarm1, a.alarm2));
+    out += " warnings=";
+    append_names(out, proto::bms_status_names(a.warning1, a.warning2));
+  }
+};
+
+std::string_view name_of(const CanFrame& f) {
+  return f.is_error ? std::string_view("error_frame") : proto::frame_name(f.id);
+}
+
+}  // namespace
+
+void write_message_json(JsonWriter& w, const Message& message) {
+  std::visit(JsonFields{w}, message);
+}
+
+void append_message_text(std::string& out, const Message& message) {
+  std::visit(TextFields{out}, message);
+}
+
+void append_frame_json(std::string& out, const CanFrame& frame, std::string_view iface) {
+  JsonWriter w(out);
+  w.begin_object();
+  w.key("t").seconds(frame.stamp);
+  w.key("iface").string(iface);
+  w.key("id").unsigned_integer(frame.id);
+  w.key("name").string(name_of(frame));
+  w.key("dlc").integer(frame.dlc);
+  w.key("data");
+  std::string hex;
+  append_hex_data(hex, frame, '\0');
+  w.string(hex);
+  const Result<Message> decoded = decode(frame);
+  if (decoded) {
+    write_message_json(w, *decoded);
+  } else {
+    w.key("error").string(decoded.error().message);
+  }
+  w.end_object();
+}
+
+void append_frame_text(std::string& out, const CanFrame& frame, std::string_view iface) {
+  append_seconds(out, frame.stamp);
+  out += ' ';
+  out.append(iface.data(), iface.size());
+  if (frame.is_error) {
+    appendf(out, " %08X", frame.id);
+  } else {
+    appendf(out, " %03X", frame.id);
+  }
+  appendf(out, " %-28s ", std::string(name_of(frame)).c_str());
+  const Result<Message> decoded = decode(frame);
+  if (decoded) {
+    append_message_text(out, *decoded);
+  } else {
+    out += "error: " + decoded.error().message + "  [";
+    out += std::to_string(frame.dlc);
+    out += "] ";
+    append_hex_data(out, frame, ' ');
+  }
+}
+
+}  // namespace ranger::cli

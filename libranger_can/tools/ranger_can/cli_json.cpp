@@ -1,0 +1,151 @@
+#include "cli_json.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+
+namespace ranger::cli {
+
+void append_json_number(std::string& out, double v) {
+  if (!std::isfinite(v)) {
+    out += "null";
+    return;
+  }
+  char buf[32];
+  const auto res = std::to_chars(buf, buf + sizeof buf, v);  // shortest round-trip form
+  out.append(buf, res.ptr);
+  // Keep doubles recognisable as such ("0.0", not "0"): JSON readers that type numbers (Python,
+  // jq's tonumber round trips) then see a float for every physical quantity.
+  bool has_fraction_or_exponent = false;
+  for (const char* p = buf; p != res.ptr; ++p) {
+    if (*p == '.' || *p == 'e') has_fraction_or_exponent = true;
+  }
+  if (!has_fraction_or_exponent) out += ".0";
+}
+
+void append_json_string(std::string& out, std::string_view v) {
+  static constexpr char kHex[] = "0123456789abcdef";
+  out += '"';
+  for (const char ch : v) {
+    const auto c = static_cast<unsigned char>(ch);
+    switch (c) {
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      default:
+        if (c < 0x20 || c >= 0x7F) {  // control bytes and anything non-ASCII (may be bad UTF-8)
+          out += "\\u00";
+          out += kHex[c >> 4];
+          out += kHex[c & 0x0F];
+        } else {
+          out += ch;
+        }
+    }
+  }
+  out += '"';
+}
+
+void append_seconds(std::string& out, Timestamp t) {
+  const long long ns = t.count();
+  const unsigned long long mag =
+      ns < 0 ? 0ULL - static_cast<unsigned long long>(ns) : static_cast<unsigned long long>(ns);
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%s%llu.%06llu", ns < 0 ? "-" : "", mag / 1000000000ULL,
+                mag % 1000000000ULL / 1000ULL);
+  out += buf;
+}
+
+void JsonWriter::before_value() {
+  if (need_comma_) out_ += ',';
+  need_comma_ = true;
+}
+
+JsonWriter& JsonWriter::begin_object() {
+  before_value();
+  out_ += '{';
+  need_comma_ = false;
+  return *this;
+}
+
+JsonWriter& JsonWriter::end_object() {
+  out_ += '}';
+  need_comma_ = true;
+  return *this;
+}
+
+JsonWriter& JsonWriter::begin_array() {
+  before_value();
+  out_ += '[';
+  need_comma_ = false;
+  return *this;
+}
+
+JsonWriter& JsonWriter::end_array() {
+  out_ += ']';
+  need_comma_ = true;
+  return *this;
+}
+
+JsonWriter& JsonWriter::key(std::string_view name) {
+  before_value();
+  append_json_string(out_, name);
+  out_ += ':';
+  need_comma_ = false;
+  return *this;
+}
+
+JsonWriter& JsonWriter::number(double v) {
+  before_value();
+  append_json_number(out_, v);
+  return *this;
+}
+
+JsonWriter& JsonWriter::integer(std::int64_t v) {
+  before_value();
+  out_ += std::to_string(v);
+  return *this;
+}
+
+JsonWriter& JsonWriter::unsigned_integer(std::uint64_t v) {
+  before_value();
+  out_ += std::to_string(v);
+  return *this;
+}
+
+JsonWriter& JsonWriter::boolean(bool v) {
+  before_value();
+  out_ += v ? "true" : "false";
+  return *this;
+}
+
+JsonWriter& JsonWriter::string(std::string_view v) {
+  before_value();
+  append_json_string(out_, v);
+  return *this;
+}
+
+JsonWriter& JsonWriter::null() {
+  before_value();
+  out_ += "null";
+  return *this;
+}
+
+JsonWriter& JsonWriter::seconds(Timestamp t) {
+  before_value();
+  append_seconds(out_, t);
+  return *this;
+}
+
+}  // namespace ranger::cli

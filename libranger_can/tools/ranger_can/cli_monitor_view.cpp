@@ -1,0 +1,436 @@
+#include "cli_monitor_view.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <type_traits>
+#include <vector>
+
+#include "cli_json.hpp"
+#include "ranger_can/geometry.hpp"
+#include "ranger_can/interpretation.hpp"
+#include "ranger_can/protocol.hpp"
+
+namespace ranger::cli {
+
+namespace {
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+
+struct Style {
+  bool color;
+  std::string red(const std::string& s) const { return color ? "\x1b[31m" + s + "\x1b[0m" : s; }
+  std::string yellow(const std::string& s) const { return color ? "\x1b[33m" + s + "\x1b[0m" : s; }
+  std::string green(const std::string& s) const { return color ? "\x1b[32m" + s + "\x1b[0m" : s; }
+  std::string bold(const std::string& s) const { return color ? "\x1b[1m" + s + "\x1b[0m" : s; }
+};
+
+std::string fmt(const char* format, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, format, v);
+  return buf;
+}
+
+// An angle in the manual's sign (positive = right) shown unambiguously: "12.50 deg left".
+std::string steering_text(double manual_rad) {
+  const double rep = interpretation::rep103_from_manual_steering(manual_rad) * kRadToDeg;
+  if (std::abs(rep) < 0.005) return "  0.00 deg straight";
+  return fmt("%6.2f deg ", std::abs(rep)) + (rep > 0 ? "left " : "right");
+}
+std::string wheel_angle_text(double manual_rad) {
+  const double rep = interpretation::rep103_from_manual_wheel_angle(manual_rad) * kRadToDeg;
+  if (std::abs(rep) < 0.005) return "  0.00 deg      ";
+  return fmt("%6.2f deg ", std::abs(rep)) + (rep > 0 ? "left " : "right");
+}
+
+std::string age_text(Timestamp received, Timestamp now) {
+  const double ms = std::chrono::duration<double, std::milli>(now - received).count();
+  if (ms < 1000) return fmt("%.0f ms ago", ms);
+  return fmt("%.1f s ago", ms / 1000);
+}
+
+std::string hex_id(std::uint32_t id) {
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "0x%03X", id);
+  return buf;
+}
+
+// Nominal frames per second of a feedback ID (0 for commands and on-change frames).
+double nominal_rate(std::uint32_t id) {
+  if (id == protocol::kSystemStatusId || id == protocol::kMotionFeedbackId ||
+      id == protocol::kSteeringAnglesId || id == protocol::kWheelSpeedsId ||
+      id == protocol::kMotionModeFeedbackId ||
+      (id > protocol::kMotorHighSpeedBaseId && id <= protocol::kMotorHighSpeedBaseId + 8)) {
+    return 1000.0 / protocol::kFastPeriodMs;
+  }
+  if (id == protocol::kUltrasonic1to4Id || id == protocol::kUltrasonic5to8Id) {
+    return 1000.0 / protocol::kUltrasonicPeriodMs;
+  }
+  if (id > protocol::kMotorLowSpeedBaseId && id <= protocol::kMotorLowSpeedBaseId + 8) {
+    return 1000.0 / protocol::kSlowPeriodMs;
+  }
+  if (id >= protocol::kBmsBaseId && id < protocol::kBmsBaseId + 10) {
+    return 1000.0 / protocol::kBmsPeriodMs;
+  }
+  return 0.0;
+}
+
+std::string ultrasonic_text(std::int16_t raw) {
+  if (raw >= 0) return std::to_string(raw) + " mm";
+  return std::string(protocol::ultrasonic_status_name(raw));
+}
+
+template <typename T>
+void store(std::optional<Stamped<T>>& slot, const T& v, const CanFrame& f, Timestamp now) {
+  slot = Stamped<T>{v, now, f.stamp};
+}
+
+}  // namespace
+
+ChassisMonitor::ChassisMonitor(std::chrono::nanoseconds rate_window) : window_(rate_window) {}
+
+void ChassisMonitor::on_frame(const CanFrame& frame, Timestamp now) {
+  if (frame.is_error) {
+    ++error_frames_;
+    return;
+  }
+  ++frames_;
+  auto& q = arrivals_[frame.id];
+  q.push_back(now);
+  while (!q.empty() && q.front() <= now - window_)
+    q.pop_front();
+
+  auto decoded = decode(frame);
+  if (!decoded) {
+    ++decode_errors_;
+    return;
+  }
+  std::visit(
+      [&](const auto& m) {
+        using T = std::decay_t<decltype(m)>;
+        if constexpr (std::is_same_v<T, MotionCommand>) {
+          motion_command_ = Seen<MotionCommand>{m, now};
+        } else if constexpr (std::is_same_v<T, MotionModeCommand>) {
+          motion_mode_command_ = Seen<MotionModeCommand>{m, now};
+        } else if constexpr (std::is_same_v<T, ControlModeCommand>) {
+          control_mode_command_ = Seen<ControlModeCommand>{m, now};
+        } else if constexpr (std::is_same_v<T, ErrorClearCommand>) {
+          error_clear_command_ = Seen<ErrorClearCommand>{m, now};
+        } else if constexpr (std::is_same_v<T, UltrasonicSettingCommand>) {
+          // shown through the chassis's 0x45A answer
+        } else {
+          ++feedback_frames_;
+          if constexpr (std::is_same_v<T, SystemStatus>) store(fb_.system_status, m, frame, now);
+          if constexpr (std::is_same_v<T, MotionFeedback>) store(fb_.motion, m, frame, now);
+          if constexpr (std::is_same_v<T, MotionModeFeedback>)
+            store(fb_.motion_mode, m, frame, now);
+          if constexpr (std::is_same_v<T, SteeringAnglesFeedback>) {
+            store(fb_.steering_angles, m, frame, now);
+          }
+          if constexpr (std::is_same_v<T, WheelSpeedsFeedback>)
+            store(fb_.wheel_speeds, m, frame, now);
+          if constexpr (std::is_same_v<T, MotorHighSpeedFeedback>) {
+            if (m.motor >= 1 && m.motor <= protocol::kMotorCount) {
+              store(fb_.motor_high_speed[m.motor - 1], m, frame, now);
+            }
+          }
+          if constexpr (std::is_same_v<T, MotorLowSpeedFeedback>) {
+            if (m.motor >= 1 && m.motor <= protocol::kMotorCount) {
+              store(fb_.motor_low_speed[m.motor - 1], m, frame, now);
+            }
+          }
+          if constexpr (std::is_same_v<T, BmsData>) {
+            if (m.battery >= 0 && m.battery <= protocol::kBatteryCount)
+              store(fb_.bms[m.battery], m, frame, now);
+          }
+          if constexpr (std::is_same_v<T, BmsAlarm>) {
+            if (m.battery >= 0 && m.battery <= protocol::kBatteryCount) {
+              store(fb_.bms_alarm[m.battery], m, frame, now);
+            }
+          }
+          if constexpr (std::is_same_v<T, UltrasonicFeedback>) {
+            store(fb_.ultrasonic[m.first_sensor == 5 ? 1 : 0], m, frame, now);
+          }
+          if constexpr (std::is_same_v<T, UltrasonicSettingFeedback>) {
+            store(fb_.ultrasonic_setting, m, frame, now);
+          }
+        }
+      },
+      *decoded);
+}
+
+double ChassisMonitor::rate(std::uint32_t id, Timestamp now) const {
+  auto it = arrivals_.find(id);
+  if (it == arrivals_.end()) return 0.0;
+  // Intervals between the frames inside the window: (n - 1) / (last - first). Unbiased whatever
+  // the phase of the window, and right from the second frame on.
+  Timestamp first{0}, last{0};
+  long n = 0;
+  for (Timestamp t : it->second) {
+    if (t <= now - window_ || t > now) continue;
+    if (n++ == 0) first = t;
+    last = t;
+  }
+  const double span = std::chrono::duration<double>(last - first).count();
+  return n >= 2 && span > 0 ? static_cast<double>(n - 1) / span : 0.0;
+}
+
+std::string ChassisMonitor::render_text(std::string_view iface, const BusStatus& bus, Timestamp now,
+                                        bool color) const {
+  const Style st{color};
+  std::string o;
+  auto line = [&](const std::string& s) { o += s + "\n"; };
+
+  std::string bus_state(to_string(bus.state));
+  bus_state = bus.state == BusState::kActive ? st.green(bus_state) : st.red(bus_state);
+  double total_rate = 0;
+  for (const auto& [id, q] : arrivals_)
+    total_rate += rate(id, now);
+  line(st.bold("RANGER monitor  " + std::string(iface)) + "   bus " + bus_state +
+       (bus.detail.empty() ? "" : " (" + bus.detail + ")") + "   frames " +
+       std::to_string(frames_) + fmt("  %.0f/s", total_rate) + "   undecodable " +
+       std::to_string(decode_errors_) + "   error frames " +
+       std::to_string(error_frames_ + bus.stats.error_frames) + "   dropped rx/tx " +
+       std::to_string(bus.stats.rx_dropped) + "/" + std::to_string(bus.stats.tx_dropped));
+
+  if (!fb_.system_status) {
+    line(st.red(frames_ == 0 ? "no frames received yet: is the chassis on and the bus up?"
+                             : "no 0x211 system status received yet"));
+  } else {
+    const auto& s = fb_.system_status->value;
+    const bool stale = now - fb_.system_status->received > std::chrono::milliseconds(500);
+    std::string control(protocol::to_string(s.control_mode));
+    if (s.control_mode != protocol::ControlMode::kCan) control = st.yellow(control);
+    std::string vehicle(protocol::to_string(s.vehicle_status));
+    if (s.vehicle_status != protocol::VehicleStatus::kNormal) vehicle = st.red(vehicle);
+    std::string age = "last 0x211 " + age_text(fb_.system_status->received, now);
+    if (stale) age = st.red(age + "  CHASSIS SILENT");
+    line("Chassis   control " + control + "   vehicle " + vehicle +
+         fmt("   battery %.1f V", s.battery_voltage) + "   " + age);
+    const auto names = protocol::error_bit_names(s.error_bits);
+    if (names.empty()) {
+      line("Errors    " + st.green("none"));
+    } else {
+      std::string errs;
+      for (const auto& n : names)
+        errs += (errs.empty() ? "" : ", ") + n;
+      char word[16];
+      std::snprintf(word, sizeof word, "0x%08X", s.error_bits);
+      line("Errors    " + st.red(errs) + "  (" + word + ")");
+    }
+  }
+
+  std::string motion = "Motion    mode ";
+  if (fb_.motion_mode) {
+    const auto& m = fb_.motion_mode->value;
+    motion += std::string(protocol::to_string(m.mode));
+    motion += m.switching ? "   " + st.yellow("SWITCHING") : "   switching no";
+  } else {
+    motion += "?";
+  }
+  if (fb_.motion) {
+    const auto& m = fb_.motion->value;
+    motion += fmt("   speed %+.3f m/s", m.speed) + "   steering " + steering_text(m.steering_angle);
+  }
+  line(motion);
+
+  std::string host = "Host      ";
+  if (motion_command_) {
+    const auto& c = motion_command_->value;
+    host += fmt("0x111 speed %+.3f m/s", c.linear_speed) + "  steer " +
+            steering_text(c.steering_angle) + fmt("  spin %+.3f m/s", c.spin_speed) + "  (" +
+            age_text(motion_command_->received, now) +
+            fmt(", %.1f/s)", rate(protocol::kMotionCommandId, now));
+  } else {
+    host += st.yellow("no 0x111 seen");
+  }
+  if (control_mode_command_) {
+    host += "   0x421 " + std::string(protocol::to_string(control_mode_command_->value.mode));
+  }
+  if (motion_mode_command_) {
+    host += "   0x141 " + std::string(protocol::to_string(motion_mode_command_->value.mode));
+  }
+  if (error_clear_command_) host += fmt("   0x441 %.0f", error_clear_command_->value.code);
+  line(host);
+
+  line(
+      "Wheels         steering           speed      drive rpm      A   steer rpm      A   drv/mot "
+      "degC  driver status");
+  for (int i = 0; i < kWheelCount; ++i) {
+    std::string row = "  " + std::string(kWheelNames[i]);
+    row.resize(14, ' ');
+    row += fb_.steering_angles ? wheel_angle_text(fb_.steering_angles->value.angles[i])
+                               : std::string("      ?         ");
+    row +=
+        fb_.wheel_speeds ? fmt("  %+7.3f m/s", fb_.wheel_speeds->value.speeds[i]) : "        ?    ";
+    const auto& drive = fb_.motor_high_speed[i];
+    const auto& steer = fb_.motor_high_speed[i + kWheelCount];
+    row += drive ? fmt("  %+9.1f", drive->value.rpm) + fmt(" %+6.1f", drive->value.current)
+                 : "          ?      ?";
+    row += steer ? fmt("  %+9.1f", steer->value.rpm) + fmt(" %+6.1f", steer->value.current)
+                 : "          ?      ?";
+    const auto& low = fb_.motor_low_speed[i];
+    if (low) {
+      row += fmt("   %3.0f", low->value.driver_temperature) +
+             fmt("/%-3.0f", low->value.motor_temperature);
+      std::string status;
+      for (int m : {i, i + kWheelCount}) {
+        const auto& l = fb_.motor_low_speed[m];
+        if (!l) continue;
+        for (const auto& n : protocol::driver_status_names(l->value.driver_status)) {
+          status += (status.empty() ? "" : ",") + n + "(m" + std::to_string(m + 1) + ")";
+        }
+      }
+      row += "      " + (status.empty() ? st.green("ok") : st.red(status));
+    }
+    line(row);
+  }
+
+  for (int b = 0; b <= protocol::kBatteryCount; ++b) {
+    if (!fb_.bms[b]) continue;
+    const auto& d = fb_.bms[b]->value;
+    std::string row = b == 0 ? "Battery   pack  " : "          bat " + std::to_string(b) + " ";
+    std::string soc = fmt("SOC %5.1f%%", d.soc);
+    if (d.soc < 10) {
+      soc = st.red(soc);
+    } else if (d.soc < 15) {
+      soc = st.yellow(soc);
+    }
+    row += soc + fmt("  SOH %5.1f%%", d.soh) + fmt("  %6.2f V", d.voltage) +
+           fmt("  %+6.1f A", d.current) + fmt("  %5.1f degC", d.temperature);
+    if (fb_.bms_alarm[b]) {
+      const auto& a = fb_.bms_alarm[b]->value;
+      auto names = [](std::uint8_t s1, std::uint8_t s2) {
+        std::string out;
+        for (const auto& bit : protocol::bms_status1_bits()) {
+          if (s1 & (1u << bit.index)) out += (out.empty() ? "" : ",") + std::string(bit.name);
+        }
+        for (const auto& bit : protocol::bms_status2_bits()) {
+          if (s2 & (1u << bit.index)) out += (out.empty() ? "" : ",") + std::string(bit.name);
+        }
+        return out.empty() ? std::string("none") : out;
+      };
+      const std::string alarms = names(a.alarm1, a.alarm2);
+      const std::string warnings = names(a.warning1, a.warning2);
+      row += "  alarms " + (alarms == "none" ? alarms : st.red(alarms)) + "  warnings " +
+             (warnings == "none" ? warnings : st.yellow(warnings));
+    }
+    line(row);
+  }
+
+  std::string us = "Ultrasonic avoidance ";
+  us += fb_.ultrasonic_setting ? (fb_.ultrasonic_setting->value.enabled ? "enabled" : "disabled")
+                               : "? (no 0x45A yet)";
+  for (int k = 0; k < 2; ++k) {
+    if (!fb_.ultrasonic[k]) continue;
+    for (int i = 0; i < 4; ++i) {
+      us += "  " + std::to_string(fb_.ultrasonic[k]->value.first_sensor + i) + ":" +
+            ultrasonic_text(fb_.ultrasonic[k]->value.raw[i]);
+    }
+  }
+  line(us);
+
+  // Frame rates: every ID seen, plus the periodic feedback IDs that are missing.
+  line("Rates /s  (expected in brackets; " + st.red("red") + " = more than 20% off)");
+  std::vector<std::uint32_t> ids;
+  for (const auto& [id, q] : arrivals_)
+    ids.push_back(id);
+  for (auto id : protocol::all_ids()) {
+    const bool optional_battery = id >= protocol::kBmsBaseId + 2 && id < protocol::kBmsBaseId + 10;
+    if (nominal_rate(id) > 0 && !optional_battery && !arrivals_.count(id)) ids.push_back(id);
+  }
+  std::sort(ids.begin(), ids.end());
+  std::string row;
+  int in_row = 0;
+  for (auto id : ids) {
+    const double r = rate(id, now);
+    const double nominal = nominal_rate(id);
+    std::string cell = hex_id(id) + fmt(" %5.1f", r);
+    cell += nominal > 0 ? fmt(" (%2.0f)", nominal) : "     ";
+    if (nominal > 0 && std::abs(r - nominal) > 0.2 * nominal) cell = st.red(cell);
+    row += "  " + cell;
+    if (++in_row == 6) {
+      line(row);
+      row.clear();
+      in_row = 0;
+    }
+  }
+  if (!row.empty()) line(row);
+  return o;
+}
+
+std::string ChassisMonitor::render_json(std::string_view iface, const BusStatus& bus,
+                                        Timestamp now) const {
+  std::string out;
+  JsonWriter w(out);
+  w.begin_object();
+  w.key("iface").string(iface);
+  w.key("bus").begin_object();
+  w.key("state").string(to_string(bus.state));
+  w.key("rx_dropped").unsigned_integer(bus.stats.rx_dropped);
+  w.key("tx_dropped").unsigned_integer(bus.stats.tx_dropped);
+  w.key("error_frames").unsigned_integer(bus.stats.error_frames + error_frames_);
+  w.end_object();
+  w.key("frames").unsigned_integer(frames_);
+  w.key("undecodable").unsigned_integer(decode_errors_);
+  if (fb_.system_status) {
+    const auto& s = fb_.system_status->value;
+    w.key("control_mode").string(protocol::to_string(s.control_mode));
+    w.key("vehicle_status").string(protocol::to_string(s.vehicle_status));
+    w.key("battery_voltage").number(s.battery_voltage);
+    w.key("error_bits").unsigned_integer(s.error_bits);
+    w.key("errors").begin_array();
+    for (const auto& n : protocol::error_bit_names(s.error_bits))
+      w.string(n);
+    w.end_array();
+    w.key("status_age")
+        .number(std::chrono::duration<double>(now - fb_.system_status->received).count());
+  }
+  if (fb_.motion_mode) {
+    w.key("motion_mode").string(protocol::to_string(fb_.motion_mode->value.mode));
+    w.key("switching").boolean(fb_.motion_mode->value.switching);
+  }
+  if (fb_.motion) {
+    w.key("speed").number(fb_.motion->value.speed);
+    w.key("steering_angle").number(fb_.motion->value.steering_angle);
+  }
+  if (fb_.steering_angles && fb_.wheel_speeds) {
+    w.key("wheels").begin_array();
+    for (int i = 0; i < kWheelCount; ++i) {
+      w.begin_object()
+          .key("name")
+          .string(kWheelNames[i])
+          .key("angle")
+          .number(fb_.steering_angles->value.angles[i])
+          .key("speed")
+          .number(fb_.wheel_speeds->value.speeds[i])
+          .end_object();
+    }
+    w.end_array();
+  }
+  if (fb_.bms[0]) {
+    const auto& b = fb_.bms[0]->value;
+    w.key("battery").begin_object();
+    w.key("soc").number(b.soc).key("soh").number(b.soh).key("voltage").number(b.voltage);
+    w.key("current").number(b.current).key("temperature").number(b.temperature);
+    w.end_object();
+  }
+  if (fb_.ultrasonic_setting)
+    w.key("ultrasonic_enabled").boolean(fb_.ultrasonic_setting->value.enabled);
+  if (motion_command_) {
+    w.key("host_motion_command").begin_object();
+    w.key("linear_speed").number(motion_command_->value.linear_speed);
+    w.key("spin_speed").number(motion_command_->value.spin_speed);
+    w.key("steering_angle").number(motion_command_->value.steering_angle);
+    w.key("age").number(std::chrono::duration<double>(now - motion_command_->received).count());
+    w.end_object();
+  }
+  w.key("rates").begin_object();
+  for (const auto& [id, q] : arrivals_)
+    w.key(hex_id(id)).number(rate(id, now));
+  w.end_object();
+  w.end_object();
+  return out;
+}
+
+}  // namespace ranger::cli

@@ -1,0 +1,63 @@
+// What `ranger_can monitor` knows about a chassis and how it shows it: the latest of every
+// feedback message, the commands other nodes sent, frame rates per ID over a sliding window, and
+// a text (ANSI) or JSON rendering. No bus and no clock in here: the sub-command feeds frames with
+// its own time, and tests feed them from a virtual chassis.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "ranger_can/bus.hpp"
+#include "ranger_can/codec.hpp"
+#include "ranger_can/controller.hpp"  // ChassisFeedback, Stamped
+#include "ranger_can/frame.hpp"
+
+namespace ranger::cli {
+
+class ChassisMonitor {
+ public:
+  explicit ChassisMonitor(std::chrono::nanoseconds rate_window = std::chrono::seconds(1));
+
+  // A frame received at `now` (the monitor's clock).
+  void on_frame(const CanFrame& frame, Timestamp now);
+
+  // The full view; `color` adds ANSI colours. Lines end with '\n'.
+  std::string render_text(std::string_view iface, const BusStatus& bus, Timestamp now,
+                          bool color) const;
+  // The same content as one JSON object (no newline). Angles and speeds as on the wire (SI units,
+  // the manual's signs), like `ranger_can decode --json`.
+  std::string render_json(std::string_view iface, const BusStatus& bus, Timestamp now) const;
+
+  // Frames per second of `id` over the window ending at `now`.
+  double rate(std::uint32_t id, Timestamp now) const;
+  std::uint64_t frames() const { return frames_; }
+  // True once any chassis feedback frame decoded.
+  bool heard_chassis() const { return feedback_frames_ > 0; }
+  const ChassisFeedback& feedback() const { return fb_; }
+
+ private:
+  template <typename T>
+  struct Seen {
+    T value;
+    Timestamp received{0};
+  };
+
+  std::chrono::nanoseconds window_;
+  ChassisFeedback fb_;
+  std::optional<Seen<MotionCommand>> motion_command_;  // commands from other nodes (the host)
+  std::optional<Seen<MotionModeCommand>> motion_mode_command_;
+  std::optional<Seen<ControlModeCommand>> control_mode_command_;
+  std::optional<Seen<ErrorClearCommand>> error_clear_command_;
+  std::map<std::uint32_t, std::deque<Timestamp>> arrivals_;
+  std::uint64_t frames_ = 0;
+  std::uint64_t feedback_frames_ = 0;
+  std::uint64_t decode_errors_ = 0;
+  std::uint64_t error_frames_ = 0;
+};
+
+}  // namespace ranger::cli

@@ -1,0 +1,226 @@
+#include "cli_sim_control.hpp"
+
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+#include <vector>
+
+#include "cli_args.hpp"
+#include "ranger_can/protocol.hpp"
+
+namespace ranger::cli {
+
+const char* const kSimControlHelp =
+    "control commands (one per line):\n"
+    "  remote on|can|off|lost   the remote control takes over | hands back to CAN command mode |\n"
+    "                           is switched off (standby) | loses its signal (standby + error)\n"
+    "  estop on|off             press / release the emergency stop\n"
+    "  error BIT|NAME [on|off]  raise (default) or drop a 0x211 error bit: 0-31 or its name,\n"
+    "                           e.g. 'error 9' = host_communication_lost, 'error 15 off'\n"
+    "  clear [CODE]             what 0x441 CODE does (0-16 or 0x00-0x10, default 0)\n"
+    "  battery PCT              set the state of charge (below 10: power cut, refuses motion)\n"
+    "  silent SEC|on|off        send nothing for SEC seconds / until 'silent off'\n"
+    "  garbage N                send N frames a driver must reject (unknown IDs, bad DLC)\n"
+    "  stuck on|off             motion-mode switches never complete / complete again\n"
+    "  ultrasonic N|all MM      distance of sensor N (1-8) or all sensors, mm (-1..-4: codes)\n"
+    "  ultrasonic on|off        obstacle avoidance, as the remote's SWC switch sets it\n"
+    "  pose X Y YAW             move the ground truth (m, m, rad)\n"
+    "  status                   print the chassis state\n"
+    "  wait SEC                 hold the following commands for SEC seconds (scripting)\n"
+    "  help                     this list\n"
+    "  quit                     stop the simulator\n";
+
+namespace {
+
+std::vector<std::string> split(std::string_view line) {
+  std::vector<std::string> words;
+  std::istringstream in{std::string(line)};
+  std::string w;
+  while (in >> w)
+    words.push_back(w);
+  return words;
+}
+
+Error usage(const std::string& what) {
+  return Error{Errc::kInvalidArgument, what};
+}
+
+Result<bool> parse_on_off(const std::string& command, const std::string& word) {
+  if (word == "on") return true;
+  if (word == "off") return false;
+  return usage(command + ": expected 'on' or 'off', got '" + word + "'");
+}
+
+std::string fixed(double v, int decimals) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+  return buf;
+}
+
+}  // namespace
+
+Result<int> parse_error_bit(const std::string& text) {
+  if (!text.empty() && (std::isdigit(static_cast<unsigned char>(text[0])) != 0)) {
+    auto n = parse_integer("error bit", text, 0, 31);
+    if (!n) return n.error();
+    return static_cast<int>(*n);
+  }
+  std::string names;
+  for (const auto& b : protocol::system_error_bits()) {
+    if (b.name == text) return b.index;
+    names += (names.empty() ? "" : ", ") + std::string(b.name);
+  }
+  return Error{Errc::kInvalidArgument,
+               "unknown error bit '" + text + "' (give 0-31 or one of: " + names + ")"};
+}
+
+std::string describe_chassis(const sim::ChassisSnapshot& s) {
+  std::string out;
+  out += "control " + std::string(protocol::to_string(s.control_mode));
+  out += ", motion " + std::string(protocol::to_string(s.motion_mode));
+  if (s.switching)
+    out += " (switching to " + std::string(protocol::to_string(s.switch_target)) + ")";
+  out += ", vehicle " + std::string(protocol::to_string(s.vehicle_status));
+  out +=
+      ", speed " + fixed(s.speed, 3) + ", steering " + fixed(s.steering * 180 / M_PI, 1) + " deg";
+  out += ", twist (" + fixed(s.twist.vx, 3) + ", " + fixed(s.twist.vy, 3) + ", " +
+         fixed(s.twist.wz, 3) + ")";
+  out += ", pose (" + fixed(s.pose.x, 3) + ", " + fixed(s.pose.y, 3) + ", " +
+         fixed(s.pose.yaw * 180 / M_PI, 1) + " deg)";
+  out += ", battery " + fixed(s.battery.soc, 1) + "% " + fixed(s.battery.voltage, 1) + " V";
+  out += ", errors ";
+  const auto names = protocol::error_bit_names(s.error_bits);
+  if (names.empty()) out += "none";
+  for (std::size_t i = 0; i < names.size(); ++i)
+    out += (i ? "," : "") + names[i];
+  out += s.motion_allowed ? ", motion allowed" : ", motion refused: " + s.motion_refused_reason;
+  if (s.silent) out += ", SILENT";
+  return out;
+}
+
+Result<std::string> apply_sim_command(std::string_view line, sim::VirtualChassis& chassis) {
+  const auto w = split(line);
+  if (w.empty() || w[0][0] == '#') return std::string();
+  const std::string& cmd = w[0];
+  auto need = [&](std::size_t n, const char* form) -> Status {
+    if (w.size() != n) return usage("usage: " + std::string(form));
+    return ok_status();
+  };
+
+  if (cmd == "remote") {
+    if (auto s = need(2, "remote on|can|off|lost"); !s) return s.error();
+    if (w[1] == "on") {
+      chassis.remote_takeover();
+    } else if (w[1] == "can") {
+      chassis.remote_hand_back(false);
+    } else if (w[1] == "off") {
+      chassis.remote_hand_back(true);
+    } else if (w[1] == "lost") {
+      chassis.remote_signal_lost();
+    } else {
+      return usage("remote: expected on|can|off|lost, got '" + w[1] + "'");
+    }
+    return std::string();
+  }
+  if (cmd == "estop") {
+    if (auto s = need(2, "estop on|off"); !s) return s.error();
+    auto on = parse_on_off(cmd, w[1]);
+    if (!on) return on.error();
+    chassis.set_emergency_stop(*on);
+    return std::string();
+  }
+  if (cmd == "error") {
+    if (w.size() != 2 && w.size() != 3) return usage("usage: error BIT|NAME [on|off]");
+    auto bit = parse_error_bit(w[1]);
+    if (!bit) return bit.error();
+    bool on = true;
+    if (w.size() == 3) {
+      auto v = parse_on_off(cmd, w[2]);
+      if (!v) return v.error();
+      on = *v;
+    }
+    chassis.set_error_bit(*bit, on);
+    return std::string();
+  }
+  if (cmd == "clear") {
+    if (w.size() > 2) return usage("usage: clear [CODE]");
+    std::int64_t code = 0;
+    if (w.size() == 2) {
+      auto c = parse_integer("clear CODE", w[1], 0, protocol::kMaxErrorClearCode);
+      if (!c) return c.error();
+      code = *c;
+    }
+    chassis.clear_errors(static_cast<std::uint8_t>(code));
+    return std::string();
+  }
+  if (cmd == "battery") {
+    if (auto s = need(2, "battery PCT"); !s) return s.error();
+    auto pct = parse_double_in("battery PCT", w[1], 0.0, 100.0);
+    if (!pct) return pct.error();
+    chassis.set_battery_soc(*pct);
+    return std::string();
+  }
+  if (cmd == "silent") {
+    if (auto s = need(2, "silent SEC|on|off"); !s) return s.error();
+    if (w[1] == "on" || w[1] == "off") {
+      chassis.set_silent(w[1] == "on");
+    } else {
+      auto sec = parse_double_in("silent SEC", w[1], 0.0, 86400.0);
+      if (!sec) return sec.error();
+      chassis.silence_for(std::chrono::duration_cast<std::chrono::nanoseconds>(
+          std::chrono::duration<double>(*sec)));
+    }
+    return std::string();
+  }
+  if (cmd == "garbage") {
+    if (auto s = need(2, "garbage N"); !s) return s.error();
+    auto n = parse_integer("garbage N", w[1], 1, 100000);
+    if (!n) return n.error();
+    chassis.inject_garbage(static_cast<int>(*n));
+    return std::string();
+  }
+  if (cmd == "stuck") {
+    if (auto s = need(2, "stuck on|off"); !s) return s.error();
+    auto on = parse_on_off(cmd, w[1]);
+    if (!on) return on.error();
+    chassis.set_mode_switch_stuck(*on);
+    return std::string();
+  }
+  if (cmd == "ultrasonic") {
+    if (w.size() == 2) {
+      auto on = parse_on_off(cmd, w[1]);
+      if (!on) return on.error();
+      chassis.set_ultrasonic_enabled(*on);
+      return std::string();
+    }
+    if (w.size() != 3) return usage("usage: ultrasonic N|all MM  or  ultrasonic on|off");
+    auto mm = parse_integer("ultrasonic MM", w[2], -4, 32767);
+    if (!mm) return mm.error();
+    if (w[1] == "all") {
+      for (int n = 1; n <= protocol::kUltrasonicCount; ++n) {
+        chassis.set_ultrasonic(n, static_cast<std::int16_t>(*mm));
+      }
+    } else {
+      auto n = parse_integer("ultrasonic N", w[1], 1, protocol::kUltrasonicCount);
+      if (!n) return n.error();
+      chassis.set_ultrasonic(static_cast<int>(*n), static_cast<std::int16_t>(*mm));
+    }
+    return std::string();
+  }
+  if (cmd == "pose") {
+    if (auto s = need(4, "pose X Y YAW"); !s) return s.error();
+    auto x = parse_double("pose X", w[1]);
+    if (!x) return x.error();
+    auto y = parse_double("pose Y", w[2]);
+    if (!y) return y.error();
+    auto yaw = parse_double("pose YAW", w[3]);
+    if (!yaw) return yaw.error();
+    chassis.set_pose(Pose2D{*x, *y, sim::wrap_angle(*yaw)});
+    return std::string();
+  }
+  if (cmd == "status") return describe_chassis(chassis.snapshot());
+  return usage("unknown command '" + cmd + "' (try 'help')");
+}
+
+}  // namespace ranger::cli

@@ -1,0 +1,266 @@
+#include "ranger_base/chassis_link.hpp"
+
+#include <poll.h>
+#include <sys/eventfd.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <exception>
+
+#include <ranger_can/codec.hpp>
+#include <ranger_can/socketcan_bus.hpp>
+
+namespace ranger_base {
+namespace {
+
+using std::chrono::milliseconds;
+using std::chrono::nanoseconds;
+
+// The longest the CAN thread sleeps: the controller wants a tick at least every half keep-alive
+// period, and a stop request should be noticed promptly.
+constexpr nanoseconds kMaxWait = milliseconds(10);
+// Frames handled per wake-up before the controller is ticked (bounds the time between ticks
+// under a flood of frames).
+constexpr int kMaxFramesPerIteration = 256;
+
+ranger::Status not_connected(const std::string& port, const std::string& why) {
+  return ranger::Error{ranger::Errc::kInterfaceDown,
+                       "not connected to " + port + (why.empty() ? "" : ": " + why)};
+}
+
+}  // namespace
+
+ChassisLink::ChassisLink(ChassisLinkOptions options, const ranger::Clock& clock)
+    : options_(std::move(options)),
+      clock_(clock),
+      odometry_(options_.odometry),
+      joints_(options_.odometry.geometry.wheel_radius) {
+  wake_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
+  if (options_.sim) {
+    ranger::LoopbackOptions net;
+    net.interface = "sim";
+    network_ = std::make_unique<ranger::LoopbackNetwork>(net);
+    sim_bus_ = network_->connect();
+    runner_ = std::make_unique<ranger::sim::VirtualChassisRunner>(*sim_bus_, *options_.sim, clock_);
+    if (options_.sim_error_bits != 0) {
+      runner_->with_chassis([this](ranger::sim::VirtualChassis& c) {
+        c.set_error_bits(options_.sim_error_bits);
+        return 0;
+      });
+    }
+  }
+}
+
+ChassisLink::~ChassisLink() {
+  stop();
+  if (wake_fd_ >= 0) ::close(wake_fd_);
+}
+
+void ChassisLink::start(CommandObserver observer) {
+  if (thread_.joinable() || stopped_) return;
+  observer_ = std::move(observer);
+  thread_ = std::thread([this] { loop(); });
+}
+
+void ChassisLink::stop() {
+  stop_requested_ = true;
+  wake();
+  if (thread_.joinable()) thread_.join();
+  std::lock_guard<std::mutex> lock(mutex_);
+  // The thread sends the stop on its way out; this covers a link that never started (or whose
+  // thread died). shutdown() is idempotent.
+  if (controller_) controller_->shutdown(clock_.now());
+  stopped_ = true;
+}
+
+void ChassisLink::wake() {
+  if (wake_fd_ < 0) return;
+  const std::uint64_t one = 1;
+  // A full counter (EAGAIN) means a wake-up is pending anyway.
+  [[maybe_unused]] const auto n = ::write(wake_fd_, &one, sizeof one);
+}
+
+void ChassisLink::wait(int bus_fd, nanoseconds timeout) {
+  pollfd fds[2];
+  nfds_t count = 0;
+  if (wake_fd_ >= 0) fds[count++] = {wake_fd_, POLLIN, 0};
+  if (bus_fd >= 0) fds[count++] = {bus_fd, POLLIN, 0};
+  // Round up so a sub-millisecond deadline does not become a busy loop of zero-timeout polls.
+  const auto ms = std::chrono::ceil<milliseconds>(std::max(timeout, nanoseconds(0))).count();
+  ::poll(fds, count, static_cast<int>(ms));
+  if (wake_fd_ >= 0 && count > 0 && (fds[0].revents & POLLIN)) {
+    std::uint64_t value;
+    [[maybe_unused]] const auto n = ::read(wake_fd_, &value, sizeof value);
+  }
+}
+
+void ChassisLink::try_open(ranger::Timestamp now) {
+  if (now < next_open_attempt_) return;
+  next_open_attempt_ = now + options_.reconnect_interval;
+  ranger::Result<std::unique_ptr<ranger::Bus>> bus = ranger::Error{ranger::Errc::kIoError, ""};
+  if (network_) {
+    bus = std::unique_ptr<ranger::Bus>(network_->connect());
+  } else {
+    auto opened = ranger::SocketCanBus::open(options_.port_name);
+    if (opened) {
+      bus = std::unique_ptr<ranger::Bus>(std::move(*opened));
+    } else {
+      bus = opened.error();
+    }
+  }
+  if (!bus) {
+    bus_error_ = bus.error().message;
+    return;
+  }
+  bus_error_.clear();
+  bus_ = std::move(*bus);
+  controller_ = std::make_unique<ranger::ChassisController>(*bus_, options_.controller);
+  if (pending_mode_) controller_->request_motion_mode(*pending_mode_, now);
+}
+
+void ChassisLink::handle_frame(const ranger::CanFrame& frame, ranger::Timestamp now) {
+  if (frame.is_error) {
+    controller_->on_frame(frame, now);  // counts it
+    return;
+  }
+  ++frames_received_;
+  ++frames_by_id_[frame.id];
+  auto message = ranger::decode(frame);
+  if (!message) {
+    controller_->on_frame(frame, now);  // counts and records the decode error
+    return;
+  }
+  controller_->on_message(*message, frame.stamp, now);
+  odometry_.on_message(*message, frame.stamp);
+  joints_.on_message(*message, frame.stamp);
+}
+
+void ChassisLink::drain_and_tick(ranger::Timestamp now) {
+  for (int i = 0; i < kMaxFramesPerIteration; ++i) {
+    auto frame = bus_->receive(nanoseconds(0));
+    if (!frame) break;  // kTimeout: nothing more; other errors: the bus reports and reopens
+    handle_frame(*frame, now);
+  }
+  controller_->tick(clock_.now());
+  const auto& st = controller_->state();
+  if (st.counters.motion_commands_sent != motion_commands_seen_) {
+    motion_commands_seen_ = st.counters.motion_commands_sent;
+    if (observer_ && st.last_motion_command) {
+      pending_events_.push_back(
+          {std::chrono::system_clock::now(), *st.last_motion_command, st.last_solution});
+    }
+  }
+}
+
+void ChassisLink::loop() {
+  std::vector<MotionCommandEvent> events;
+  try {
+    while (!stop_requested_.load()) {
+      int bus_fd = -1;
+      nanoseconds timeout = kMaxWait;
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        const auto now = clock_.now();
+        if (!bus_) try_open(now);
+        if (bus_) {
+          bus_fd = bus_->fd();
+          timeout = std::min(timeout, controller_->next_tick_due() - now);
+          // A command posted but not yet sent goes out within min_command_interval of the
+          // previous 0x111 (the controller's rate bound): look again then.
+          const auto& st = controller_->state();
+          if (st.refusal == ranger::MotionRefusal::kNone && st.has_command &&
+              st.last_command_time > st.last_motion_command_time) {
+            timeout = std::min(timeout, options_.controller.min_command_interval);
+          }
+        }
+      }
+      wait(bus_fd, timeout);
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        ++loop_iterations_;
+        if (bus_) drain_and_tick(clock_.now());
+        events.swap(pending_events_);
+      }
+      for (const auto& e : events) observer_(e);
+      events.clear();
+    }
+  } catch (const std::exception& e) {  // never let an exception escape the thread
+    std::lock_guard<std::mutex> lock(mutex_);
+    bus_error_ = std::string("CAN thread failed: ") + e.what();
+  } catch (...) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    bus_error_ = "CAN thread failed";
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (controller_) controller_->shutdown(clock_.now());
+}
+
+ranger::Status ChassisLink::set_command(const ranger::MotionRequest& request) {
+  ranger::Status st = ranger::ok_status();
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!controller_) return not_connected(options_.port_name, bus_error_);
+    st = controller_->set_command(request, clock_.now());
+  }
+  wake();
+  return st;
+}
+
+void ChassisLink::request_motion_mode(std::optional<ranger::protocol::MotionMode> mode) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    pending_mode_ = mode;  // also applied to a controller created later
+    if (controller_) controller_->request_motion_mode(mode, clock_.now());
+  }
+  wake();
+}
+
+ranger::Status ChassisLink::clear_errors(std::uint8_t code) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!controller_) return not_connected(options_.port_name, bus_error_);
+  // Sends at once: send() never blocks (a full queue is an error, not a wait).
+  return controller_->clear_errors(code, clock_.now());
+}
+
+ranger::Status ChassisLink::set_ultrasonic(bool enable) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!controller_) return not_connected(options_.port_name, bus_error_);
+  return controller_->set_ultrasonic(enable, clock_.now());
+}
+
+LinkSnapshot ChassisLink::snapshot() const {
+  LinkSnapshot s;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    s.now = clock_.now();
+    s.port_name = options_.port_name;
+    s.bus_open = bus_ != nullptr;
+    s.bus_error = bus_error_;
+    if (bus_) s.bus = bus_->status();
+    s.has_controller = controller_ != nullptr;
+    if (controller_) s.controller = controller_->state();
+    s.odometry = odometry_.state();
+    s.joints = joints_.joints();
+    s.frames_by_id = frames_by_id_;
+    s.frames_received = frames_received_;
+    s.loop_iterations = loop_iterations_;
+  }
+  if (runner_) {
+    s.sim = runner_->with_chassis([](ranger::sim::VirtualChassis& c) { return c.snapshot(); });
+    s.sim_failure = runner_->failure();
+  }
+  return s;
+}
+
+bool ChassisLink::with_sim(const std::function<void(ranger::sim::VirtualChassis&)>& f) {
+  if (!runner_) return false;
+  runner_->with_chassis([&f](ranger::sim::VirtualChassis& c) {
+    f(c);
+    return 0;
+  });
+  return true;
+}
+
+}  // namespace ranger_base

@@ -1,0 +1,435 @@
+#include "ranger_base/parameters.hpp"
+
+#include <ros/node_handle.h>
+#include <ros/param.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <iomanip>
+#include <set>
+#include <sstream>
+
+#include <ranger_can/interpretation.hpp>
+#include <ranger_can/protocol.hpp>
+
+namespace ranger_base {
+namespace {
+
+using std::chrono::duration;
+using std::chrono::duration_cast;
+using std::chrono::nanoseconds;
+
+// A closed or half-open interval, printed the way the error messages show valid ranges.
+struct Interval {
+  double lo;
+  double hi;
+  bool lo_open = false;
+  bool hi_open = false;
+
+  bool contains(double v) const {
+    return (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi);
+  }
+  std::string describe(const std::string& unit) const {
+    std::ostringstream out;
+    out << (lo_open ? "(" : "[") << lo << ", " << hi << (hi_open ? ")" : "]");
+    if (!unit.empty()) out << ' ' << unit;
+    return out.str();
+  }
+};
+Interval closed(double lo, double hi) { return {lo, hi, false, false}; }
+Interval open_closed(double lo, double hi) { return {lo, hi, true, false}; }
+
+std::string show(const XmlRpc::XmlRpcValue& v) {
+  XmlRpc::XmlRpcValue copy = v;  // toXml() is not const
+  switch (copy.getType()) {
+    case XmlRpc::XmlRpcValue::TypeString: return "\"" + static_cast<std::string&>(copy) + "\"";
+    case XmlRpc::XmlRpcValue::TypeBoolean: return static_cast<bool&>(copy) ? "true" : "false";
+    case XmlRpc::XmlRpcValue::TypeInt: return std::to_string(static_cast<int&>(copy));
+    case XmlRpc::XmlRpcValue::TypeDouble: {
+      std::ostringstream out;
+      out << static_cast<double&>(copy);
+      return out.str();
+    }
+    case XmlRpc::XmlRpcValue::TypeArray: return "a list of " + std::to_string(copy.size());
+    case XmlRpc::XmlRpcValue::TypeStruct: return "a dictionary";
+    default: return "a value of another type";
+  }
+}
+
+std::optional<double> as_number(const XmlRpc::XmlRpcValue& v) {
+  XmlRpc::XmlRpcValue copy = v;
+  if (copy.getType() == XmlRpc::XmlRpcValue::TypeDouble) return static_cast<double&>(copy);
+  if (copy.getType() == XmlRpc::XmlRpcValue::TypeInt) return static_cast<int&>(copy);
+  return std::nullopt;
+}
+
+// Reads parameters one by one, collecting every problem instead of stopping at the first.
+class Reader {
+ public:
+  explicit Reader(const ParameterSource& source) : source_(source) {}
+
+  double number(const std::string& name, double def, Interval valid, const std::string& unit) {
+    names_.push_back(name);
+    const auto raw = source_.get(name);
+    if (!raw) return def;
+    const auto v = as_number(*raw);
+    if (!v) {
+      fail(name, "= " + show(*raw) + ": expected a number in " + valid.describe(unit));
+      return def;
+    }
+    if (!std::isfinite(*v) || !valid.contains(*v)) {
+      fail(name, "= " + show(*raw) + " is out of range: valid " + valid.describe(unit));
+      return def;
+    }
+    return *v;
+  }
+
+  int integer(const std::string& name, int def, int lo, int hi) {
+    names_.push_back(name);
+    const auto raw = source_.get(name);
+    if (!raw) return def;
+    XmlRpc::XmlRpcValue copy = *raw;
+    const std::string range = "[" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+    if (copy.getType() != XmlRpc::XmlRpcValue::TypeInt) {
+      fail(name, "= " + show(*raw) + ": expected an integer in " + range);
+      return def;
+    }
+    const int v = static_cast<int&>(copy);
+    if (v < lo || v > hi) {
+      fail(name, "= " + show(*raw) + " is out of range: valid " + range);
+      return def;
+    }
+    return v;
+  }
+
+  nanoseconds seconds(const std::string& name, nanoseconds def, Interval valid) {
+    const double s = number(name, duration<double>(def).count(), valid, "s");
+    return duration_cast<nanoseconds>(duration<double>(s));
+  }
+
+  bool flag(const std::string& name, bool def) {
+    names_.push_back(name);
+    const auto raw = source_.get(name);
+    if (!raw) return def;
+    XmlRpc::XmlRpcValue copy = *raw;
+    if (copy.getType() != XmlRpc::XmlRpcValue::TypeBoolean) {
+      fail(name, "= " + show(*raw) + ": expected true or false");
+      return def;
+    }
+    return static_cast<bool&>(copy);
+  }
+
+  std::string text(const std::string& name, const std::string& def) {
+    names_.push_back(name);
+    const auto raw = source_.get(name);
+    if (!raw) return def;
+    XmlRpc::XmlRpcValue copy = *raw;
+    if (copy.getType() != XmlRpc::XmlRpcValue::TypeString) {
+      fail(name, "= " + show(*raw) + ": expected a string");
+      return def;
+    }
+    return static_cast<std::string&>(copy);
+  }
+
+  // A tf2 frame id: non-empty, no whitespace, no leading '/'.
+  std::string frame(const std::string& name, const std::string& def) {
+    std::string v = text(name, def);
+    const bool has_space =
+        std::any_of(v.begin(), v.end(), [](unsigned char c) { return std::isspace(c) != 0; });
+    if (v.empty() || has_space || v.front() == '/') {
+      fail(name, "= \"" + v +
+                     "\": expected a tf2 frame id (non-empty, no spaces, no leading '/')");
+      return def;
+    }
+    return v;
+  }
+
+  std::array<double, 6> diagonal(const std::string& name, const std::array<double, 6>& def) {
+    names_.push_back(name);
+    const auto raw = source_.get(name);
+    if (!raw) return def;
+    XmlRpc::XmlRpcValue copy = *raw;
+    const std::string expected =
+        ": expected a list of 6 variances >= 0 (x, y, z, roll, pitch, yaw)";
+    if (copy.getType() != XmlRpc::XmlRpcValue::TypeArray || copy.size() != 6) {
+      fail(name, "= " + show(*raw) + expected);
+      return def;
+    }
+    std::array<double, 6> out{};
+    for (int i = 0; i < 6; ++i) {
+      const auto v = as_number(copy[i]);
+      if (!v || !std::isfinite(*v) || *v < 0.0) {
+        fail(name, "[" + std::to_string(i) + "] = " + show(copy[i]) + expected);
+        return def;
+      }
+      out[static_cast<std::size_t>(i)] = *v;
+    }
+    return out;
+  }
+
+  std::vector<std::string> text_list(const std::string& name) {
+    names_.push_back(name);
+    std::vector<std::string> out;
+    const auto raw = source_.get(name);
+    if (!raw) return out;
+    XmlRpc::XmlRpcValue copy = *raw;
+    if (copy.getType() != XmlRpc::XmlRpcValue::TypeArray) {
+      fail(name, "= " + show(*raw) + ": expected a list of strings");
+      return out;
+    }
+    for (int i = 0; i < copy.size(); ++i) {
+      if (copy[i].getType() != XmlRpc::XmlRpcValue::TypeString) {
+        fail(name, "[" + std::to_string(i) + "] = " + show(copy[i]) + ": expected a string");
+        return {};
+      }
+      out.push_back(static_cast<std::string&>(copy[i]));
+    }
+    return out;
+  }
+
+  void fail(const std::string& name, const std::string& problem) {
+    errors_.push_back("parameter " + source_.display_name(name) + " " + problem);
+  }
+
+  const std::vector<std::string>& errors() const { return errors_; }
+  const std::vector<std::string>& names() const { return names_; }
+
+ private:
+  const ParameterSource& source_;
+  std::vector<std::string> errors_;
+  std::vector<std::string> names_;
+};
+
+constexpr double kDeg = M_PI / 180.0;
+
+// ros_controllers' per-axis limits (diff_drive_controller's SpeedLimiter parameters): a missing
+// min_* defaults to -max_*.
+ranger::SpeedLimits read_speed_limits(Reader& r, const std::string& axis, const std::string& unit,
+                                      double max_velocity_bound) {
+  ranger::SpeedLimits l;
+  const std::string vel_unit = unit + "/s", acc_unit = unit + "/s^2";
+  l.has_velocity_limits = r.flag(axis + "/has_velocity_limits", false);
+  l.max_velocity = r.number(axis + "/max_velocity", 1.0, closed(0.0, max_velocity_bound), vel_unit);
+  l.min_velocity = r.number(axis + "/min_velocity", -l.max_velocity,
+                            closed(-max_velocity_bound, l.max_velocity), vel_unit);
+  l.has_acceleration_limits = r.flag(axis + "/has_acceleration_limits", false);
+  l.max_acceleration =
+      r.number(axis + "/max_acceleration", 1.0, open_closed(0.0, 1000.0), acc_unit);
+  l.min_acceleration = r.number(axis + "/min_acceleration", -l.max_acceleration,
+                                Interval{-1000.0, 0.0, false, true}, acc_unit);
+  return l;
+}
+
+// Reads everything; `r` collects the problems.
+NodeParameters read_all(Reader& r) {
+  NodeParameters p;
+  auto& c = p.controller;
+  auto& o = p.odometry;
+
+  // ---- connection and frames
+  p.port_name = r.text("port_name", p.port_name);
+  if (p.port_name.empty() || p.port_name.size() > 15 ||
+      p.port_name.find_first_of("/ \t") != std::string::npos) {
+    r.fail("port_name", "= \"" + p.port_name +
+                            "\": expected a CAN interface name (1-15 characters, e.g. can0, "
+                            "vcan0) or \"sim\" for the in-process virtual chassis");
+  }
+  p.odom_frame = r.frame("odom_frame", p.odom_frame);
+  p.base_frame = r.frame("base_frame", p.base_frame);
+  if (p.odom_frame == p.base_frame) {
+    r.fail("base_frame", "= \"" + p.base_frame + "\" must differ from odom_frame");
+  }
+  p.publish_odom_tf = r.flag("publish_odom_tf", p.publish_odom_tf);
+  p.publish_rate = r.number("publish_rate", p.publish_rate, open_closed(0.0, 1000.0), "Hz");
+  p.state_publish_rate =
+      r.number("state_publish_rate", p.state_publish_rate, open_closed(0.0, 100.0), "Hz");
+  p.publish_cmd = r.flag("publish_cmd", p.publish_cmd);
+  p.reconnect_interval = r.seconds("reconnect_interval", p.reconnect_interval, closed(0.05, 60.0));
+
+  // ---- control
+  c.cmd_timeout = r.seconds("cmd_vel_timeout", c.cmd_timeout, closed(0.02, 60.0));
+  c.auto_command_mode = r.flag("auto_command_mode", c.auto_command_mode);
+  c.link_timeout = r.seconds("link_timeout", c.link_timeout, closed(0.02, 10.0));
+  c.mode_switch_timeout =
+      r.seconds("mode_switch_timeout", c.mode_switch_timeout, closed(0.1, 30.0));
+  c.mode_switch_max_attempts =
+      r.integer("mode_switch_max_attempts", c.mode_switch_max_attempts, 1, 100);
+  c.standstill_speed = r.number("standstill_speed", c.standstill_speed, closed(0.0, 1.0), "m/s");
+  c.low_battery_soc = r.number("low_battery_soc", c.low_battery_soc, closed(0.0, 100.0), "%");
+
+  // ---- geometry (ranger_description/config/geometry.yaml)
+  ranger::VehicleGeometry g;
+  g.wheelbase = r.number("wheelbase", g.wheelbase, open_closed(0.0, 10.0), "m");
+  g.track = r.number("track", g.track, open_closed(0.0, 10.0), "m");
+  g.wheel_radius = r.number("wheel_radius", g.wheel_radius, open_closed(0.0, 5.0), "m");
+  c.geometry = g;
+  o.geometry = g;
+  p.sim.geometry = g;
+
+  // ---- kinematic limits (the chassis's own ranges are the upper bounds)
+  auto& k = c.limits;
+  const double vmax = ranger::interpretation::kMaxLinearSpeedMps;
+  k.max_linear_speed = r.number("max_linear_speed", k.max_linear_speed, open_closed(0.0, vmax), "m/s");
+  k.max_speed_at_large_steering = r.number("max_speed_at_large_steering",
+                                           k.max_speed_at_large_steering, open_closed(0.0, vmax),
+                                           "m/s");
+  k.max_ackermann_steering = r.number("max_ackermann_steering", k.max_ackermann_steering,
+                                      open_closed(0.0, 40.0 * kDeg), "rad (40 deg)");
+  k.max_oblique_steering = r.number("max_oblique_steering", k.max_oblique_steering,
+                                    open_closed(0.0, 90.0 * kDeg), "rad (90 deg)");
+  k.max_spin_wheel_speed =
+      r.number("max_spin_wheel_speed", k.max_spin_wheel_speed, open_closed(0.0, 1.0), "m/s");
+
+  // ---- velocity / acceleration limits per axis (ros_controllers names)
+  c.limit_vx = read_speed_limits(r, "linear/x", "m", vmax);
+  c.limit_vy = read_speed_limits(r, "linear/y", "m", vmax);
+  c.limit_wz = read_speed_limits(r, "angular/z", "rad", 10.0);
+
+  // ---- automatic motion-mode selection
+  auto& m = c.mode_selection;
+  m.lateral_enter = r.number("mode_selection/lateral_enter", m.lateral_enter, closed(0.0, 2.6), "m/s");
+  m.lateral_exit = r.number("mode_selection/lateral_exit", m.lateral_exit, closed(0.0, 2.6), "m/s");
+  m.linear_enter = r.number("mode_selection/linear_enter", m.linear_enter, closed(0.0, 2.6), "m/s");
+  m.linear_exit = r.number("mode_selection/linear_exit", m.linear_exit, closed(0.0, 2.6), "m/s");
+  m.rotation_enter =
+      r.number("mode_selection/rotation_enter", m.rotation_enter, closed(0.0, 10.0), "rad/s");
+  m.rotation_exit =
+      r.number("mode_selection/rotation_exit", m.rotation_exit, closed(0.0, 10.0), "rad/s");
+  m.confirm_time = r.seconds("mode_selection/confirm_time", m.confirm_time, closed(0.0, 10.0));
+  m.min_dwell = r.seconds("mode_selection/min_dwell", m.min_dwell, closed(0.0, 60.0));
+
+  // ---- odometry
+  const std::string source = r.text("odometry_source", "wheels");
+  if (auto parsed = ranger::parse_odometry_source(source)) {
+    o.source = *parsed;
+  } else {
+    r.fail("odometry_source", "= \"" + source + "\": expected \"wheels\" or \"motion\"");
+  }
+  o.wheel_data_timeout =
+      r.seconds("wheel_data_timeout", o.wheel_data_timeout, closed(0.02, 5.0));
+  p.pose_covariance_diagonal = r.diagonal("pose_covariance_diagonal", p.pose_covariance_diagonal);
+  p.twist_covariance_diagonal =
+      r.diagonal("twist_covariance_diagonal", p.twist_covariance_diagonal);
+  // The node adds the floor above; the library models only the growth.
+  o.initial_pose_variance_xy = 0.0;
+  o.initial_pose_variance_yaw = 0.0;
+  o.pose_variance_per_meter =
+      r.number("pose_variance_per_meter", o.pose_variance_per_meter, closed(0.0, 1e3), "m^2/m");
+  o.yaw_variance_per_radian = r.number("yaw_variance_per_radian", o.yaw_variance_per_radian,
+                                       closed(0.0, 1e3), "rad^2/rad");
+  o.yaw_variance_per_meter =
+      r.number("yaw_variance_per_meter", o.yaw_variance_per_meter, closed(0.0, 1e3), "rad^2/m");
+
+  // ---- ultrasonic as sensor_msgs/Range
+  auto& u = p.ultrasonic;
+  u.field_of_view =
+      r.number("ultrasonic/field_of_view", u.field_of_view, open_closed(0.0, M_PI), "rad");
+  u.min_range = r.number("ultrasonic/min_range", u.min_range, closed(0.0, 10.0), "m");
+  u.max_range = r.number("ultrasonic/max_range", u.max_range,
+                         Interval{u.min_range, 32.767, true, false}, "m");
+
+  // ---- the in-process virtual chassis (port_name = sim)
+  auto& s = p.sim;
+  s.initial_soc = r.number("sim/initial_soc", s.initial_soc, closed(0.0, 100.0), "%");
+  s.mode_switch_duration =
+      r.seconds("sim/mode_switch_duration", s.mode_switch_duration, closed(0.0, 10.0));
+  s.boot_in_remote_mode = r.flag("sim/boot_in_remote_mode", s.boot_in_remote_mode);
+  const double ultrasonic_m = r.number("sim/ultrasonic_range", 3.0, closed(0.0, 32.767), "m");
+  s.ultrasonic.fill(static_cast<std::int16_t>(std::lround(ultrasonic_m * 1000.0)));
+  for (const auto& name : r.text_list("sim/errors")) {
+    const auto& bits = ranger::protocol::system_error_bits();
+    const auto it = std::find_if(bits.begin(), bits.end(),
+                                 [&name](const auto& b) { return b.name == name; });
+    if (it == bits.end()) {
+      r.fail("sim/errors", "contains \"" + name +
+                               "\": not a 0x211 error bit name (see ranger_msgs/SystemErrors)");
+    } else {
+      p.sim_error_bits |= 1u << it->index;
+    }
+  }
+  return p;
+}
+
+}  // namespace
+
+NodeHandleParameterSource::NodeHandleParameterSource(const ros::NodeHandle& private_nh)
+    : nh_(private_nh) {}
+
+std::optional<XmlRpc::XmlRpcValue> NodeHandleParameterSource::get(const std::string& name) const {
+  XmlRpc::XmlRpcValue v;
+  if (!nh_.getParam(name, v)) return std::nullopt;
+  return v;
+}
+
+std::string NodeHandleParameterSource::display_name(const std::string& name) const {
+  return nh_.resolveName(name);
+}
+
+std::vector<std::string> NodeHandleParameterSource::names() const {
+  std::vector<std::string> all, out;
+  if (!ros::param::getParamNames(all)) return out;
+  std::string prefix = nh_.getNamespace();
+  if (prefix.empty() || prefix.back() != '/') prefix += '/';
+  for (const auto& n : all) {
+    if (n.compare(0, prefix.size(), prefix) == 0) out.push_back(n.substr(prefix.size()));
+  }
+  return out;
+}
+
+std::optional<XmlRpc::XmlRpcValue> MapParameterSource::get(const std::string& name) const {
+  const auto it = values.find(name);
+  if (it == values.end()) return std::nullopt;
+  return it->second;
+}
+
+std::vector<std::string> MapParameterSource::names() const {
+  std::vector<std::string> out;
+  for (const auto& kv : values) out.push_back(kv.first);
+  return out;
+}
+
+ranger::Result<NodeParameters> load_parameters(const ParameterSource& source) {
+  Reader reader(source);
+  NodeParameters p = read_all(reader);
+  std::vector<std::string> errors = reader.errors();
+
+  // The library's own checks catch combinations the per-parameter ranges cannot (e.g.
+  // min_velocity above max_velocity after defaults, hysteresis thresholds in the wrong order).
+  if (errors.empty()) {
+    if (auto st = p.controller.validate(); !st) {
+      errors.push_back("parameters rejected: " + st.error().message);
+    }
+    if (auto st = p.odometry.validate(); !st) {
+      errors.push_back("parameters rejected: " + st.error().message);
+    }
+  }
+  if (errors.empty()) return p;
+  std::string message;
+  for (const auto& e : errors) message += (message.empty() ? "" : "\n") + e;
+  return ranger::Error{ranger::Errc::kInvalidArgument, message};
+}
+
+const std::vector<std::string>& known_parameter_names() {
+  static const std::vector<std::string> names = [] {
+    MapParameterSource empty;
+    Reader reader(empty);
+    read_all(reader);
+    return reader.names();
+  }();
+  return names;
+}
+
+std::vector<std::string> unknown_parameter_names(const ParameterSource& source) {
+  const auto& known = known_parameter_names();
+  const std::set<std::string> known_set(known.begin(), known.end());
+  std::vector<std::string> out;
+  for (const auto& n : source.names()) {
+    if (n.rfind("description/", 0) == 0) continue;  // the URDF's part of geometry.yaml
+    if (n == "diagnostic_period") continue;          // read by diagnostic_updater
+    if (known_set.count(n) == 0) out.push_back(n);
+  }
+  return out;
+}
+
+}  // namespace ranger_base

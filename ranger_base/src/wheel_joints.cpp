@@ -1,0 +1,48 @@
+#include "ranger_base/wheel_joints.hpp"
+
+#include <ranger_can/interpretation.hpp>
+
+namespace ranger_base {
+namespace {
+
+// dt in seconds between two frame stamps, or nullopt when the step must not be integrated.
+bool usable_step(ranger::Timestamp previous, ranger::Timestamp now, double* dt) {
+  if (previous.count() == 0 || now <= previous || now - previous > WheelJointTracker::kMaxStep) {
+    return false;
+  }
+  *dt = std::chrono::duration<double>(now - previous).count();
+  return true;
+}
+
+}  // namespace
+
+void WheelJointTracker::on_message(const ranger::Message& message, ranger::Timestamp stamp) {
+  if (const auto* angles = std::get_if<ranger::SteeringAnglesFeedback>(&message)) {
+    double dt = 0.0;
+    const bool step = joints_.has_steering && usable_step(steering_stamp_, stamp, &dt);
+    for (int i = 0; i < ranger::kWheelCount; ++i) {
+      const auto w = static_cast<std::size_t>(i);
+      // + 0.0 turns the -0.0 of a sign flip into 0.0 for tidy joint_states.
+      const double angle =
+          ranger::interpretation::rep103_from_manual_wheel_angle(angles->angles[w]) + 0.0;
+      joints_.steering_velocity[w] = step ? (angle - joints_.steering_position[w]) / dt : 0.0;
+      joints_.steering_position[w] = angle;
+    }
+    joints_.has_steering = true;
+    steering_stamp_ = stamp;
+  } else if (const auto* speeds = std::get_if<ranger::WheelSpeedsFeedback>(&message)) {
+    double dt = 0.0;
+    const bool step = joints_.has_wheels && usable_step(wheels_stamp_, stamp, &dt);
+    for (int i = 0; i < ranger::kWheelCount; ++i) {
+      const auto w = static_cast<std::size_t>(i);
+      const double velocity = speeds->speeds[w] / wheel_radius_;
+      // Trapezoid between the previous and the new speed, like the odometry's mean twist.
+      if (step) joints_.wheel_position[w] += 0.5 * (joints_.wheel_velocity[w] + velocity) * dt;
+      joints_.wheel_velocity[w] = velocity;
+    }
+    joints_.has_wheels = true;
+    wheels_stamp_ = stamp;
+  }
+}
+
+}  // namespace ranger_base

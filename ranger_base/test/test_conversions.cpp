@@ -1,0 +1,302 @@
+// libranger_can types -> ROS messages.
+#include <gtest/gtest.h>
+
+#include <tf2/utils.h>
+
+#include <cmath>
+#include <set>
+
+#include <ranger_can/geometry.hpp>
+#include <ranger_can/protocol.hpp>
+
+#include "ranger_base/conversions.hpp"
+
+namespace ranger_base {
+namespace {
+
+namespace protocol = ranger::protocol;
+using namespace std::chrono_literals;
+
+template <typename Map>
+std::set<std::string> keys(const Map& m) {
+  std::set<std::string> out;
+  for (const auto& kv : m) out.emplace(kv.first);
+  return out;
+}
+
+std::set<std::string> names(const std::vector<protocol::NamedBit>& bits) {
+  std::set<std::string> out;
+  for (const auto& b : bits) out.emplace(b.name);
+  return out;
+}
+
+// ---- named bits: the messages name every bit libranger_can defines, and nothing else ----------
+
+TEST(NamedBits, SystemErrorsHaveAFieldForEveryLibraryBit) {
+  EXPECT_EQ(keys(system_error_fields()), names(protocol::system_error_bits()));
+}
+
+TEST(NamedBits, DriverStatusHasAFieldForEveryLibraryBit) {
+  EXPECT_EQ(keys(driver_status_fields()), names(protocol::driver_status_bits()));
+}
+
+TEST(NamedBits, BmsFlagsHaveAFieldForEveryLibraryBit) {
+  auto expected = names(protocol::bms_status1_bits());
+  for (const auto& n : names(protocol::bms_status2_bits())) expected.insert(n);
+  EXPECT_EQ(keys(bms_flag_fields()), expected);
+}
+
+TEST(NamedBits, EachErrorBitSetsExactlyItsField) {
+  const auto& fields = system_error_fields();
+  for (const auto& bit : protocol::system_error_bits()) {
+    ranger_msgs::SystemErrors msg;
+    fill_system_errors(1u << bit.index, msg);
+    for (const auto& [name, field] : fields) {
+      EXPECT_EQ(msg.*field != 0, name == bit.name) << "bit " << bit.name << ", field " << name;
+    }
+  }
+}
+
+TEST(NamedBits, BmsStatusBytesMapToTheirOwnFields) {
+  for (const auto& bit : protocol::bms_status2_bits()) {
+    const auto flags = to_bms_flags(0, static_cast<std::uint8_t>(1u << bit.index));
+    EXPECT_TRUE(flags.*(bms_flag_fields().at(bit.name))) << bit.name;
+    EXPECT_FALSE(flags.over_voltage);
+  }
+  const auto all1 = to_bms_flags(0xFF, 0x00);
+  EXPECT_TRUE(all1.over_voltage);
+  EXPECT_TRUE(all1.discharge_over_current);
+  EXPECT_FALSE(all1.charge_over_current);
+}
+
+// ---- system state ----------------------------------------------------------------------------
+
+TEST(SystemState, CarriesModesRawWordAndActiveNames) {
+  ranger::ControllerState st;
+  st.link = ranger::LinkState::kConnected;
+  ranger::SystemStatus status;
+  status.control_mode = protocol::ControlMode::kRemote;
+  status.control_mode_raw = 3;
+  status.vehicle_status = protocol::VehicleStatus::kEmergencyStop;
+  status.vehicle_status_raw = 1;
+  status.battery_voltage = 51.2;
+  st.feedback.system_status = ranger::Stamped<ranger::SystemStatus>{status, 1s, 1s};
+  ranger::MotionModeFeedback mode;
+  mode.mode = protocol::MotionMode::kSpin;
+  mode.mode_raw = 2;
+  mode.switching = true;
+  st.feedback.motion_mode = ranger::Stamped<ranger::MotionModeFeedback>{mode, 1s, 1s};
+  const auto& bits = protocol::system_error_bits();
+  st.error_bits = (1u << bits.front().index) | (1u << bits.back().index);
+  st.refusal = ranger::MotionRefusal::kRemote;
+
+  const auto msg = to_system_state(st, ros::Time(10.0));
+  EXPECT_TRUE(msg.link_up);
+  EXPECT_EQ(msg.control_mode, ranger_msgs::SystemState::CONTROL_MODE_REMOTE);
+  EXPECT_EQ(msg.vehicle_status, ranger_msgs::SystemState::VEHICLE_STATUS_EMERGENCY_STOP);
+  EXPECT_EQ(msg.motion_mode, ranger_msgs::SystemState::MOTION_MODE_SPIN);
+  EXPECT_TRUE(msg.motion_mode_switching);
+  EXPECT_NEAR(msg.battery_voltage, 51.2, 1e-4);
+  EXPECT_EQ(msg.error_word, st.error_bits);
+  ASSERT_EQ(msg.active_errors.size(), 2u);
+  EXPECT_EQ(msg.motion_inhibited_reason, "remote");
+  EXPECT_EQ(msg.control_mode_name, std::string(protocol::to_string(protocol::ControlMode::kRemote)));
+}
+
+TEST(SystemState, UnknownBeforeTheFirstFrame) {
+  const auto msg = to_system_state(ranger::ControllerState{}, ros::Time(1.0));
+  EXPECT_FALSE(msg.link_up);
+  EXPECT_EQ(msg.control_mode_name, "unknown");
+  EXPECT_EQ(msg.motion_mode_name, "unknown");
+}
+
+// ---- odometry ---------------------------------------------------------------------------------
+
+TEST(Odometry, PoseTwistFramesAndCovariance) {
+  NodeParameters p;
+  p.odom_frame = "r1/odom";
+  p.base_frame = "r1/base_link";
+  p.pose_covariance_diagonal = {0.1, 0.2, 1e6, 1e6, 1e6, 0.3};
+  p.twist_covariance_diagonal = {0.01, 0.02, 1e6, 1e6, 1e6, 0.03};
+  ranger::OdometryState o;
+  o.pose = {1.0, -2.0, 0.75};
+  o.twist = {0.5, 0.1, -0.2};
+  o.pose_variance = {0.5, 0.6, 0.7};
+
+  const auto msg = to_odometry(o, p, ros::Time(5.0));
+  EXPECT_EQ(msg.header.frame_id, "r1/odom");
+  EXPECT_EQ(msg.child_frame_id, "r1/base_link");
+  EXPECT_DOUBLE_EQ(msg.pose.pose.position.x, 1.0);
+  EXPECT_DOUBLE_EQ(msg.pose.pose.position.y, -2.0);
+  EXPECT_NEAR(tf2::getYaw(msg.pose.pose.orientation), 0.75, 1e-12);
+  EXPECT_DOUBLE_EQ(msg.twist.twist.linear.x, 0.5);
+  EXPECT_DOUBLE_EQ(msg.twist.twist.linear.y, 0.1);
+  EXPECT_DOUBLE_EQ(msg.twist.twist.angular.z, -0.2);
+  // Row-major 6x6: the diagonal is at 0, 7, 14, 21, 28, 35.
+  EXPECT_DOUBLE_EQ(msg.pose.covariance[0], 0.1 + 0.5);
+  EXPECT_DOUBLE_EQ(msg.pose.covariance[7], 0.2 + 0.6);
+  EXPECT_DOUBLE_EQ(msg.pose.covariance[14], 1e6);
+  EXPECT_DOUBLE_EQ(msg.pose.covariance[35], 0.3 + 0.7);
+  EXPECT_DOUBLE_EQ(msg.twist.covariance[0], 0.01);
+  EXPECT_DOUBLE_EQ(msg.twist.covariance[35], 0.03);
+  for (int r = 0; r < 6; ++r) {
+    for (int c = 0; c < 6; ++c) {
+      if (r != c) EXPECT_EQ(msg.pose.covariance[static_cast<std::size_t>(r * 6 + c)], 0.0);
+    }
+  }
+  const auto tf = to_transform(msg);
+  EXPECT_EQ(tf.header.frame_id, "r1/odom");
+  EXPECT_EQ(tf.child_frame_id, "r1/base_link");
+  EXPECT_DOUBLE_EQ(tf.transform.translation.x, 1.0);
+  EXPECT_NEAR(tf2::getYaw(tf.transform.rotation), 0.75, 1e-12);
+}
+
+TEST(JointState, NamesComeFromTheSharedGeometryHeader) {
+  WheelJoints j;
+  j.steering_position = {0.1, 0.2, 0.3, 0.4};
+  j.wheel_position = {1, 2, 3, 4};
+  j.wheel_velocity = {5, 6, 7, 8};
+  const auto msg = to_joint_state(j, ros::Time(1.0));
+  ASSERT_EQ(msg.name.size(), 8u);
+  ASSERT_EQ(msg.position.size(), 8u);
+  ASSERT_EQ(msg.velocity.size(), 8u);
+  for (int i = 0; i < ranger::kWheelCount; ++i) {
+    const auto w = static_cast<std::size_t>(i);
+    EXPECT_EQ(msg.name[w], ranger::kSteeringJointNames[w]);
+    EXPECT_EQ(msg.name[w + 4], ranger::kWheelJointNames[w]);
+    EXPECT_DOUBLE_EQ(msg.position[w], j.steering_position[w]);
+    EXPECT_DOUBLE_EQ(msg.position[w + 4], j.wheel_position[w]);
+    EXPECT_DOUBLE_EQ(msg.velocity[w + 4], j.wheel_velocity[w]);
+  }
+}
+
+// ---- battery ----------------------------------------------------------------------------------
+
+ranger::Stamped<ranger::BmsData> bms(int battery, double soc, double voltage, ranger::Timestamp t) {
+  ranger::BmsData d;
+  d.battery = battery;
+  d.soc = soc;
+  d.voltage = voltage;
+  d.current = -3.0;
+  d.temperature = 21.5;
+  return {d, t, t};
+}
+
+TEST(Battery, PercentageIsAFractionAndSlotsReportPresence) {
+  ranger::ControllerState st;
+  st.feedback.bms[0] = bms(0, 87.0, 52.1, 10s);
+  st.feedback.bms[2] = bms(2, 80.0, 52.0, 10s);
+  st.feedback.bms[3] = bms(3, 80.0, 51.0, 1s);  // stale: removed long ago
+  const auto msg = to_battery_state(st, 10s + 100ms, ros::Time(3.0));
+  EXPECT_TRUE(msg.present);
+  EXPECT_NEAR(msg.percentage, 0.87, 1e-6);
+  EXPECT_NEAR(msg.voltage, 52.1, 1e-4);
+  EXPECT_NEAR(msg.current, -3.0, 1e-6);
+  EXPECT_EQ(msg.power_supply_status, sensor_msgs::BatteryState::POWER_SUPPLY_STATUS_DISCHARGING);
+  ASSERT_EQ(msg.cell_voltage.size(), 4u);
+  EXPECT_TRUE(std::isnan(msg.cell_voltage[0]));  // slot 1 never reported
+  EXPECT_NEAR(msg.cell_voltage[1], 52.0, 1e-4);  // slot 2
+  EXPECT_TRUE(std::isnan(msg.cell_voltage[2]));  // slot 3 stale
+  EXPECT_TRUE(std::isnan(msg.cell_voltage[3]));
+
+  const auto array = to_bms_state(st.feedback, TimeMapper(ros::Time(3.0), 10s + 100ms),
+                                  10s + 100ms, ros::Time(3.0));
+  ASSERT_EQ(array.batteries.size(), 5u);
+  EXPECT_TRUE(array.batteries[0].present);
+  EXPECT_FALSE(array.batteries[1].present);
+  EXPECT_TRUE(array.batteries[2].present);
+  EXPECT_FALSE(array.batteries[3].present);
+  EXPECT_NEAR(array.batteries[2].header.stamp.toSec(), 2.9, 1e-6);
+}
+
+TEST(Battery, PercentageStaysInZeroToOne) {
+  ranger::ControllerState st;
+  st.feedback.bms[0] = bms(0, 250.0, 52.1, 1s);
+  EXPECT_FLOAT_EQ(to_battery_state(st, 1s, ros::Time(1.0)).percentage, 1.0f);
+}
+
+TEST(Battery, WithoutBmsTheStatusVoltageIsUsedAndPercentageUnknown) {
+  ranger::ControllerState st;
+  ranger::SystemStatus status;
+  status.battery_voltage = 49.5;
+  st.feedback.system_status = ranger::Stamped<ranger::SystemStatus>{status, 1s, 1s};
+  const auto msg = to_battery_state(st, 1s, ros::Time(1.0));
+  EXPECT_NEAR(msg.voltage, 49.5, 1e-4);
+  EXPECT_TRUE(std::isnan(msg.percentage));
+}
+
+// ---- ultrasonic -------------------------------------------------------------------------------
+
+TEST(Ultrasonic, RangeFollowsRep117) {
+  UltrasonicRangeParameters p;
+  p.max_range = 4.0;
+  const auto ok = to_range(3, 1234, p, ros::Time(1.0));
+  EXPECT_EQ(ok.header.frame_id, "ultrasonic_3_link");
+  EXPECT_EQ(ok.radiation_type, sensor_msgs::Range::ULTRASOUND);
+  EXPECT_NEAR(ok.range, 1.234, 1e-6);
+  EXPECT_TRUE(std::isnan(to_range(1, -1, p, ros::Time(1.0)).range));  // offline
+  EXPECT_TRUE(std::isinf(to_range(1, 5000, p, ros::Time(1.0)).range));
+}
+
+TEST(Ultrasonic, StateListsSensorsInOrderWithStatusNames) {
+  ranger::ControllerState st;
+  ranger::UltrasonicFeedback back;
+  back.first_sensor = 5;
+  back.raw = {100, -1, -2, 300};
+  ranger::UltrasonicFeedback front;
+  front.first_sensor = 1;
+  front.raw = {1000, 2000, 3000, 4000};
+  st.feedback.ultrasonic[1] = ranger::Stamped<ranger::UltrasonicFeedback>{back, 1s, 1s};
+  st.feedback.ultrasonic[0] = ranger::Stamped<ranger::UltrasonicFeedback>{front, 1s, 1s};
+  st.ultrasonic_enabled = true;
+  const auto msg = to_ultrasonic_state(st, ros::Time(1.0));
+  EXPECT_TRUE(msg.avoidance_known);
+  EXPECT_TRUE(msg.avoidance_enabled);
+  ASSERT_EQ(msg.sensors.size(), 8u);
+  for (std::size_t i = 0; i < 8; ++i) EXPECT_EQ(msg.sensors[i].sensor, i + 1);
+  EXPECT_EQ(msg.sensors[5].status, "offline");
+  EXPECT_TRUE(std::isnan(msg.sensors[5].range));
+  EXPECT_EQ(msg.sensors[0].status, "ok");
+  EXPECT_NEAR(msg.sensors[0].range, 1.0, 1e-6);
+}
+
+// ---- actuators, time, twist -------------------------------------------------------------------
+
+TEST(Actuators, EightMotorsWithTheirJoints) {
+  ranger::ChassisFeedback fb;
+  ranger::MotorLowSpeedFeedback low;
+  low.motor = 6;
+  low.driver_status = 0x40;  // bit 6: driver disabled
+  fb.motor_low_speed[5] = ranger::Stamped<ranger::MotorLowSpeedFeedback>{low, 2s, 2s};
+  const auto msg = to_actuator_state(fb, TimeMapper(ros::Time(100.0), 3s), ros::Time(100.0));
+  ASSERT_EQ(msg.actuators.size(), 8u);
+  EXPECT_EQ(msg.actuators[0].joint_name, ranger::kWheelJointNames[0]);
+  EXPECT_EQ(msg.actuators[5].joint_name, ranger::kSteeringJointNames[1]);
+  EXPECT_TRUE(msg.actuators[5].driver_status_bits.driver_disabled);
+  EXPECT_FALSE(msg.actuators[5].driver_status_bits.driver_error);
+  EXPECT_NEAR(msg.actuators[5].low_speed_stamp.toSec(), 99.0, 1e-6);
+  EXPECT_TRUE(msg.actuators[0].high_speed_stamp.isZero());
+}
+
+TEST(TimeMapper, MapsLinkTimeToRosTime) {
+  const TimeMapper m(ros::Time(1000.0), 50s);
+  EXPECT_NEAR(m.to_ros(49500ms).toSec(), 999.5, 1e-9);
+  EXPECT_TRUE(m.to_ros(ranger::Timestamp{0}).isZero());
+}
+
+TEST(CmdVel, PlanarComponentsOnly) {
+  geometry_msgs::Twist t;
+  t.linear.x = 1.0;
+  t.linear.y = -0.5;
+  t.angular.z = 0.25;
+  const auto b = to_body_twist(t);
+  EXPECT_DOUBLE_EQ(b.vx, 1.0);
+  EXPECT_DOUBLE_EQ(b.vy, -0.5);
+  EXPECT_DOUBLE_EQ(b.wz, 0.25);
+  EXPECT_FALSE(has_non_planar_components(t));
+  t.angular.x = 0.1;
+  EXPECT_TRUE(has_non_planar_components(t));
+}
+
+}  // namespace
+}  // namespace ranger_base

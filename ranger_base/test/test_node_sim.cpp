@@ -1,0 +1,462 @@
+// ranger_base_node end to end against its in-process virtual chassis (port_name:=sim), through
+// ROS only: cmd_vel in; system_state, odom, sim/ground_truth, cmd_vel_out (every 0x111 the node
+// sent, stamped with its send time), services out. Launched by node_sim.test (and, filtered to
+// the Faults suite, by node_sim_faults.test).
+//
+// Waits are bounded only to fail a broken build instead of hanging; timing is asserted on the
+// node's own stamps and on message order, never on how long the test took.
+#include <geometry_msgs/Twist.h>
+#include <geometry_msgs/TwistStamped.h>
+#include <gtest/gtest.h>
+#include <nav_msgs/Odometry.h>
+#include <ranger_msgs/ClearErrors.h>
+#include <ranger_msgs/SetMotionMode.h>
+#include <ranger_msgs/SetUltrasonic.h>
+#include <ranger_msgs/SystemState.h>
+#include <ranger_msgs/UltrasonicState.h>
+#include <ros/ros.h>
+#include <rosgraph_msgs/Log.h>
+#include <tf2/utils.h>
+
+#include <cmath>
+#include <deque>
+#include <functional>
+#include <limits>
+#include <mutex>
+#include <optional>
+
+namespace {
+
+using ranger_msgs::SystemState;
+
+// The node's parameters in node_sim.test.
+constexpr double kCmdVelTimeout = 0.3;     // s
+constexpr double kPublishPeriod = 0.02;    // s (publish_rate 50)
+constexpr double kMaxLinearSpeed = 1.0;    // m/s
+constexpr double kMinCommandInterval = 0.005;  // s, ControllerConfig default
+
+template <typename M>
+class Latest {
+ public:
+  void set(const M& m) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    value_ = m;
+  }
+  std::optional<M> get() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return value_;
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::optional<M> value_;
+};
+
+// roscpp's subscribe() overloads are ambiguous for a lambda: name the callback type.
+template <typename M, typename F>
+ros::Subscriber subscribe(ros::NodeHandle& nh, const std::string& topic, int queue, F f) {
+  return nh.subscribe<M>(topic, queue, boost::function<void(const typename M::ConstPtr&)>(f));
+}
+
+class NodeSim : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    nh_ = std::make_unique<ros::NodeHandle>();
+    auto& nh = *nh_;
+    subs_.push_back(subscribe<SystemState>(
+        nh, "system_state", 10, [](const SystemState::ConstPtr& m) { state_.set(*m); }));
+    subs_.push_back(subscribe<nav_msgs::Odometry>(
+        nh, "odom", 10, [](const nav_msgs::Odometry::ConstPtr& m) { odom_.set(*m); }));
+    subs_.push_back(subscribe<nav_msgs::Odometry>(
+        nh, "sim/ground_truth", 10, [](const nav_msgs::Odometry::ConstPtr& m) { truth_.set(*m); }));
+    subs_.push_back(subscribe<ranger_msgs::UltrasonicState>(
+        nh, "ultrasonic_state", 10,
+        [](const ranger_msgs::UltrasonicState::ConstPtr& m) { ultrasonic_.set(*m); }));
+    subs_.push_back(subscribe<geometry_msgs::TwistStamped>(
+        nh, "cmd_vel_out", 1000, [](const geometry_msgs::TwistStamped::ConstPtr& m) {
+          std::lock_guard<std::mutex> lock(commands_mutex_);
+          commands_.push_back(*m);
+          if (commands_.size() > 20000) commands_.pop_front();
+        }));
+    subs_.push_back(subscribe<rosgraph_msgs::Log>(
+        nh, "/rosout", 1000, [](const rosgraph_msgs::Log::ConstPtr& m) {
+          if (m->name.find("ranger_base_node") == std::string::npos) return;
+          std::lock_guard<std::mutex> lock(commands_mutex_);
+          logs_.push_back(*m);
+        }));
+    cmd_pub_ = nh.advertise<geometry_msgs::Twist>("cmd_vel", 100);
+    spinner_ = std::make_unique<ros::AsyncSpinner>(2);
+    spinner_->start();
+  }
+
+  static void TearDownTestSuite() {
+    spinner_->stop();
+    subs_.clear();
+    cmd_pub_.shutdown();
+    nh_.reset();
+  }
+
+  void SetUp() override {
+    ASSERT_TRUE(wait_for([] {
+      const auto s = state_.get();
+      return s && s->link_up && s->control_mode == SystemState::CONTROL_MODE_CAN &&
+             cmd_pub_.getNumSubscribers() > 0 && truth_.get() && odom_.get();
+    })) << "the node never reached CAN command mode";
+    stop_and_settle();
+  }
+
+  static bool wait_for(const std::function<bool()>& condition, double limit_s = 20.0) {
+    const auto end = ros::WallTime::now() + ros::WallDuration(limit_s);
+    while (ros::ok() && ros::WallTime::now() < end) {
+      if (condition()) return true;
+      ros::WallDuration(0.005).sleep();
+    }
+    return condition();
+  }
+
+  static geometry_msgs::Twist twist(double vx, double vy, double wz) {
+    geometry_msgs::Twist t;
+    t.linear.x = vx;
+    t.linear.y = vy;
+    t.angular.z = wz;
+    return t;
+  }
+
+  // Publishes `cmd` at 20 Hz (a teleop's rate, well inside cmd_vel_timeout) until `condition`.
+  static bool drive_until(const geometry_msgs::Twist& cmd, const std::function<bool()>& condition,
+                          double limit_s = 20.0) {
+    const auto end = ros::WallTime::now() + ros::WallDuration(limit_s);
+    while (ros::ok() && ros::WallTime::now() < end) {
+      cmd_pub_.publish(cmd);
+      if (wait_for(condition, 0.05)) return true;
+    }
+    return false;
+  }
+
+  static double speed(const nav_msgs::Odometry& o) {
+    return std::hypot(o.twist.twist.linear.x, o.twist.twist.linear.y) +
+           std::abs(o.twist.twist.angular.z);
+  }
+
+  // Stops publishing and waits until the virtual chassis is at rest.
+  static void stop_and_settle() {
+    cmd_pub_.publish(twist(0, 0, 0));
+    ASSERT_TRUE(wait_for([] { return speed(*truth_.get()) < 1e-3; })) << "chassis did not stop";
+  }
+
+  static std::vector<geometry_msgs::TwistStamped> commands_since(const ros::Time& t) {
+    std::lock_guard<std::mutex> lock(commands_mutex_);
+    std::vector<geometry_msgs::TwistStamped> out;
+    for (const auto& c : commands_) {
+      if (c.header.stamp >= t) out.push_back(c);
+    }
+    return out;
+  }
+
+  static bool is_zero(const geometry_msgs::TwistStamped& c) {
+    return c.twist.linear.x == 0.0 && c.twist.linear.y == 0.0 && c.twist.angular.z == 0.0;
+  }
+
+  // Odometry against the virtual chassis's ground truth, both from the same node cycle.
+  static void expect_odom_matches_truth(double distance_travelled) {
+    const auto odom = odom_.get();
+    const auto truth = truth_.get();
+    ASSERT_TRUE(odom && truth);
+    const double tolerance = 0.02 + 0.02 * distance_travelled;
+    EXPECT_NEAR(odom->pose.pose.position.x, truth->pose.pose.position.x, tolerance);
+    EXPECT_NEAR(odom->pose.pose.position.y, truth->pose.pose.position.y, tolerance);
+    const double dyaw = std::remainder(
+        tf2::getYaw(odom->pose.pose.orientation) - tf2::getYaw(truth->pose.pose.orientation),
+        2 * M_PI);
+    EXPECT_LT(std::abs(dyaw), 2.0 * M_PI / 180.0);
+    EXPECT_GT(odom->pose.covariance[0], 0.0);
+    EXPECT_GT(odom->twist.covariance[35], 0.0);
+  }
+
+  static std::unique_ptr<ros::NodeHandle> nh_;
+  static std::vector<ros::Subscriber> subs_;
+  static ros::Publisher cmd_pub_;
+  static std::unique_ptr<ros::AsyncSpinner> spinner_;
+  static Latest<SystemState> state_;
+  static Latest<nav_msgs::Odometry> odom_, truth_;
+  static Latest<ranger_msgs::UltrasonicState> ultrasonic_;
+  static std::mutex commands_mutex_;
+  static std::deque<geometry_msgs::TwistStamped> commands_;
+  static std::vector<rosgraph_msgs::Log> logs_;
+};
+
+std::unique_ptr<ros::NodeHandle> NodeSim::nh_;
+std::vector<ros::Subscriber> NodeSim::subs_;
+ros::Publisher NodeSim::cmd_pub_;
+std::unique_ptr<ros::AsyncSpinner> NodeSim::spinner_;
+Latest<SystemState> NodeSim::state_;
+Latest<nav_msgs::Odometry> NodeSim::odom_, NodeSim::truth_;
+Latest<ranger_msgs::UltrasonicState> NodeSim::ultrasonic_;
+std::mutex NodeSim::commands_mutex_;
+std::deque<geometry_msgs::TwistStamped> NodeSim::commands_;
+std::vector<rosgraph_msgs::Log> NodeSim::logs_;
+
+double yaw_of(const nav_msgs::Odometry& o) { return tf2::getYaw(o.pose.pose.orientation); }
+
+TEST_F(NodeSim, HandshakeReachesCanCommandMode) {
+  const auto s = state_.get();
+  ASSERT_TRUE(s);
+  EXPECT_TRUE(s->link_up);
+  EXPECT_EQ(s->control_mode, SystemState::CONTROL_MODE_CAN);
+  EXPECT_EQ(s->vehicle_status, SystemState::VEHICLE_STATUS_NORMAL);
+  EXPECT_EQ(s->error_word, 0u);
+}
+
+TEST_F(NodeSim, AckermannArcMovesForwardAndTurnsLeft) {
+  const auto start = *truth_.get();
+  ASSERT_TRUE(drive_until(twist(0.5, 0.0, 0.4), [&] {
+    const auto t = truth_.get();
+    return std::hypot(t->pose.pose.position.x - start.pose.pose.position.x,
+                      t->pose.pose.position.y - start.pose.pose.position.y) > 0.8;
+  }));
+  EXPECT_EQ(state_.get()->motion_mode, SystemState::MOTION_MODE_ACKERMANN);
+  const auto end = *truth_.get();
+  EXPECT_GT(std::remainder(yaw_of(end) - yaw_of(start), 2 * M_PI), 0.1);  // CCW = left (REP-103)
+  stop_and_settle();
+  expect_odom_matches_truth(1.0);
+}
+
+TEST_F(NodeSim, LateralVelocityCrabsInObliqueMode) {
+  const auto start = *truth_.get();
+  const double yaw0 = yaw_of(start);
+  ASSERT_TRUE(drive_until(twist(0.0, 0.4, 0.0), [&] {
+    const auto t = truth_.get();
+    // Displacement expressed in the body frame at the start: to the left (+y).
+    const double dx = t->pose.pose.position.x - start.pose.pose.position.x;
+    const double dy = t->pose.pose.position.y - start.pose.pose.position.y;
+    return -std::sin(yaw0) * dx + std::cos(yaw0) * dy > 0.5;
+  }));
+  EXPECT_EQ(state_.get()->motion_mode, SystemState::MOTION_MODE_OBLIQUE);
+  EXPECT_LT(std::abs(std::remainder(yaw_of(*truth_.get()) - yaw0, 2 * M_PI)), 0.02);
+  stop_and_settle();
+  expect_odom_matches_truth(1.0);
+}
+
+TEST_F(NodeSim, PureRotationSpinsInPlace) {
+  const auto start = *truth_.get();
+  double turned = 0.0, last = yaw_of(start);
+  ASSERT_TRUE(drive_until(twist(0.0, 0.0, 0.6), [&] {
+    const double y = yaw_of(*truth_.get());
+    turned += std::remainder(y - last, 2 * M_PI);
+    last = y;
+    return turned > 1.5;
+  }));
+  EXPECT_EQ(state_.get()->motion_mode, SystemState::MOTION_MODE_SPIN);
+  const auto end = *truth_.get();
+  EXPECT_LT(std::hypot(end.pose.pose.position.x - start.pose.pose.position.x,
+                       end.pose.pose.position.y - start.pose.pose.position.y),
+            0.05);
+  stop_and_settle();
+  expect_odom_matches_truth(0.0);
+}
+
+TEST_F(NodeSim, CmdVelStoppingGivesAZeroCommandWithinTheTimeout) {
+  ASSERT_TRUE(drive_until(twist(0.4, 0.0, 0.0), [] { return truth_.get()->twist.twist.linear.x > 0.3; }));
+  for (int i = 0; i < 5; ++i) {  // keep driving a little: the command is fresh
+    cmd_pub_.publish(twist(0.4, 0.0, 0.0));
+    ros::WallDuration(0.05).sleep();
+  }
+  const ros::Time last_publish = ros::Time::now();
+  cmd_pub_.publish(twist(0.4, 0.0, 0.0));
+  // Then silence. The first zero 0x111 after the last cmd_vel must be stamped (by the node, when
+  // it sent it) no earlier than the timeout after that cmd_vel was published, and no later than
+  // the timeout + one publish period + a generous allowance for ROS transport and scheduling.
+  std::optional<geometry_msgs::TwistStamped> first_zero;
+  ASSERT_TRUE(wait_for([&] {
+    for (const auto& c : commands_since(last_publish)) {
+      if (is_zero(c)) {
+        first_zero = c;
+        return true;
+      }
+    }
+    return false;
+  }));
+  const double delay = (first_zero->header.stamp - last_publish).toSec();
+  EXPECT_GE(delay, kCmdVelTimeout - 0.001);
+  EXPECT_LE(delay, kCmdVelTimeout + kPublishPeriod + 0.25);
+  // Until then the chassis kept being commanded (keep-alive), in order.
+  for (const auto& c : commands_since(last_publish)) {
+    if (c.header.stamp >= first_zero->header.stamp) break;
+    EXPECT_GT(c.twist.linear.x, 0.0);
+  }
+  EXPECT_EQ(state_.get()->motion_inhibited_reason, "cmd_timeout");
+  ASSERT_TRUE(wait_for([] { return speed(*truth_.get()) < 1e-3; }));
+}
+
+TEST_F(NodeSim, NonFiniteCommandsAreRefusedStopTheChassisAndAreLoggedThrottled) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  for (const auto& bad : {twist(nan, 0, 0), twist(0, inf, 0), twist(0.3, 0, -inf)}) {
+    ASSERT_TRUE(drive_until(twist(0.4, 0, 0), [] { return truth_.get()->twist.twist.linear.x > 0.3; }));
+    const ros::Time sent = ros::Time::now();
+    cmd_pub_.publish(bad);
+    // A zero command follows at once (not after the timeout), and nothing non-finite is sent.
+    ASSERT_TRUE(wait_for([&] {
+      for (const auto& c : commands_since(sent)) {
+        if (is_zero(c)) return true;
+      }
+      return false;
+    }));
+    for (const auto& c : commands_since(sent)) {
+      EXPECT_TRUE(std::isfinite(c.twist.linear.x) && std::isfinite(c.twist.linear.y) &&
+                  std::isfinite(c.twist.angular.z));
+    }
+    ASSERT_TRUE(wait_for([] { return speed(*truth_.get()) < 1e-3; }));
+  }
+  // A flood of NaN: the refusal is logged at most once per second.
+  const ros::Time flood_start = ros::Time::now();
+  for (int i = 0; i < 400; ++i) {
+    cmd_pub_.publish(twist(nan, 0, 0));
+    ros::WallDuration(0.0025).sleep();
+  }
+  ros::WallDuration(0.5).sleep();  // let /rosout arrive
+  const double flood_s = (ros::Time::now() - flood_start).toSec();
+  std::lock_guard<std::mutex> lock(commands_mutex_);
+  int refusals = 0;
+  for (const auto& l : logs_) {
+    if (l.header.stamp >= flood_start && l.msg.find("cmd_vel refused") != std::string::npos) {
+      ++refusals;
+    }
+  }
+  EXPECT_GE(refusals, 1);
+  EXPECT_LE(refusals, static_cast<int>(std::ceil(flood_s)) + 1);
+}
+
+TEST_F(NodeSim, HugeCommandsAreClampedToTheLimits) {
+  ASSERT_TRUE(drive_until(twist(1e9, 0, 0), [] { return truth_.get()->twist.twist.linear.x > 0.9; }));
+  const ros::Time t = ros::Time::now();
+  for (int i = 0; i < 20; ++i) {
+    cmd_pub_.publish(twist(1e9, 0, 0));
+    ros::WallDuration(0.05).sleep();
+  }
+  const auto commands = commands_since(t);
+  ASSERT_FALSE(commands.empty());
+  for (const auto& c : commands) EXPECT_LE(c.twist.linear.x, kMaxLinearSpeed + 1e-3);
+  EXPECT_LE(truth_.get()->twist.twist.linear.x, kMaxLinearSpeed + 1e-3);
+  stop_and_settle();
+}
+
+TEST_F(NodeSim, AFloodOfCommandsIsRateBoundedAndTheNodeStaysResponsive) {
+  const ros::Time start = ros::Time::now();
+  for (int i = 0; i < 3000; ++i) cmd_pub_.publish(twist(0.1 + 0.0001 * (i % 100), 0, 0));
+  const ros::Time end = ros::Time::now();
+  ros::WallDuration(0.2).sleep();
+  const auto commands = commands_since(start);
+  // 0x111 never goes out faster than min_command_interval apart, whatever arrives.
+  int in_window = 0;
+  for (const auto& c : commands) {
+    if (c.header.stamp <= end) ++in_window;
+  }
+  const double window = (end - start).toSec();
+  EXPECT_LE(in_window, static_cast<int>(window / kMinCommandInterval) + 2);
+  // Still alive and obeying: the latest command drives the chassis.
+  ASSERT_TRUE(drive_until(twist(0.3, 0, 0), [] {
+    return std::abs(truth_.get()->twist.twist.linear.x - 0.3) < 0.02;
+  }));
+  stop_and_settle();
+}
+
+TEST_F(NodeSim, UltrasonicServiceReachesTheChassis) {
+  ros::ServiceClient client = nh_->serviceClient<ranger_msgs::SetUltrasonic>("set_ultrasonic");
+  ASSERT_TRUE(client.waitForExistence(ros::Duration(10.0)));
+  for (const bool enable : {true, false}) {
+    ranger_msgs::SetUltrasonic srv;
+    srv.request.enable = enable;
+    ASSERT_TRUE(client.call(srv));
+    EXPECT_TRUE(srv.response.success) << srv.response.message;
+    EXPECT_EQ(srv.response.enabled, enable);
+    EXPECT_TRUE(wait_for([&] {
+      const auto u = ultrasonic_.get();
+      return u && u->avoidance_known && u->avoidance_enabled == enable;
+    }));
+  }
+  const auto u = ultrasonic_.get();
+  ASSERT_EQ(u->sensors.size(), 8u);
+  EXPECT_EQ(u->sensors[0].status, "ok");
+}
+
+TEST_F(NodeSim, ClearErrorsRefusesAnUnknownCode) {
+  ros::ServiceClient client = nh_->serviceClient<ranger_msgs::ClearErrors>("clear_errors");
+  ASSERT_TRUE(client.waitForExistence(ros::Duration(10.0)));
+  ranger_msgs::ClearErrors srv;
+  srv.request.code = 0x11;
+  ASSERT_TRUE(client.call(srv));
+  EXPECT_FALSE(srv.response.success);
+  EXPECT_NE(srv.response.message.find("17"), std::string::npos) << srv.response.message;
+  srv.request.code = ranger_msgs::ClearErrors::Request::ALL_NON_CRITICAL;
+  ASSERT_TRUE(client.call(srv));
+  EXPECT_TRUE(srv.response.success) << srv.response.message;
+}
+
+TEST_F(NodeSim, MotionModeCanBePinnedAndReleased) {
+  ros::ServiceClient client = nh_->serviceClient<ranger_msgs::SetMotionMode>("set_motion_mode");
+  ASSERT_TRUE(client.waitForExistence(ros::Duration(10.0)));
+  ranger_msgs::SetMotionMode srv;
+  srv.request.mode = ranger_msgs::SetMotionMode::Request::OBLIQUE;
+  ASSERT_TRUE(client.call(srv));
+  EXPECT_TRUE(srv.response.success);
+  // Straight ahead would be Ackermann automatically; pinned, it is driven in oblique mode.
+  ASSERT_TRUE(drive_until(twist(0.2, 0, 0), [] {
+    return state_.get()->motion_mode == SystemState::MOTION_MODE_OBLIQUE &&
+           truth_.get()->twist.twist.linear.x > 0.1;
+  }));
+  stop_and_settle();
+  srv.request.mode = ranger_msgs::SetMotionMode::Request::AUTOMATIC;
+  ASSERT_TRUE(client.call(srv));
+  EXPECT_TRUE(srv.response.success);
+  ASSERT_TRUE(drive_until(twist(0.3, 0, 0.3), [] {
+    return state_.get()->motion_mode == SystemState::MOTION_MODE_ACKERMANN &&
+           truth_.get()->twist.twist.linear.x > 0.1;
+  }));
+  srv.request.mode = 7;
+  ASSERT_TRUE(client.call(srv));
+  EXPECT_FALSE(srv.response.success);
+  stop_and_settle();
+}
+
+// ---- node_sim_faults.test: the virtual chassis boots with motor driver 1's communication fault.
+
+class Faults : public NodeSim {
+ protected:
+  void SetUp() override {
+    ASSERT_TRUE(wait_for([] {
+      const auto s = state_.get();
+      return s && s->link_up && s->control_mode == SystemState::CONTROL_MODE_CAN &&
+             cmd_pub_.getNumSubscribers() > 0 && truth_.get();
+    }));
+  }
+};
+
+TEST_F(Faults, ClearErrorsReachesTheChassisAndMotionResumes) {
+  ASSERT_TRUE(wait_for([] { return state_.get()->errors.motor_driver_1_communication_fault; }));
+  EXPECT_EQ(state_.get()->motion_inhibited_reason, "critical_error");
+  // The fault stops the chassis: commands do not move it.
+  for (int i = 0; i < 10; ++i) {
+    cmd_pub_.publish(twist(0.4, 0, 0));
+    ros::WallDuration(0.05).sleep();
+  }
+  EXPECT_LT(speed(*truth_.get()), 1e-3);
+
+  ros::ServiceClient client = nh_->serviceClient<ranger_msgs::ClearErrors>("clear_errors");
+  ASSERT_TRUE(client.waitForExistence(ros::Duration(10.0)));
+  ranger_msgs::ClearErrors srv;
+  srv.request.code = ranger_msgs::ClearErrors::Request::MOTOR1_COMMUNICATION;
+  ASSERT_TRUE(client.call(srv));
+  EXPECT_TRUE(srv.response.success) << srv.response.message;
+  ASSERT_TRUE(wait_for([] { return state_.get()->error_word == 0; }));
+  EXPECT_TRUE(drive_until(twist(0.4, 0, 0), [] { return truth_.get()->twist.twist.linear.x > 0.3; }));
+  stop_and_settle();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_node_sim");
+  return RUN_ALL_TESTS();
+}

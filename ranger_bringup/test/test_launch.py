@@ -1,0 +1,139 @@
+"""The launch files, resolved by roslaunch itself (--nodes, --dump-params; nothing is started):
+which nodes each starts, under which names, with which parameters, for each combination of the
+arguments users pass. roslaunch-check (CMakeLists.txt) covers parse errors and missing packages.
+
+The source launch files are tested (their package directories come first on ROS_PACKAGE_PATH);
+ranger_base must be findable (source the workspace's setup.bash), as for roslaunch-check."""
+
+import os
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+
+import pytest
+import yaml
+
+sys.path.insert(0, os.path.dirname(__file__))
+from rostest_support import PACKAGE_DIR  # noqa: E402
+
+REPO = os.path.dirname(PACKAGE_DIR)
+DESCRIPTION_DIR = os.path.join(REPO, "ranger_description")
+LAUNCH_DIR = os.path.join(PACKAGE_DIR, "launch")
+GEOMETRY = os.path.join(DESCRIPTION_DIR, "config", "geometry.yaml")
+ENV = dict(os.environ, ROS_HOME=os.environ.get("ROS_HOME", "/tmp/ranger-test-roshome"),
+           ROS_PACKAGE_PATH=os.pathsep.join(
+               [PACKAGE_DIR, DESCRIPTION_DIR] + [p for p in os.environ.get(
+                   "ROS_PACKAGE_PATH", "").split(os.pathsep) if p]))
+
+
+def roslaunch(option, launch, *args):
+    """`roslaunch OPTION FILE ARGS...`; option may be a list (e.g. ["--args", "/rviz"])."""
+    options = option if isinstance(option, list) else [option]
+    result = subprocess.run(["roslaunch", *options, os.path.join(LAUNCH_DIR, launch), *args],
+                            capture_output=True, text=True, env=ENV, timeout=120)
+    assert result.returncode == 0, result.stdout + result.stderr
+    return result.stdout
+
+
+def nodes(launch, *args):
+    return sorted(roslaunch("--nodes", launch, *args).split())
+
+
+def params(launch, *args):
+    return yaml.safe_load(roslaunch("--dump-params", launch, *args))
+
+
+def all_launch_files():
+    return sorted(f for f in os.listdir(LAUNCH_DIR) if f.endswith(".launch"))
+
+
+def test_every_launch_file_is_covered():
+    assert all_launch_files() == ["display.launch", "ranger_minimal.launch", "ranger_sim.launch",
+                                  "ranger_teleop_keyboard.launch"]
+
+
+@pytest.mark.parametrize("launch", all_launch_files())
+@pytest.mark.parametrize("ns", [[], ["namespace:=r1"]])
+def test_every_launch_file_resolves(launch, ns):
+    assert nodes(launch, *ns)
+
+
+def test_minimal_on_can0_by_default():
+    assert nodes("ranger_minimal.launch") == ["/diagnostic_aggregator", "/ranger_base_node",
+                                              "/robot_state_publisher"]
+    p = params("ranger_minimal.launch")
+    assert p["/ranger_base_node/port_name"] == "can0"
+    assert p["/ranger_base_node/odom_frame"] == "odom"
+    assert p["/ranger_base_node/base_frame"] == "base_footprint"  # the URDF's root
+    assert p["/ranger_base_node/publish_odom_tf"] is True
+    assert p["/diagnostic_aggregator/analyzers/ranger/path"] == "RANGER"
+
+
+def test_minimal_arguments_reach_the_node():
+    p = params("ranger_minimal.launch", "port_name:=can1", "publish_odom_tf:=false")
+    assert p["/ranger_base_node/port_name"] == "can1"
+    assert p["/ranger_base_node/publish_odom_tf"] is False
+    assert params("ranger_minimal.launch", "sim:=true", "port_name:=can1")[
+        "/ranger_base_node/port_name"] == "sim"
+
+
+def test_node_and_urdf_share_the_geometry_file():
+    with open(GEOMETRY, encoding="utf-8") as f:
+        geometry = yaml.safe_load(f)
+    p = params("ranger_minimal.launch")
+    for key in ("wheelbase", "track", "wheel_radius"):
+        assert p[f"/ranger_base_node/{key}"] == geometry[key]
+    robot = ET.fromstring(p["/robot_description"])
+    joint = robot.find("joint[@name='front_left_steering_joint']/origin")
+    x, y, _ = (float(v) for v in joint.get("xyz").split())
+    assert (x, y) == pytest.approx((geometry["wheelbase"] / 2, geometry["track"] / 2))
+
+
+def test_a_custom_geometry_file_changes_node_and_urdf_together(tmp_path):
+    with open(GEOMETRY, encoding="utf-8") as f:
+        geometry = yaml.safe_load(f)
+    geometry["wheelbase"] = 1.0
+    custom = tmp_path / "geometry.yaml"
+    custom.write_text(yaml.safe_dump(geometry))
+    p = params("ranger_minimal.launch", f"geometry_file:={custom}")
+    assert p["/ranger_base_node/wheelbase"] == 1.0
+    robot = ET.fromstring(p["/robot_description"])
+    origin = robot.find("joint[@name='rear_right_steering_joint']/origin").get("xyz")
+    assert float(origin.split()[0]) == pytest.approx(-0.5)
+
+
+def test_namespace_moves_nodes_params_and_frames():
+    assert nodes("ranger_minimal.launch", "namespace:=r1", "diagnostics_aggregator:=false") == [
+        "/r1/ranger_base_node", "/r1/robot_state_publisher"]
+    p = params("ranger_minimal.launch", "namespace:=r1")
+    assert p["/r1/ranger_base_node/odom_frame"] == "r1/odom"
+    assert p["/r1/ranger_base_node/base_frame"] == "r1/base_footprint"
+    assert p["/r1/robot_state_publisher/tf_prefix"] == "r1"
+    assert "/r1/robot_description" in p and "/robot_description" not in p
+
+
+def test_sim_in_process_and_on_vcan():
+    assert "/virtual_chassis" not in nodes("ranger_sim.launch")
+    assert params("ranger_sim.launch")["/ranger_base_node/port_name"] == "sim"
+    assert "/virtual_chassis" in nodes("ranger_sim.launch", "interface:=vcan0")
+    assert params("ranger_sim.launch", "interface:=vcan0")["/ranger_base_node/port_name"] == "vcan0"
+    assert "/rviz" in nodes("ranger_sim.launch", "rviz:=true")
+
+
+def test_display_opens_rviz_with_the_config_in_the_namespace():
+    assert nodes("display.launch") == ["/rviz"]
+    assert nodes("display.launch", "namespace:=r1") == ["/r1/rviz"]
+    assert nodes("display.launch", "description:=true") == ["/robot_state_publisher", "/rviz"]
+    # The command line rviz gets: the config and the fixed frame.
+    out = roslaunch(["--args", "/rviz"], "display.launch")
+    assert os.path.join("rviz", "ranger.rviz") in out and "-f odom" in out
+    out = roslaunch(["--args", "/r1/rviz"], "display.launch", "namespace:=r1")
+    assert "-f r1/odom" in out
+
+
+def test_teleop_parameters_and_namespace():
+    assert nodes("ranger_teleop_keyboard.launch", "namespace:=r1") == [
+        "/r1/ranger_teleop_keyboard"]
+    p = params("ranger_teleop_keyboard.launch", "speed:=0.5")
+    assert p["/ranger_teleop_keyboard/speed"] == 0.5
+    assert p["/ranger_teleop_keyboard/key_timeout"] < 0.5  # the driver's cmd_vel_timeout
