@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds everything: libranger_can with its tool, unit tests and system suites (plain CMake, in
 # build/lib), then the ROS packages with colcon (build/ws, install/).
-# Usage: scripts/build.sh [lib|all]        (default all)
+# Usage: scripts/build.sh [lib|ros|all]    (default all; `ros` skips the library's own tests)
 # Environment: RANGER_BUILD_TYPE (default RelWithDebInfo), RANGER_JOBS (default nproc).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -12,11 +12,14 @@ generator=()
 command -v ninja >/dev/null && generator=(-G Ninja)
 
 mkdir -p build && touch build/COLCON_IGNORE   # keep colcon from descending into build trees
-echo "== build: libranger_can + tests (build/lib)"
-[ -f build/lib/CMakeCache.txt ] || cmake -S . -B build/lib "${generator[@]}" \
-  -DCMAKE_BUILD_TYPE="$build_type" >/dev/null
-cmake --build build/lib -j "$jobs"
+case "$what" in lib | ros | all) ;; *) echo "build.sh: unknown target '$what'" >&2; exit 2 ;; esac
 
+if [ "$what" != ros ]; then
+  echo "== build: libranger_can + tests (build/lib)"
+  [ -f build/lib/CMakeCache.txt ] || cmake -S . -B build/lib "${generator[@]}" \
+    -DCMAKE_BUILD_TYPE="$build_type" >/dev/null
+  cmake --build build/lib -j "$jobs"
+fi
 [ "$what" = lib ] && exit 0
 
 echo "== build: ROS packages (colcon -> install/)"
@@ -24,7 +27,7 @@ echo "== build: ROS packages (colcon -> install/)"
 export PATH=/usr/bin:$PATH
 if [ -f /opt/ros/noetic/setup.bash ]; then set +u; source /opt/ros/noetic/setup.bash; set -u; fi
 colcon --log-base build/log build --base-paths . --build-base build/ws --install-base install \
-  --event-handlers console_cohesion- summary+ status- \
+  --event-handlers console_cohesion- summary+ \
   --parallel-workers "$jobs" \
   --cmake-args -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE="$build_type" \
   -DRANGER_BUILD_TESTS=OFF -DRANGER_BUILD_BENCHMARKS=OFF

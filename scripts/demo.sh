@@ -38,8 +38,8 @@ if [ "$setup" = 1 ] && [ -x scripts/setup.sh ]; then
   scripts/setup.sh ros
 fi
 if [ "$build" = 1 ] && [ -x scripts/build.sh ]; then
-  step "build (scripts/build.sh)"
-  scripts/build.sh
+  step "build: ROS packages (scripts/build.sh ros)"
+  scripts/build.sh ros
 fi
 install_dir=${RANGER_INSTALL:-$repo/install}
 setup_file=$install_dir/setup.bash
@@ -58,24 +58,45 @@ source "$setup_file"
 set -u
 export ROS_HOME="$out/ros_home" ROS_HOSTNAME=${ROS_HOSTNAME:-localhost}
 unset ROS_IP
-port=$(/usr/bin/python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
+port=$(/usr/bin/python3 -c \
+  'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
 export ROS_MASTER_URI=http://localhost:$port
 step "driver: roslaunch ranger_bringup ranger_sim.launch (virtual chassis in-process)"
 roslaunch -p "$port" ranger_bringup ranger_sim.launch log_output:=log >"$out/roslaunch.log" 2>&1 &
 launch_pid=$!
 rviz_pid=
+node_pids() {  # the processes of the nodes registered at our master, and the master's own
+  /usr/bin/python3 - <<'PY' 2>/dev/null || true
+import xmlrpc.client
+import rosgraph
+import rosnode
+master = rosgraph.Master("/demo_sh")
+print(master.getPid())
+for name in rosnode.get_node_names():
+    try:
+        print(xmlrpc.client.ServerProxy(master.lookupNode(name)).getPid("/demo_sh")[2])
+    except Exception:
+        pass
+PY
+}
 stop_launch() {  # SIGINT as Ctrl-C would: the driver stops the chassis on its way out
   local pid=$1
-  if kill -0 "$pid" 2>/dev/null; then
-    kill -INT "$pid" 2>/dev/null || true
-    for _ in $(seq 50); do kill -0 "$pid" 2>/dev/null || break; sleep 0.2; done
-    kill -KILL "$pid" 2>/dev/null || true
-  fi
+  kill -0 "$pid" 2>/dev/null || return 0
+  kill -INT "$pid" 2>/dev/null || true
+  for _ in $(seq 75); do kill -0 "$pid" 2>/dev/null || break; sleep 0.2; done
+  kill -KILL "$pid" 2>/dev/null || true
   wait "$pid" 2>/dev/null || true
 }
 cleanup() {
+  # roslaunch starts each node in a session of its own and, stopped while still starting,
+  # may leave some behind: note them first, and end whatever outlives the launches.
+  local nodes p
+  nodes=$(node_pids)
   if [ -n "$rviz_pid" ]; then stop_launch "$rviz_pid"; fi
   stop_launch "$launch_pid"
+  for p in $nodes; do
+    if kill -0 "$p" 2>/dev/null; then kill -INT "$p" 2>/dev/null || true; fi
+  done
 }
 trap cleanup EXIT
 trap 'exit 130' INT TERM
@@ -101,7 +122,8 @@ demo_route=$(catkin_find --first-only --libexec ranger_bringup demo_route) || {
 status=0
 "$demo_route" --output-dir "$out" || status=$?
 if [ "$status" -ne 0 ]; then
-  echo "demo.sh: the route did not complete; the driver's log: $out/roslaunch.log and $ROS_HOME/log" >&2
+  echo "demo.sh: the route did not complete; the driver's logs: $out/roslaunch.log," \
+    "$ROS_HOME/log" >&2
   tail -n 20 "$out/roslaunch.log" >&2 || true
   exit "$status"
 fi
@@ -109,4 +131,5 @@ if [ -n "$rviz_pid" ]; then
   echo "rviz is open: close it (or press Ctrl-C) to finish."
   wait "$rviz_pid" || true
 fi
-step "done in $((SECONDS - start)) s: plot $out/odometry_vs_ground_truth.png, summary $out/summary.txt"
+step "done in $((SECONDS - start)) s: plot $out/odometry_vs_ground_truth.png," \
+  "summary $out/summary.txt"

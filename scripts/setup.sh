@@ -15,8 +15,11 @@ ros_pkgs=(ros-base-dev libroscpp-dev librostest-dev python3-rostest python3-rosl
   python3-rosnode python3-rostopic ros-message-generation python3-genmsg libstd-msgs-dev
   libgeometry-msgs-dev libsensor-msgs-dev libnav-msgs-dev libtf2-ros-dev libtf2-geometry-msgs-dev
   libdiagnostic-updater-dev libdiagnostic-aggregator-dev libdiagnostic-aggregator-tools
-  ros-robot-state-publisher rviz liburdfdom-tools libeigen3-dev catkin colcon python3-colcon-ros
-  python3-colcon-cmake python3-matplotlib python3-numpy
+  ros-robot-state-publisher rviz liburdfdom-tools libeigen3-dev catkin rosbash
+  colcon python3-colcon-ros python3-colcon-cmake python3-colcon-bash python3-colcon-output
+  python3-colcon-parallel-executor python3-colcon-package-selection
+  python3-colcon-package-information python3-colcon-test-result python3-colcon-library-path
+  python3-matplotlib python3-numpy
   python3-yaml python3-pytest python3-geometry-msgs python3-nav-msgs python3-sensor-msgs
   python3-diagnostic-msgs python3-tf2-msgs)
 # ROS Noetic from packages.ros.org (Ubuntu 20.04), for users who already have /opt/ros/noetic.

@@ -15,10 +15,6 @@ namespace interp = ranger::interpretation;
 // Below this a twist component counts as absent (for flags and degenerate geometry only; the
 // mode thresholds live in ModeSelectorConfig).
 constexpr double kEps = 1e-9;
-constexpr double kDeg = M_PI / 180.0;
-constexpr double kMaxAckermannSteering = 40.0 * kDeg;  // 0x111: +-4000 x 0.01 deg
-constexpr double kMaxObliqueSteering = 90.0 * kDeg;    // 0x111: +-9000 x 0.01 deg
-constexpr double kMaxSpinWheelSpeed = 1.0;             // 0x111: +-1000 mm/s
 
 double sign(double v) {
   return v < 0.0 ? -1.0 : 1.0;
@@ -67,8 +63,8 @@ void solve_ackermann(const BodyTwist& t, const VehicleGeometry& g, const Kinemat
                      KinematicsSolution& s) {
   if (std::fabs(t.vy) > kEps) s.flags |= kLateralDropped;
   const double max_steer = limits.max_ackermann_steering;
-  double steering = 0.0;  // REP-103: positive = left
-  double speed = 0.0;
+  double steering = 0.0;       // REP-103: positive = left
+  double command_speed = 0.0;  // 0x111 linear speed
   double curvature = 0.0;
   if (std::fabs(t.vx) <= kEps) {
     // A rotation without forward speed has infinite curvature: Ackermann cannot do it. Turn the
@@ -86,14 +82,20 @@ void solve_ackermann(const BodyTwist& t, const VehicleGeometry& g, const Kinemat
     }
     steering = std::clamp(interp::ackermann_mean_front_angle(curvature, g.wheelbase, g.track),
                           -max_steer, max_steer);
-    speed = saturate_speed(t.vx, speed_limit_at(steering, limits), s.flags);
+    // The speed limits bound the value on the wire; interpretation point 7 relates it to vx.
+    command_speed =
+        saturate_speed(interp::command_speed_from_body_speed(t.vx, curvature, g.wheelbase, g.track),
+                       speed_limit_at(steering, limits), s.flags);
   }
-  s.command.linear_speed = speed;
+  const double speed =
+      interp::body_speed_from_command_speed(command_speed, curvature, g.wheelbase, g.track);
+  s.command.linear_speed = command_speed;
   s.command.steering_angle = interp::manual_from_rep103_command_steering(steering);
   s.achieved = BodyTwist{speed, 0.0, curvature * speed};
 }
 
-void solve_oblique(const BodyTwist& t, const KinematicsLimits& limits, KinematicsSolution& s) {
+void solve_oblique(const BodyTwist& t, const VehicleGeometry& g, const KinematicsLimits& limits,
+                   KinematicsSolution& s) {
   if (std::fabs(t.wz) > kEps) s.flags |= kRotationDropped;
   double speed = std::hypot(t.vx, t.vy);
   double direction = 0.0;  // REP-103
@@ -109,7 +111,8 @@ void solve_oblique(const BodyTwist& t, const KinematicsLimits& limits, Kinematic
   } else {
     speed = 0.0;
   }
-  s.command.linear_speed = speed;
+  // All wheels parallel: curvature 0, where the body and every wheel move alike (point 7).
+  s.command.linear_speed = interp::command_speed_from_body_speed(speed, 0.0, g.wheelbase, g.track);
   s.command.steering_angle = interp::manual_from_rep103_command_steering(direction);
   s.achieved = BodyTwist{speed * std::cos(direction), speed * std::sin(direction), 0.0};
 }
@@ -137,9 +140,9 @@ Status KinematicsLimits::validate() const {
   } checks[] = {
       {"max_linear_speed", max_linear_speed, interp::kMaxLinearSpeedMps},
       {"max_speed_at_large_steering", max_speed_at_large_steering, interp::kMaxLinearSpeedMps},
-      {"max_ackermann_steering", max_ackermann_steering, kMaxAckermannSteering},
-      {"max_oblique_steering", max_oblique_steering, kMaxObliqueSteering},
-      {"max_spin_wheel_speed", max_spin_wheel_speed, kMaxSpinWheelSpeed},
+      {"max_ackermann_steering", max_ackermann_steering, kMaxAckermannSteeringRad},
+      {"max_oblique_steering", max_oblique_steering, kMaxObliqueSteeringRad},
+      {"max_spin_wheel_speed", max_spin_wheel_speed, kMaxSpinSpeedMps},
   };
   for (const auto& c : checks) {
     Status st = check_limit(c.name, c.value, c.max);
@@ -196,7 +199,7 @@ Result<KinematicsSolution> solve_kinematics(const BodyTwist& twist, MotionMode m
       solve_ackermann(twist, geometry, limits, s);
       break;
     case MotionMode::kOblique:
-      solve_oblique(twist, limits, s);
+      solve_oblique(twist, geometry, limits, s);
       break;
     case MotionMode::kSpin:
       solve_spin(twist, geometry, limits, s);
@@ -218,12 +221,15 @@ BodyTwist twist_from_command(const MotionCommand& command, MotionMode mode,
       // A steering of +-90 deg or more (far outside the 0x111 range) has an infinite curvature:
       // no defined twist, and never a NaN.
       if (!std::isfinite(curvature)) return BodyTwist{};
-      return BodyTwist{command.linear_speed, 0.0, curvature * command.linear_speed};
+      const double vx = interp::body_speed_from_command_speed(command.linear_speed, curvature,
+                                                              geometry.wheelbase, geometry.track);
+      return BodyTwist{vx, 0.0, curvature * vx};
     }
     case MotionMode::kOblique: {
       const double direction = interp::rep103_from_manual_command_steering(command.steering_angle);
-      return BodyTwist{command.linear_speed * std::cos(direction),
-                       command.linear_speed * std::sin(direction), 0.0};
+      const double speed = interp::body_speed_from_command_speed(command.linear_speed, 0.0,
+                                                                 geometry.wheelbase, geometry.track);
+      return BodyTwist{speed * std::cos(direction), speed * std::sin(direction), 0.0};
     }
     case MotionMode::kSpin:
       return BodyTwist{0.0, 0.0,

@@ -231,19 +231,25 @@ Status LoopbackBus::send(const CanFrame& frame) {
 }
 
 Result<CanFrame> LoopbackBus::receive(std::chrono::nanoseconds timeout) {
-  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  // A poll (timeout <= 0) never touches the condition variable: even an already expired timed
+  // wait costs a futex round trip, which dominates lock-step simulations that poll every tick.
+  const bool poll = timeout <= std::chrono::nanoseconds::zero();
+  const auto deadline = poll ? std::chrono::steady_clock::time_point{}
+                             : std::chrono::steady_clock::now() + timeout;
   std::unique_lock<std::mutex> lock(wire_->mutex);
   Endpoint& ep = *endpoint_;
   const bool noticed_loss = wire_->refresh(ep);
   if (!ep.attached) {
-    if (noticed_loss) return wire_->down_error(ep);
+    if (noticed_loss || poll) return wire_->down_error(ep);
     // Nothing to wait on: wait out the timeout like an idle bus, so callers do not spin.
     while (ep.wake.wait_until(lock, deadline) != std::cv_status::timeout) {
     }
     return wire_->down_error(ep);
   }
   for (;;) {
-    ep.wake.wait_until(lock, deadline, [&] { return !ep.queue.empty() || ep.loss_pending; });
+    if (!poll) {
+      ep.wake.wait_until(lock, deadline, [&] { return !ep.queue.empty() || ep.loss_pending; });
+    }
     if (ep.loss_pending) {
       wire_->refresh(ep);
       return wire_->down_error(ep);

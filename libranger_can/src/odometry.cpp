@@ -102,21 +102,15 @@ BodyTwist twist_from_motion_feedback(const MotionFeedback& feedback, MotionMode 
           interp::ackermann_curvature_from_mean_angle(steering, geometry.wheelbase, geometry.track);
       if (std::isinf(k)) {
         // A reported angle of 90 deg or more (a corrupt frame): the limit of the formula below
-        // as k grows, a rotation about the body centre; inf * 0 would make the twist NaN.
-        return BodyTwist{
-            0.0, 0.0,
-            std::copysign(1.0, k) * interp::spin_yaw_rate_from_wheel_speed(
-                                        feedback.speed, geometry.wheelbase, geometry.track)};
+        // as k grows, a rotation about the body centre at the wheels' speed; inf * 0 would make
+        // the twist NaN.
+        return BodyTwist{0.0, 0.0,
+                         std::copysign(1.0, k) *
+                             interp::spin_yaw_rate_from_feedback_speed(
+                                 feedback.speed, geometry.wheelbase, geometry.track)};
       }
-      // 0x221 reports the mean of the four wheel speeds; each wheel runs |1 - k*y_i, k*x_i|
-      // times faster than the body centre.
-      double factor = 0.0;
-      for (int i = 0; i < kWheelCount; ++i) {
-        const WheelPosition p = geometry.wheel_position(i);
-        factor += std::hypot(1.0 - k * p.y, k * p.x);
-      }
-      factor /= kWheelCount;
-      const double vx = factor > 0.0 ? feedback.speed / factor : 0.0;
+      const double vx = interp::ackermann_body_speed_from_feedback_speed(
+          feedback.speed, k, geometry.wheelbase, geometry.track);
       return BodyTwist{vx, 0.0, k * vx};
     }
     case MotionMode::kOblique: {
@@ -126,8 +120,8 @@ BodyTwist twist_from_motion_feedback(const MotionFeedback& feedback, MotionMode 
     }
     case MotionMode::kSpin:
       return BodyTwist{0.0, 0.0,
-                       interp::spin_yaw_rate_from_wheel_speed(feedback.speed, geometry.wheelbase,
-                                                              geometry.track)};
+                       interp::spin_yaw_rate_from_feedback_speed(feedback.speed, geometry.wheelbase,
+                                                                 geometry.track)};
   }
   return BodyTwist{};
 }

@@ -332,11 +332,23 @@ void VirtualChassis::handle_motion_command(const MotionCommand& cmd) {
     ++counters_.frames_ignored;
     return;
   }
-  if (motion_.mode() == MotionMode::kSpin) {
+  const MotionMode mode = motion_.mode();
+  if (mode == MotionMode::kSpin) {
     commanded_ = {cmd.spin_speed, 0.0};
   } else {
-    commanded_ = {cmd.linear_speed,
-                  interpretation::rep103_from_manual_steering(cmd.steering_angle)};
+    const double steering = interpretation::rep103_from_manual_command_steering(cmd.steering_angle);
+    const VehicleGeometry& g = motion_.geometry();
+    // Oblique: all wheels parallel, curvature 0. Ackermann: the curvature the model will steer
+    // (its angle limit applied), which relates the wire's speed to the body centre's.
+    const double max_angle = motion_.limits().max_ackermann_angle;
+    const double curvature =
+        mode == MotionMode::kAckermann
+            ? interpretation::ackermann_curvature_from_mean_angle(
+                  std::clamp(steering, -max_angle, max_angle), g.wheelbase, g.track)
+            : 0.0;
+    commanded_ = {interpretation::body_speed_from_command_speed(cmd.linear_speed, curvature,
+                                                                g.wheelbase, g.track),
+                  steering};
   }
   ++counters_.motion_commands;
 }
@@ -557,13 +569,18 @@ void VirtualChassis::send(const Message& message, Timestamp t) {
 
 Message VirtualChassis::motion_feedback() const {
   const WheelStates w = motion_.wheels();
+  const VehicleGeometry& g = motion_.geometry();
   MotionFeedback fb;
   switch (motion_.mode()) {
     case MotionMode::kAckermann: {
+      // 0x221 reports the front wheels' mean angle and (point 8) the mean wheel speed.
       const double mean_front = (w[kRightFront].angle + w[kLeftFront].angle) / 2.0;
       fb.steering_angle = interpretation::manual_from_rep103_steering(mean_front);
-      for (const auto& s : w)
-        fb.speed += s.speed / kWheelCount;
+      const double curvature = interpretation::ackermann_curvature_from_mean_angle(
+          motion_.steering(), g.wheelbase, g.track);
+      fb.speed = interpretation::ackermann_feedback_speed_from_body_speed(motion_.twist().vx,
+                                                                          curvature, g.wheelbase,
+                                                                          g.track);
       break;
     }
     case MotionMode::kOblique: {
@@ -576,15 +593,11 @@ Message VirtualChassis::motion_feedback() const {
       break;
     }
     default: {
-      // Spin: the fixed angle (mean of |angles|) and the signed tangential speed, CCW positive:
-      // each wheel's velocity projected on the counter-clockwise tangent at its position.
-      const double r = motion_.geometry().wheel_radius_from_centre();
-      for (int i = 0; i < kWheelCount; ++i) {
-        fb.steering_angle += std::abs(w[i].angle) / kWheelCount;
-        const WheelPosition p = motion_.geometry().wheel_position(i);
-        const double vx = w[i].speed * std::cos(w[i].angle), vy = w[i].speed * std::sin(w[i].angle);
-        fb.speed += (vx * -p.y + vy * p.x) / r / kWheelCount;
-      }
+      // Spin: the fixed angle (mean of |angles|) and (point 9) the signed tangential speed.
+      for (const auto& s : w)
+        fb.steering_angle += std::abs(s.angle) / kWheelCount;
+      fb.speed = interpretation::spin_feedback_speed_from_yaw_rate(motion_.twist().wz,
+                                                                   g.wheelbase, g.track);
       break;
     }
   }

@@ -243,7 +243,7 @@ TEST(CliMonitorView, ShowsWhatTheChassisReports) {
   command(ControlModeCommand{protocol::ControlMode::kCan});
   MotionCommand turn_left;
   turn_left.linear_speed = 0.5;
-  turn_left.steering_angle = interpretation::manual_from_rep103_steering(15 * M_PI / 180);
+  turn_left.steering_angle = interpretation::manual_from_rep103_command_steering(15 * M_PI / 180);
   for (int i = 0; i < 100; ++i) {
     command(turn_left);
     feed_until(chassis.now() + 20ms);

@@ -98,5 +98,35 @@ TEST(Interpretation, CurvatureEdgeCases) {
   EXPECT_NEAR(ackermann_curvature_from_mean_angle(tiny, kL, kW) * kL / 2, tiny, 1e-24);
 }
 
+// Points 7-9: which point's speed 0x111 and 0x221 carry.
+TEST(Interpretation, CommandSpeedIsTheBodyCentreSpeed) {
+  EXPECT_EQ(body_speed_from_command_speed(0.7, 1.2, kL, kW), 0.7);
+  EXPECT_EQ(command_speed_from_body_speed(-0.4, -0.8, kL, kW), -0.4);
+}
+
+TEST(Interpretation, AckermannFeedbackSpeedIsTheMeanWheelSpeed) {
+  // Independent reference: the four wheels' rigid-body speeds at (+-L/2, +-W/2).
+  const double k = 0.9, vx = 0.6;
+  double mean = 0.0;
+  for (double x : {kL / 2, -kL / 2}) {
+    for (double y : {kW / 2, -kW / 2})
+      mean += std::hypot(vx - k * vx * y, k * vx * x) / 4;
+  }
+  EXPECT_NEAR(ackermann_feedback_speed_from_body_speed(vx, k, kL, kW), mean, 1e-15);
+  EXPECT_NEAR(ackermann_body_speed_from_feedback_speed(mean, k, kL, kW), vx, 1e-15);
+  EXPECT_NEAR(ackermann_body_speed_from_feedback_speed(-mean, -k, kL, kW), -vx, 1e-15);
+  EXPECT_EQ(ackermann_mean_wheel_speed_factor(0.0, kL, kW), 1.0);  // straight: all alike
+  // A corrupt 90-degree angle (infinite curvature) leaves the body centre at rest, never NaN.
+  EXPECT_EQ(ackermann_body_speed_from_feedback_speed(
+                0.5, std::numeric_limits<double>::infinity(), kL, kW),
+            0.0);
+}
+
+TEST(Interpretation, SpinFeedbackSpeedIsTheSignedTangentialSpeed) {
+  const double r = std::hypot(kL / 2, kW / 2);
+  EXPECT_DOUBLE_EQ(spin_yaw_rate_from_feedback_speed(0.5, kL, kW), 0.5 / r);  // CCW positive
+  EXPECT_DOUBLE_EQ(spin_feedback_speed_from_yaw_rate(-1.0, kL, kW), -r);
+}
+
 }  // namespace
 }  // namespace ranger::interpretation

@@ -88,7 +88,7 @@ struct Harness {
 MotionCommand ackermann(double v, double rep103_steering = 0.0) {
   MotionCommand c;
   c.linear_speed = v;
-  c.steering_angle = interpretation::manual_from_rep103_steering(rep103_steering);
+  c.steering_angle = interpretation::manual_from_rep103_command_steering(rep103_steering);
   return c;
 }
 MotionCommand spin(double wheel_speed) {

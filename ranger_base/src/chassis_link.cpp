@@ -1,6 +1,7 @@
 #include "ranger_base/chassis_link.hpp"
 
 #include <poll.h>
+#include <pthread.h>
 #include <sys/eventfd.h>
 #include <unistd.h>
 
@@ -155,6 +156,8 @@ void ChassisLink::drain_and_tick(ranger::Timestamp now) {
 }
 
 void ChassisLink::loop() {
+  // Named so that top -H and the performance script can tell the CAN thread apart.
+  ::pthread_setname_np(::pthread_self(), "ranger_can_link");
   std::vector<MotionCommandEvent> events;
   try {
     while (!stop_requested_.load()) {
@@ -183,7 +186,8 @@ void ChassisLink::loop() {
         if (bus_) drain_and_tick(clock_.now());
         events.swap(pending_events_);
       }
-      for (const auto& e : events) observer_(e);
+      for (const auto& e : events)
+        observer_(e);
       events.clear();
     }
   } catch (const std::exception& e) {  // never let an exception escape the thread

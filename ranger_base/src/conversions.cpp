@@ -70,8 +70,7 @@ bool has_non_planar_components(const geometry_msgs::Twist& twist) {
   return twist.linear.z != 0.0 || twist.angular.x != 0.0 || twist.angular.y != 0.0;
 }
 
-geometry_msgs::TwistStamped to_twist_stamped(const ranger::BodyTwist& twist,
-                                             const ros::Time& stamp,
+geometry_msgs::TwistStamped to_twist_stamped(const ranger::BodyTwist& twist, const ros::Time& stamp,
                                              const std::string& frame_id) {
   geometry_msgs::TwistStamped out;
   out.header.stamp = stamp;
@@ -152,7 +151,8 @@ nav_msgs::Odometry to_ground_truth(const ranger::sim::ChassisSnapshot& sim,
 
 // ---- named bits ---------------------------------------------------------------------------------
 
-#define RANGER_FIELD(msg, name) {#name, &ranger_msgs::msg::name}
+#define RANGER_FIELD(msg, name) \
+  { #name, &ranger_msgs::msg::name }
 
 const std::map<std::string_view, SystemErrorField>& system_error_fields() {
   static const std::map<std::string_view, SystemErrorField> fields = {
@@ -200,12 +200,9 @@ const std::map<std::string_view, DriverStatusField>& driver_status_fields() {
 
 const std::map<std::string_view, BmsFlagField>& bms_flag_fields() {
   static const std::map<std::string_view, BmsFlagField> fields = {
-      RANGER_FIELD(BmsFlags, over_voltage),
-      RANGER_FIELD(BmsFlags, under_voltage),
-      RANGER_FIELD(BmsFlags, high_temperature),
-      RANGER_FIELD(BmsFlags, low_temperature),
-      RANGER_FIELD(BmsFlags, discharge_over_current),
-      RANGER_FIELD(BmsFlags, charge_over_current),
+      RANGER_FIELD(BmsFlags, over_voltage),           RANGER_FIELD(BmsFlags, under_voltage),
+      RANGER_FIELD(BmsFlags, high_temperature),       RANGER_FIELD(BmsFlags, low_temperature),
+      RANGER_FIELD(BmsFlags, discharge_over_current), RANGER_FIELD(BmsFlags, charge_over_current),
   };
   return fields;
 }
@@ -333,8 +330,8 @@ ranger_msgs::BmsStateArray to_bms_state(const ranger::ChassisFeedback& feedback,
   return out;
 }
 
-sensor_msgs::BatteryState to_battery_state(const ranger::ControllerState& state,
-                                           Timestamp link_now, const ros::Time& stamp) {
+sensor_msgs::BatteryState to_battery_state(const ranger::ControllerState& state, Timestamp link_now,
+                                           const ros::Time& stamp) {
   using sensor_msgs::BatteryState;
   BatteryState out;
   out.header.stamp = stamp;
@@ -371,8 +368,7 @@ sensor_msgs::BatteryState to_battery_state(const ranger::ControllerState& state,
         out.power_supply_health = BatteryState::POWER_SUPPLY_HEALTH_OVERHEAT;
       } else if (flags.low_temperature) {
         out.power_supply_health = BatteryState::POWER_SUPPLY_HEALTH_COLD;
-      } else if (flags.under_voltage || flags.discharge_over_current ||
-                 flags.charge_over_current) {
+      } else if (flags.under_voltage || flags.discharge_over_current || flags.charge_over_current) {
         out.power_supply_health = BatteryState::POWER_SUPPLY_HEALTH_UNSPEC_FAILURE;
       }
     }
@@ -408,8 +404,8 @@ sensor_msgs::Range to_range(int sensor, std::int16_t raw, const UltrasonicRangeP
     out.range = std::numeric_limits<float>::quiet_NaN();
   } else {
     const double m = raw / 1000.0;
-    out.range = m > params.max_range ? std::numeric_limits<float>::infinity()
-                                     : static_cast<float>(m);
+    out.range =
+        m > params.max_range ? std::numeric_limits<float>::infinity() : static_cast<float>(m);
   }
   return out;
 }
@@ -426,8 +422,8 @@ ranger_msgs::UltrasonicState to_ultrasonic_state(const ranger::ControllerState& 
       ranger_msgs::UltrasonicReading r;
       r.sensor = static_cast<std::uint8_t>(group->value.first_sensor + k);
       r.raw = group->value.raw[static_cast<std::size_t>(k)];
-      r.range = r.raw < 0 ? std::numeric_limits<float>::quiet_NaN()
-                          : static_cast<float>(r.raw / 1000.0);
+      r.range =
+          r.raw < 0 ? std::numeric_limits<float>::quiet_NaN() : static_cast<float>(r.raw / 1000.0);
       r.status = std::string(protocol::ultrasonic_status_name(r.raw));
       out.sensors.push_back(r);
     }

@@ -21,7 +21,9 @@ std::string hex(std::uint32_t v, int width) {
   return buf;
 }
 
-double seconds(std::chrono::nanoseconds d) { return std::chrono::duration<double>(d).count(); }
+double seconds(std::chrono::nanoseconds d) {
+  return std::chrono::duration<double>(d).count();
+}
 
 // A fault that stops the chassis is an ERROR; anything else it reports is a WARN.
 bool stops_chassis(const ranger::ControllerState& c) {
@@ -34,7 +36,7 @@ void diagnose_link(const LinkSnapshot& s, DiagnosticStatusWrapper& out) {
   out.add("Port", s.port_name);
   if (!s.bus_open) {
     out.summary(DiagnosticStatus::ERROR, "CAN interface " + s.port_name + " not open: " +
-                                              (s.bus_error.empty() ? "opening" : s.bus_error));
+                                             (s.bus_error.empty() ? "opening" : s.bus_error));
     return;
   }
   out.add("Bus state", std::string(ranger::to_string(s.bus.state)));
@@ -98,8 +100,7 @@ void diagnose_control(const LinkSnapshot& s, DiagnosticStatusWrapper& out) {
   out.add("Control mode requests", c.counters.control_mode_requests);
   out.add("Mode switch requests", c.counters.mode_switch_requests);
   if (c.last_solution) {
-    out.add("Last command limits",
-            ranger::kinematics_flags_to_string(c.last_solution->flags));
+    out.add("Last command limits", ranger::kinematics_flags_to_string(c.last_solution->flags));
   }
 
   if (!s.has_controller || c.link != ranger::LinkState::kConnected) {
@@ -127,13 +128,15 @@ void diagnose_errors(const LinkSnapshot& s, DiagnosticStatusWrapper& out) {
   out.add("Error word", hex(c.error_bits, 8));
   out.add("Vehicle status",
           c.vehicle_status ? std::string(protocol::to_string(*c.vehicle_status)) : "unknown");
-  for (const auto& fault : c.faults) out.add(fault, "active");
+  for (const auto& fault : c.faults)
+    out.add(fault, "active");
   if (c.faults.empty()) {
     out.summary(DiagnosticStatus::OK, "no faults");
     return;
   }
   std::string list;
-  for (const auto& fault : c.faults) list += (list.empty() ? "" : ", ") + fault;
+  for (const auto& fault : c.faults)
+    list += (list.empty() ? "" : ", ") + fault;
   out.summary(stops_chassis(c) ? DiagnosticStatus::ERROR : DiagnosticStatus::WARN, list);
 }
 
@@ -199,10 +202,9 @@ void FrameRateMonitor::diagnose(const LinkSnapshot& s, DiagnosticStatusWrapper& 
       it == s.frames_by_id.end() ? 0.0 : static_cast<double>(it->second - before) / dt;
   const double nominal = 1000.0 / protocol::kFastPeriodMs;
   if (status_rate < 0.5 * nominal) {
-    out.summary(DiagnosticStatus::WARN, "system status (0x211) at " +
-                                            std::to_string(static_cast<int>(status_rate)) +
-                                            " Hz, expected " +
-                                            std::to_string(static_cast<int>(nominal)));
+    out.summary(DiagnosticStatus::WARN,
+                "system status (0x211) at " + std::to_string(static_cast<int>(status_rate)) +
+                    " Hz, expected " + std::to_string(static_cast<int>(nominal)));
   } else {
     out.summary(DiagnosticStatus::OK, std::to_string(static_cast<int>(total)) + " frames/s");
   }
@@ -224,6 +226,8 @@ ChassisDiagnostics::ChassisDiagnostics(diagnostic_updater::Updater& updater,
               [this](DiagnosticStatusWrapper& out) { rates_.diagnose(current_, out); });
 }
 
-void ChassisDiagnostics::refresh() { current_ = link_.snapshot(); }
+void ChassisDiagnostics::refresh() {
+  current_ = link_.snapshot();
+}
 
 }  // namespace ranger_base

@@ -10,6 +10,7 @@
 #include <set>
 #include <sstream>
 
+#include <ranger_can/codec.hpp>
 #include <ranger_can/interpretation.hpp>
 #include <ranger_can/protocol.hpp>
 
@@ -37,23 +38,33 @@ struct Interval {
     return out.str();
   }
 };
-Interval closed(double lo, double hi) { return {lo, hi, false, false}; }
-Interval open_closed(double lo, double hi) { return {lo, hi, true, false}; }
+Interval closed(double lo, double hi) {
+  return {lo, hi, false, false};
+}
+Interval open_closed(double lo, double hi) {
+  return {lo, hi, true, false};
+}
 
 std::string show(const XmlRpc::XmlRpcValue& v) {
   XmlRpc::XmlRpcValue copy = v;  // toXml() is not const
   switch (copy.getType()) {
-    case XmlRpc::XmlRpcValue::TypeString: return "\"" + static_cast<std::string&>(copy) + "\"";
-    case XmlRpc::XmlRpcValue::TypeBoolean: return static_cast<bool&>(copy) ? "true" : "false";
-    case XmlRpc::XmlRpcValue::TypeInt: return std::to_string(static_cast<int&>(copy));
+    case XmlRpc::XmlRpcValue::TypeString:
+      return "\"" + static_cast<std::string&>(copy) + "\"";
+    case XmlRpc::XmlRpcValue::TypeBoolean:
+      return static_cast<bool&>(copy) ? "true" : "false";
+    case XmlRpc::XmlRpcValue::TypeInt:
+      return std::to_string(static_cast<int&>(copy));
     case XmlRpc::XmlRpcValue::TypeDouble: {
       std::ostringstream out;
       out << static_cast<double&>(copy);
       return out.str();
     }
-    case XmlRpc::XmlRpcValue::TypeArray: return "a list of " + std::to_string(copy.size());
-    case XmlRpc::XmlRpcValue::TypeStruct: return "a dictionary";
-    default: return "a value of another type";
+    case XmlRpc::XmlRpcValue::TypeArray:
+      return "a list of " + std::to_string(copy.size());
+    case XmlRpc::XmlRpcValue::TypeStruct:
+      return "a dictionary";
+    default:
+      return "a value of another type";
   }
 }
 
@@ -138,8 +149,7 @@ class Reader {
     const bool has_space =
         std::any_of(v.begin(), v.end(), [](unsigned char c) { return std::isspace(c) != 0; });
     if (v.empty() || has_space || v.front() == '/') {
-      fail(name, "= \"" + v +
-                     "\": expected a tf2 frame id (non-empty, no spaces, no leading '/')");
+      fail(name, "= \"" + v + "\": expected a tf2 frame id (non-empty, no spaces, no leading '/')");
       return def;
     }
     return v;
@@ -200,8 +210,6 @@ class Reader {
   std::vector<std::string> errors_;
   std::vector<std::string> names_;
 };
-
-constexpr double kDeg = M_PI / 180.0;
 
 // ros_controllers' per-axis limits (diff_drive_controller's SpeedLimiter parameters): a missing
 // min_* defaults to -max_*.
@@ -270,16 +278,18 @@ NodeParameters read_all(Reader& r) {
   // ---- kinematic limits (the chassis's own ranges are the upper bounds)
   auto& k = c.limits;
   const double vmax = ranger::interpretation::kMaxLinearSpeedMps;
-  k.max_linear_speed = r.number("max_linear_speed", k.max_linear_speed, open_closed(0.0, vmax), "m/s");
-  k.max_speed_at_large_steering = r.number("max_speed_at_large_steering",
-                                           k.max_speed_at_large_steering, open_closed(0.0, vmax),
-                                           "m/s");
+  k.max_linear_speed =
+      r.number("max_linear_speed", k.max_linear_speed, open_closed(0.0, vmax), "m/s");
+  k.max_speed_at_large_steering = r.number(
+      "max_speed_at_large_steering", k.max_speed_at_large_steering, open_closed(0.0, vmax), "m/s");
   k.max_ackermann_steering = r.number("max_ackermann_steering", k.max_ackermann_steering,
-                                      open_closed(0.0, 40.0 * kDeg), "rad (40 deg)");
+                                      open_closed(0.0, ranger::kMaxAckermannSteeringRad),
+                                      "rad (40 deg)");
   k.max_oblique_steering = r.number("max_oblique_steering", k.max_oblique_steering,
-                                    open_closed(0.0, 90.0 * kDeg), "rad (90 deg)");
-  k.max_spin_wheel_speed =
-      r.number("max_spin_wheel_speed", k.max_spin_wheel_speed, open_closed(0.0, 1.0), "m/s");
+                                    open_closed(0.0, ranger::kMaxObliqueSteeringRad),
+                                    "rad (90 deg)");
+  k.max_spin_wheel_speed = r.number("max_spin_wheel_speed", k.max_spin_wheel_speed,
+                                    open_closed(0.0, ranger::kMaxSpinSpeedMps), "m/s");
 
   // ---- velocity / acceleration limits per axis (ros_controllers names)
   c.limit_vx = read_speed_limits(r, "linear/x", "m", vmax);
@@ -288,7 +298,8 @@ NodeParameters read_all(Reader& r) {
 
   // ---- automatic motion-mode selection
   auto& m = c.mode_selection;
-  m.lateral_enter = r.number("mode_selection/lateral_enter", m.lateral_enter, closed(0.0, 2.6), "m/s");
+  m.lateral_enter =
+      r.number("mode_selection/lateral_enter", m.lateral_enter, closed(0.0, 2.6), "m/s");
   m.lateral_exit = r.number("mode_selection/lateral_exit", m.lateral_exit, closed(0.0, 2.6), "m/s");
   m.linear_enter = r.number("mode_selection/linear_enter", m.linear_enter, closed(0.0, 2.6), "m/s");
   m.linear_exit = r.number("mode_selection/linear_exit", m.linear_exit, closed(0.0, 2.6), "m/s");
@@ -306,8 +317,7 @@ NodeParameters read_all(Reader& r) {
   } else {
     r.fail("odometry_source", "= \"" + source + "\": expected \"wheels\" or \"motion\"");
   }
-  o.wheel_data_timeout =
-      r.seconds("wheel_data_timeout", o.wheel_data_timeout, closed(0.02, 5.0));
+  o.wheel_data_timeout = r.seconds("wheel_data_timeout", o.wheel_data_timeout, closed(0.02, 5.0));
   p.pose_covariance_diagonal = r.diagonal("pose_covariance_diagonal", p.pose_covariance_diagonal);
   p.twist_covariance_diagonal =
       r.diagonal("twist_covariance_diagonal", p.twist_covariance_diagonal);
@@ -316,8 +326,8 @@ NodeParameters read_all(Reader& r) {
   o.initial_pose_variance_yaw = 0.0;
   o.pose_variance_per_meter =
       r.number("pose_variance_per_meter", o.pose_variance_per_meter, closed(0.0, 1e3), "m^2/m");
-  o.yaw_variance_per_radian = r.number("yaw_variance_per_radian", o.yaw_variance_per_radian,
-                                       closed(0.0, 1e3), "rad^2/rad");
+  o.yaw_variance_per_radian =
+      r.number("yaw_variance_per_radian", o.yaw_variance_per_radian, closed(0.0, 1e3), "rad^2/rad");
   o.yaw_variance_per_meter =
       r.number("yaw_variance_per_meter", o.yaw_variance_per_meter, closed(0.0, 1e3), "rad^2/m");
 
@@ -339,8 +349,8 @@ NodeParameters read_all(Reader& r) {
   s.ultrasonic.fill(static_cast<std::int16_t>(std::lround(ultrasonic_m * 1000.0)));
   for (const auto& name : r.text_list("sim/errors")) {
     const auto& bits = ranger::protocol::system_error_bits();
-    const auto it = std::find_if(bits.begin(), bits.end(),
-                                 [&name](const auto& b) { return b.name == name; });
+    const auto it =
+        std::find_if(bits.begin(), bits.end(), [&name](const auto& b) { return b.name == name; });
     if (it == bits.end()) {
       r.fail("sim/errors", "contains \"" + name +
                                "\": not a 0x211 error bit name (see ranger_msgs/SystemErrors)");
@@ -385,7 +395,8 @@ std::optional<XmlRpc::XmlRpcValue> MapParameterSource::get(const std::string& na
 
 std::vector<std::string> MapParameterSource::names() const {
   std::vector<std::string> out;
-  for (const auto& kv : values) out.push_back(kv.first);
+  for (const auto& kv : values)
+    out.push_back(kv.first);
   return out;
 }
 
@@ -406,7 +417,8 @@ ranger::Result<NodeParameters> load_parameters(const ParameterSource& source) {
   }
   if (errors.empty()) return p;
   std::string message;
-  for (const auto& e : errors) message += (message.empty() ? "" : "\n") + e;
+  for (const auto& e : errors)
+    message += (message.empty() ? "" : "\n") + e;
   return ranger::Error{ranger::Errc::kInvalidArgument, message};
 }
 
@@ -426,7 +438,7 @@ std::vector<std::string> unknown_parameter_names(const ParameterSource& source) 
   std::vector<std::string> out;
   for (const auto& n : source.names()) {
     if (n.rfind("description/", 0) == 0) continue;  // the URDF's part of geometry.yaml
-    if (n == "diagnostic_period") continue;          // read by diagnostic_updater
+    if (n == "diagnostic_period") continue;         // read by diagnostic_updater
     if (known_set.count(n) == 0) out.push_back(n);
   }
   return out;

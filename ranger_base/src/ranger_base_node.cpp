@@ -17,7 +17,9 @@ volatile std::sig_atomic_t g_signal = 0;
 
 // roscpp's own handler would call ros::shutdown() from the signal; ours only records the
 // request, so the main thread stops the chassis first and shuts ROS down afterwards.
-void on_signal(int sig) { g_signal = sig; }
+void on_signal(int sig) {
+  g_signal = sig;
+}
 
 }  // namespace
 
@@ -36,7 +38,8 @@ int main(int argc, char** argv) {
   auto params = ranger_base::load_parameters(source);
   if (!params) {
     std::istringstream lines(params.error().message);
-    for (std::string line; std::getline(lines, line);) ROS_FATAL("%s", line.c_str());
+    for (std::string line; std::getline(lines, line);)
+      ROS_FATAL("%s", line.c_str());
     ROS_FATAL("ranger_base_node not started: fix the parameters above");
     ros::shutdown();
     return 2;
@@ -46,7 +49,8 @@ int main(int argc, char** argv) {
     ranger_base::RangerNode node(nh, private_nh, std::move(*params));
     node.start();
     ros::WallRate idle(50.0);
-    while (ros::ok() && g_signal == 0) idle.sleep();
+    while (ros::ok() && g_signal == 0)
+      idle.sleep();
     if (g_signal != 0) ROS_INFO("signal %d: stopping the chassis", static_cast<int>(g_signal));
     node.shutdown();  // zero 0x111 before anything else goes away
   }

@@ -77,7 +77,9 @@ RangerNode::RangerNode(const ros::NodeHandle& nh, const ros::NodeHandle& private
   diagnostics_ = std::make_unique<ChassisDiagnostics>(updater_, *link_);
 }
 
-RangerNode::~RangerNode() { shutdown(); }
+RangerNode::~RangerNode() {
+  shutdown();
+}
 
 void RangerNode::start() {
   link_->start([this](const MotionCommandEvent& e) { on_motion_command(e); });
@@ -86,7 +88,8 @@ void RangerNode::start() {
   // them late; TCP_NODELAY keeps the latency down.
   cmd_vel_sub_ = cmd_nh_.subscribe("cmd_vel", 1, &RangerNode::on_cmd_vel, this,
                                    ros::TransportHints().tcpNoDelay());
-  clear_errors_srv_ = service_nh_.advertiseService("clear_errors", &RangerNode::on_clear_errors, this);
+  clear_errors_srv_ =
+      service_nh_.advertiseService("clear_errors", &RangerNode::on_clear_errors, this);
   set_ultrasonic_srv_ =
       service_nh_.advertiseService("set_ultrasonic", &RangerNode::on_set_ultrasonic, this);
   set_motion_mode_srv_ =
@@ -96,8 +99,8 @@ void RangerNode::start() {
                                          &RangerNode::on_publish_timer, this);
   state_timer_ = nh_.createSteadyTimer(ros::WallDuration(1.0 / params_.state_publish_rate),
                                        &RangerNode::on_state_timer, this);
-  diagnostics_timer_ = nh_.createSteadyTimer(ros::WallDuration(0.25),
-                                             &RangerNode::on_diagnostics_timer, this);
+  diagnostics_timer_ =
+      nh_.createSteadyTimer(ros::WallDuration(0.25), &RangerNode::on_diagnostics_timer, this);
 
   spinner_ = std::make_unique<ros::AsyncSpinner>(1);
   cmd_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &cmd_queue_);
@@ -192,7 +195,8 @@ void RangerNode::log_state_changes(const LinkSnapshot& s) {
   if (s.bus_error != last_bus_error_) {
     if (!s.bus_error.empty()) {
       ROS_ERROR("CAN interface %s: %s (retrying every %.1f s)", s.port_name.c_str(),
-                s.bus_error.c_str(), std::chrono::duration<double>(params_.reconnect_interval).count());
+                s.bus_error.c_str(),
+                std::chrono::duration<double>(params_.reconnect_interval).count());
     } else {
       ROS_INFO("CAN interface %s open", s.port_name.c_str());
     }
@@ -222,8 +226,10 @@ void RangerNode::log_state_changes(const LinkSnapshot& s) {
   }
   if (c.error_bits != last_error_bits_) {
     std::string names;
-    for (const auto& n : protocol::error_bit_names(c.error_bits)) names += " " + n;
-    ROS_WARN("chassis error word 0x%08X:%s", c.error_bits, names.empty() ? " (clear)" : names.c_str());
+    for (const auto& n : protocol::error_bit_names(c.error_bits))
+      names += " " + n;
+    ROS_WARN("chassis error word 0x%08X:%s", c.error_bits,
+             names.empty() ? " (clear)" : names.c_str());
     last_error_bits_ = c.error_bits;
   }
   if (c.last_solution && c.last_solution->flags != ranger::kKinematicsExact) {
@@ -293,10 +299,17 @@ bool RangerNode::on_set_motion_mode(ranger_msgs::SetMotionMode::Request& req,
   using Req = ranger_msgs::SetMotionMode::Request;
   std::optional<protocol::MotionMode> mode;
   switch (req.mode) {
-    case Req::ACKERMANN: mode = protocol::MotionMode::kAckermann; break;
-    case Req::OBLIQUE: mode = protocol::MotionMode::kOblique; break;
-    case Req::SPIN: mode = protocol::MotionMode::kSpin; break;
-    case Req::AUTOMATIC: break;
+    case Req::ACKERMANN:
+      mode = protocol::MotionMode::kAckermann;
+      break;
+    case Req::OBLIQUE:
+      mode = protocol::MotionMode::kOblique;
+      break;
+    case Req::SPIN:
+      mode = protocol::MotionMode::kSpin;
+      break;
+    case Req::AUTOMATIC:
+      break;
     default:
       res.success = false;
       res.message = "mode " + std::to_string(req.mode) +

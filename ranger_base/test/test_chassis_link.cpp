@@ -125,6 +125,23 @@ TEST_F(ChassisLinkSim, PinnedMotionModeIsReachedAtStandstill) {
   }));
 }
 
+TEST_F(ChassisLinkSim, InterfaceGoingDownIsReportedAndRecovered) {
+  link_->sim_network()->set_link_up(false);  // `ip link set sim down`: the adapter is unplugged
+  ASSERT_TRUE(wait_until([&] {
+    const auto s = link_->snapshot();
+    return s.bus.state == ranger::BusState::kDown &&
+           s.controller.link == ranger::LinkState::kStale;
+  }));
+  EXPECT_EQ(link_->snapshot().controller.refusal, ranger::MotionRefusal::kLinkLost);
+  link_->sim_network()->set_link_up(true);
+  EXPECT_TRUE(wait_until([&] {
+    const auto s = link_->snapshot();
+    return s.bus.state == ranger::BusState::kActive && in_command_mode(s) &&
+           s.bus.stats.reopens > 0;
+  }));
+  EXPECT_TRUE(drive_until({0.3, 0.0, 0.0}, [&] { return link_->snapshot().sim->twist.vx > 0.2; }));
+}
+
 TEST(ChassisLink, MissingInterfaceIsReportedAndRetriedWithoutCrashing) {
   ranger::SteadyClock clock;
   ChassisLinkOptions o;
@@ -156,7 +173,8 @@ TEST(ChassisLink, InjectedErrorIsVisibleAndClearedThroughTheLink) {
   o.sim_error_bits = 1u << it->index;
   ChassisLink link(o, clock);
   link.start();
-  ASSERT_TRUE(wait_until([&] { return link.snapshot().controller.error_bits == o.sim_error_bits; }));
+  ASSERT_TRUE(
+      wait_until([&] { return link.snapshot().controller.error_bits == o.sim_error_bits; }));
   ASSERT_TRUE(link.clear_errors(0x01).ok());  // motor driver 1 communication
   EXPECT_TRUE(wait_until([&] { return link.snapshot().controller.error_bits == 0; }));
   link.stop();

@@ -20,13 +20,15 @@ using namespace std::chrono_literals;
 template <typename Map>
 std::set<std::string> keys(const Map& m) {
   std::set<std::string> out;
-  for (const auto& kv : m) out.emplace(kv.first);
+  for (const auto& kv : m)
+    out.emplace(kv.first);
   return out;
 }
 
 std::set<std::string> names(const std::vector<protocol::NamedBit>& bits) {
   std::set<std::string> out;
-  for (const auto& b : bits) out.emplace(b.name);
+  for (const auto& b : bits)
+    out.emplace(b.name);
   return out;
 }
 
@@ -42,7 +44,8 @@ TEST(NamedBits, DriverStatusHasAFieldForEveryLibraryBit) {
 
 TEST(NamedBits, BmsFlagsHaveAFieldForEveryLibraryBit) {
   auto expected = names(protocol::bms_status1_bits());
-  for (const auto& n : names(protocol::bms_status2_bits())) expected.insert(n);
+  for (const auto& n : names(protocol::bms_status2_bits()))
+    expected.insert(n);
   EXPECT_EQ(keys(bms_flag_fields()), expected);
 }
 
@@ -100,7 +103,8 @@ TEST(SystemState, CarriesModesRawWordAndActiveNames) {
   EXPECT_EQ(msg.error_word, st.error_bits);
   ASSERT_EQ(msg.active_errors.size(), 2u);
   EXPECT_EQ(msg.motion_inhibited_reason, "remote");
-  EXPECT_EQ(msg.control_mode_name, std::string(protocol::to_string(protocol::ControlMode::kRemote)));
+  EXPECT_EQ(msg.control_mode_name,
+            std::string(protocol::to_string(protocol::ControlMode::kRemote)));
 }
 
 TEST(SystemState, UnknownBeforeTheFirstFrame) {
@@ -199,8 +203,8 @@ TEST(Battery, PercentageIsAFractionAndSlotsReportPresence) {
   EXPECT_TRUE(std::isnan(msg.cell_voltage[2]));  // slot 3 stale
   EXPECT_TRUE(std::isnan(msg.cell_voltage[3]));
 
-  const auto array = to_bms_state(st.feedback, TimeMapper(ros::Time(3.0), 10s + 100ms),
-                                  10s + 100ms, ros::Time(3.0));
+  const auto array = to_bms_state(st.feedback, TimeMapper(ros::Time(3.0), 10s + 100ms), 10s + 100ms,
+                                  ros::Time(3.0));
   ASSERT_EQ(array.batteries.size(), 5u);
   EXPECT_TRUE(array.batteries[0].present);
   EXPECT_FALSE(array.batteries[1].present);
@@ -253,7 +257,8 @@ TEST(Ultrasonic, StateListsSensorsInOrderWithStatusNames) {
   EXPECT_TRUE(msg.avoidance_known);
   EXPECT_TRUE(msg.avoidance_enabled);
   ASSERT_EQ(msg.sensors.size(), 8u);
-  for (std::size_t i = 0; i < 8; ++i) EXPECT_EQ(msg.sensors[i].sensor, i + 1);
+  for (std::size_t i = 0; i < 8; ++i)
+    EXPECT_EQ(msg.sensors[i].sensor, i + 1);
   EXPECT_EQ(msg.sensors[5].status, "offline");
   EXPECT_TRUE(std::isnan(msg.sensors[5].range));
   EXPECT_EQ(msg.sensors[0].status, "ok");

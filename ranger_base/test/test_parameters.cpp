@@ -19,7 +19,8 @@ XmlRpcValue list(std::initializer_list<double> values) {
   XmlRpcValue v;
   v.setSize(static_cast<int>(values.size()));
   int i = 0;
-  for (double d : values) v[i++] = d;
+  for (double d : values)
+    v[i++] = d;
   return v;
 }
 
@@ -102,30 +103,30 @@ TEST_P(RejectsBadValue, NamingTheParameterAndTheValidRange) {
 
 INSTANTIATE_TEST_SUITE_P(
     Parameters, RejectsBadValue,
-    ::testing::Values(
-        BadValue{"publish_rate", -5.0, "(0, 1000] Hz"},
-        BadValue{"publish_rate", 0.0, "(0, 1000] Hz"},
-        BadValue{"publish_rate", "fast", "expected a number"},
-        BadValue{"cmd_vel_timeout", 0.0, "[0.02, 60] s"},
-        BadValue{"cmd_vel_timeout", std::numeric_limits<double>::quiet_NaN(), "[0.02, 60] s"},
-        BadValue{"wheelbase", -0.89, "(0, 10] m"},
-        BadValue{"track", 0.0, "(0, 10] m"},
-        BadValue{"max_linear_speed", 3.0, "(0, 2.6] m/s"},
-        BadValue{"max_ackermann_steering", 1.0, "40 deg"},
-        BadValue{"max_spin_wheel_speed", 1.5, "(0, 1] m/s"},
-        BadValue{"odometry_source", "gps", "\"wheels\" or \"motion\""},
-        BadValue{"port_name", "", "CAN interface name"},
-        BadValue{"port_name", "a/b", "CAN interface name"},
-        BadValue{"odom_frame", "/odom", "no leading '/'"},
-        BadValue{"base_frame", "odom", "must differ from odom_frame"},
-        BadValue{"publish_odom_tf", 1, "expected true or false"},
-        BadValue{"pose_covariance_diagonal", list({1, 2, 3, 4, 5}), "list of 6"},
-        BadValue{"twist_covariance_diagonal", list({1, 1, 1, -1, 1, 1}), "list of 6"},
-        BadValue{"linear/x/max_acceleration", -1.0, "(0, 1000] m/s^2"},
-        BadValue{"low_battery_soc", 120.0, "[0, 100] %"},
-        BadValue{"mode_switch_max_attempts", 0, "[1, 100]"},
-        BadValue{"ultrasonic/max_range", 0.01, "m"},
-        BadValue{"sim/errors", XmlRpcValue("motor_driver_9"), "list of strings"}));
+    ::testing::Values(BadValue{"publish_rate", -5.0, "(0, 1000] Hz"},
+                      BadValue{"publish_rate", 0.0, "(0, 1000] Hz"},
+                      BadValue{"publish_rate", "fast", "expected a number"},
+                      BadValue{"cmd_vel_timeout", 0.0, "[0.02, 60] s"},
+                      BadValue{"cmd_vel_timeout", std::numeric_limits<double>::quiet_NaN(),
+                               "[0.02, 60] s"},
+                      BadValue{"wheelbase", -0.89, "(0, 10] m"},
+                      BadValue{"track", 0.0, "(0, 10] m"},
+                      BadValue{"max_linear_speed", 3.0, "(0, 2.6] m/s"},
+                      BadValue{"max_ackermann_steering", 1.0, "40 deg"},
+                      BadValue{"max_spin_wheel_speed", 1.5, "(0, 1] m/s"},
+                      BadValue{"odometry_source", "gps", "\"wheels\" or \"motion\""},
+                      BadValue{"port_name", "", "CAN interface name"},
+                      BadValue{"port_name", "a/b", "CAN interface name"},
+                      BadValue{"odom_frame", "/odom", "no leading '/'"},
+                      BadValue{"base_frame", "odom", "must differ from odom_frame"},
+                      BadValue{"publish_odom_tf", 1, "expected true or false"},
+                      BadValue{"pose_covariance_diagonal", list({1, 2, 3, 4, 5}), "list of 6"},
+                      BadValue{"twist_covariance_diagonal", list({1, 1, 1, -1, 1, 1}), "list of 6"},
+                      BadValue{"linear/x/max_acceleration", -1.0, "(0, 1000] m/s^2"},
+                      BadValue{"low_battery_soc", 120.0, "[0, 100] %"},
+                      BadValue{"mode_switch_max_attempts", 0, "[1, 100]"},
+                      BadValue{"ultrasonic/max_range", 0.01, "m"},
+                      BadValue{"sim/errors", XmlRpcValue("motor_driver_9"), "list of strings"}));
 
 TEST(Parameters, ReportsEveryProblemAtOnce) {
   MapParameterSource source;

@@ -19,7 +19,8 @@ ranger::WheelSpeedsFeedback speeds(double v) {
 TEST(WheelJoints, WheelAngleIsDistanceOverRadius) {
   WheelJointTracker t(0.16);
   // 1 m/s for 1 s in 20 ms steps: 1 m of tread = 6.25 rad.
-  for (int i = 0; i <= 50; ++i) t.on_message(speeds(1.0), ranger::Timestamp(i * 20ms));
+  for (int i = 0; i <= 50; ++i)
+    t.on_message(speeds(1.0), ranger::Timestamp(1s + i * 20ms));
   EXPECT_NEAR(t.joints().wheel_position[0], 1.0 / 0.16, 1e-9);
   EXPECT_NEAR(t.joints().wheel_velocity[3], 1.0 / 0.16, 1e-9);
 }

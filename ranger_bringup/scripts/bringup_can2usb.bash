@@ -16,7 +16,10 @@ fail() {
 }
 
 case "$bitrate" in
-  '' | *[!0-9]*) echo "bringup_can2usb: bitrate must be a number of bit/s, got '$bitrate'" >&2; exit 2 ;;
+  '' | *[!0-9]*)
+    echo "bringup_can2usb: bitrate must be a number of bit/s, got '$bitrate'" >&2
+    exit 2
+    ;;
 esac
 if [ "$#" -gt 2 ] || [[ ! "$iface" =~ ^[A-Za-z0-9_.-]{1,15}$ ]]; then
   echo "usage: bringup_can2usb.bash [INTERFACE] [BITRATE]   (default: can0 500000)" >&2
@@ -34,8 +37,9 @@ command -v ip >/dev/null || fail "'ip' not found: install iproute2"
 if [ ! -d "$sysfs_net/$iface" ]; then
   command -v modprobe >/dev/null || fail "'modprobe' not found: install kmod"
   if ! "${sudo[@]}" modprobe gs_usb; then
-    fail "cannot load the gs_usb kernel module: this kernel has no CAN USB support (on a VM or a" \
-      "container, use the virtual chassis instead: roslaunch ranger_bringup ranger_minimal.launch sim:=true)"
+    fail "cannot load the gs_usb kernel module: this kernel has no CAN USB support (on a VM" \
+      "or a container, use the virtual chassis instead:" \
+      "roslaunch ranger_bringup ranger_minimal.launch sim:=true)"
   fi
   # The interface appears a moment after the driver binds to the adapter.
   for _ in 1 2 3 4 5 6 7 8 9 10; do

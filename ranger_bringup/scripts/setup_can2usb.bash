@@ -10,7 +10,10 @@ modules_load_dir=${RANGER_MODULES_LOAD_DIR:-/etc/modules-load.d}  # tests use a 
 
 sudo=()
 if [ "$(id -u)" -ne 0 ]; then
-  command -v sudo >/dev/null || { echo "setup_can2usb: not root and no sudo: run as root" >&2; exit 1; }
+  if ! command -v sudo >/dev/null; then
+    echo "setup_can2usb: not root and no sudo: run as root" >&2
+    exit 1
+  fi
   sudo=(sudo)
 fi
 

@@ -20,6 +20,8 @@ class Launch:
         self.log_path = os.path.join(master.home, f"{log_name}.log")
         self.log = open(self.log_path, "wb")
         environment = dict(master.env if env is None else env)
+        self.log_dir = os.path.join(master.home, "log", log_name)
+        environment["ROS_LOG_DIR"] = self.log_dir
         environment["ROS_PACKAGE_PATH"] = os.pathsep.join(
             [PACKAGE_DIR, os.path.join(REPO, "ranger_description")]
             + [p for p in environment.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p])
@@ -51,7 +53,28 @@ class Launch:
             except subprocess.TimeoutExpired:
                 os.killpg(self.process.pid, signal.SIGKILL)
                 self.process.wait()
+        # roslaunch starts every node in a session of its own and may leave some behind when
+        # stopped early: interrupt whatever of this launch outlived it.
+        for pid in self._node_pids():
+            try:
+                os.kill(pid, signal.SIGINT)
+            except OSError:
+                pass
         self.log.close()
+
+    def _node_pids(self):
+        """The nodes this launch started: roslaunch passes __log:=<ROS_LOG_DIR>/... to each,
+        and every Launch has a log directory of its own."""
+        marker = (self.log_dir + os.sep).encode()
+        for entry in os.listdir("/proc"):
+            if not entry.isdigit():
+                continue
+            try:
+                with open(f"/proc/{entry}/cmdline", "rb") as f:
+                    if marker in f.read():
+                        yield int(entry)
+            except OSError:
+                continue
 
 
 class Latest:

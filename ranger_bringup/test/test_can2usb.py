@@ -32,7 +32,8 @@ def fake(tmp_path):
     write_exe(bin_dir / "modprobe", '''echo "modprobe $*" >> "$CALLS"
 [ -n "${MODPROBE_FAILS:-}" ] && { echo "modprobe: FATAL: Module gs_usb not found" >&2; exit 1; }
 if [ -n "${MODPROBE_CREATES:-}" ]; then
-  mkdir -p "$RANGER_SYSFS_NET/$MODPROBE_CREATES"; echo 280 > "$RANGER_SYSFS_NET/$MODPROBE_CREATES/type"
+  mkdir -p "$RANGER_SYSFS_NET/$MODPROBE_CREATES"
+  echo 280 > "$RANGER_SYSFS_NET/$MODPROBE_CREATES/type"
 fi
 exit 0
 ''')

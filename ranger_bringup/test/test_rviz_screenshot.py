@@ -96,12 +96,13 @@ def test_rviz_draws_the_moving_robot(master):
     if os.path.exists(shot):
         os.remove(shot)
     xvfb = Xvfb()
-    driver = Launch(master, "ranger_minimal.launch", "sim:=true", "log_output:=log",
-                    log_name="driver")
-    env = dict(master.env, DISPLAY=xvfb.display, LIBGL_ALWAYS_SOFTWARE="1",
-               XDG_RUNTIME_DIR=master.home)
-    rviz = Launch(master, "display.launch", log_name="rviz", env=env)
+    driver = rviz = None
     try:
+        driver = Launch(master, "ranger_minimal.launch", "sim:=true", "log_output:=log",
+                        log_name="driver")
+        env = dict(master.env, DISPLAY=xvfb.display, LIBGL_ALWAYS_SOFTWARE="1",
+                   XDG_RUNTIME_DIR=master.home)
+        rviz = Launch(master, "display.launch", log_name="rviz", env=env)
         rospy.init_node("rviz_screenshot_test", anonymous=True, disable_signals=True)
         truth = Latest("/sim/ground_truth", Odometry)
         driver.wait_until(lambda: truth.get() is not None, timeout=60)
@@ -136,6 +137,7 @@ def test_rviz_draws_the_moving_robot(master):
         colours = len({tuple(p) for p in rgb[::4, ::4].reshape(-1, 3)})
         assert colours > 200, f"only {colours} colours: {shot}"
     finally:
-        rviz.stop()
-        driver.stop()
+        for launch in (rviz, driver):
+            if launch:
+                launch.stop()
         xvfb.stop()

@@ -26,30 +26,32 @@ def sim():
 
     master = RosMaster()
     launch = Launch(master, "ranger_minimal.launch", "sim:=true", "log_output:=log")
-    rospy.init_node("sim_bringup_test", anonymous=True, disable_signals=True)
+    try:
+        rospy.init_node("sim_bringup_test", anonymous=True, disable_signals=True)
 
-    class Sim:
-        pass
+        class Sim:
+            pass
 
-    s = Sim()
-    s.master, s.launch = master, launch
-    s.truth = Latest("/sim/ground_truth", Odometry)
-    s.state = Latest("/system_state", SystemState)
-    s.joints = Latest("/joint_states", JointState)
-    s.diagnostics = Latest("/diagnostics_agg", DiagnosticArray)
-    s.frames = {}  # child frame -> parent frame, from /tf and /tf_static
+        s = Sim()
+        s.master, s.launch = master, launch
+        s.truth = Latest("/sim/ground_truth", Odometry)
+        s.state = Latest("/system_state", SystemState)
+        s.joints = Latest("/joint_states", JointState)
+        s.diagnostics = Latest("/diagnostics_agg", DiagnosticArray)
+        s.frames = {}  # child frame -> parent frame, from /tf and /tf_static
 
-    def on_tf(msg):
-        for t in msg.transforms:
-            s.frames[t.child_frame_id] = t.header.frame_id
+        def on_tf(msg):
+            for t in msg.transforms:
+                s.frames[t.child_frame_id] = t.header.frame_id
 
-    s.tf_subs = [rospy.Subscriber(topic, TFMessage, on_tf, queue_size=100)
-                 for topic in ("/tf", "/tf_static")]
-    launch.wait_until(lambda: s.state.get() is not None and s.state.get().control_mode == 1,
-                      timeout=60)
-    yield s
-    launch.stop()
-    master.stop()
+        s.tf_subs = [rospy.Subscriber(topic, TFMessage, on_tf, queue_size=100)
+                     for topic in ("/tf", "/tf_static")]
+        launch.wait_until(
+            lambda: s.state.get() is not None and s.state.get().control_mode == 1, timeout=60)
+        yield s
+    finally:
+        launch.stop()
+        master.stop()
 
 
 def test_tf_tree_reaches_every_urdf_link_from_odom(sim):

@@ -74,10 +74,12 @@ def load_geometry(path):
     if g["steering_limit"] > math.pi:
         raise GeometryError("description/steering_limit: must be <= pi")
     if 4 * (g["wheel_mass"] + g["steering_module_mass"]) >= TOTAL_MASS:
-        raise GeometryError("description/wheel_mass + steering_module_mass: exceed the vehicle mass")
+        raise GeometryError(
+            "description/wheel_mass + steering_module_mass: exceed the vehicle mass")
     sensors = desc.get("ultrasonic")
     if not isinstance(sensors, list) or len(sensors) != ULTRASONIC_COUNT:
-        raise GeometryError(f"description/ultrasonic: expected a list of {ULTRASONIC_COUNT} [x, y, yaw]")
+        raise GeometryError(
+            f"description/ultrasonic: expected a list of {ULTRASONIC_COUNT} [x, y, yaw]")
     g["ultrasonic"] = []
     for i, s in enumerate(sensors):
         where = f"description/ultrasonic[{i}]/"

@@ -83,7 +83,8 @@ def geometry():
 
 @pytest.fixture(scope="module")
 def urdf_text():
-    return generate_urdf.to_xml(generate_urdf.build_urdf(generate_urdf.load_geometry(GEOMETRY_YAML)))
+    robot = generate_urdf.build_urdf(generate_urdf.load_geometry(GEOMETRY_YAML))
+    return generate_urdf.to_xml(robot)
 
 
 @pytest.fixture(scope="module")
@@ -254,8 +255,10 @@ def write_variant(tmp_path, geometry, change):
     (lambda g: g.update(track=float("nan")), "track: must be finite"),
     (lambda g: g.pop("wheel_radius"), "wheel_radius: missing"),
     (lambda g: g.update(wheel_radius="big"), "wheel_radius: expected a number"),
-    (lambda g: g["description"].update(body_height=0.3, body_clearance=0.1), "wheel_radius: the wheel does not fit"),
-    (lambda g: g["description"]["ultrasonic"].pop(), "description/ultrasonic: expected a list of 8"),
+    (lambda g: g["description"].update(body_height=0.3, body_clearance=0.1),
+     "wheel_radius: the wheel does not fit"),
+    (lambda g: g["description"]["ultrasonic"].pop(),
+     "description/ultrasonic: expected a list of 8"),
     (lambda g: g["description"].update(steering_limit=4.0), "description/steering_limit"),
 ])
 def test_bad_geometry_is_refused_naming_the_field(tmp_path, geometry, change, message):

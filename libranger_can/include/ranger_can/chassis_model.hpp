@@ -22,6 +22,7 @@
 
 #include <array>
 
+#include "ranger_can/codec.hpp"
 #include "ranger_can/geometry.hpp"
 #include "ranger_can/interpretation.hpp"
 #include "ranger_can/kinematics.hpp"  // BodyTwist, WheelState(s)
@@ -32,9 +33,9 @@ namespace ranger::sim {
 
 struct MotionLimits {
   double max_linear_speed = interpretation::kMaxLinearSpeedMps;  // m/s, Ackermann and oblique
-  double max_spin_speed = 1.0;                       // m/s wheel speed (0x111 valid +-1000 mm/s)
-  double max_ackermann_angle = 40.0 * M_PI / 180.0;  // rad, mean front angle (0x111 +-4000)
-  double max_oblique_angle = 90.0 * M_PI / 180.0;    // rad (0x111 +-9000)
+  double max_spin_speed = kMaxSpinSpeedMps;              // m/s wheel speed (0x111's range)
+  double max_ackermann_angle = kMaxAckermannSteeringRad;  // rad, mean front angle (0x111's range)
+  double max_oblique_angle = kMaxObliqueSteeringRad;      // rad (0x111's range)
   double acceleration = 1.0;                         // m/s^2 when speeding up
   double deceleration = 2.0;                         // m/s^2 when slowing down or stopping
   double emergency_deceleration = 6.0;               // m/s^2 for e-stop and power cut

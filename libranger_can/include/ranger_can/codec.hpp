@@ -9,6 +9,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <variant>
@@ -28,6 +29,11 @@ struct MotionCommand {
   double spin_speed = 0.0;      // m/s wheel speed, CCW positive    (wire: int16 mm/s, +-1000)
   double steering_angle = 0.0;  // rad, manual sign: positive right (wire: int16 0.01 deg, +-9000)
 };
+// 0x111's valid ranges in SI units, for code above the codec (the linear speed's range is open
+// point 1: interpretation::kMaxLinearSpeedMps).
+inline constexpr double kMaxAckermannSteeringRad = 40.0 * M_PI / 180.0;  // +-4000 x 0.01 deg
+inline constexpr double kMaxObliqueSteeringRad = 90.0 * M_PI / 180.0;    // +-9000 x 0.01 deg
+inline constexpr double kMaxSpinSpeedMps = 1.0;                          // +-1000 mm/s
 struct MotionModeCommand {  // 0x141
   protocol::MotionMode mode = protocol::MotionMode::kAckermann;
 };

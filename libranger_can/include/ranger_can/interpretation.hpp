@@ -1,6 +1,7 @@
 // The manual's open points, decided once.
 //
-// shared/reference/PROTOCOL.md lists six places where the RANGER manual is cut off or silent.
+// shared/reference/PROTOCOL.md lists six places where the RANGER manual is cut off or silent
+// (points 1-6); points 7-9 are further readings the code needs that PROTOCOL.md does not list.
 // Each decision below is the only place in the code base that encodes it: every other file calls
 // these names, so a test on a real chassis that disproves one reading is a one-line change here
 // (and docs/PROTOCOL_INTERPRETATIONS.md says why each reading was chosen).
@@ -90,5 +91,61 @@ inline double ackermann_mean_front_angle(double curvature, double wheelbase_m, d
 // `mean_angle`; |mean_angle| >= pi/2 gives +-infinity (turning about the body centre); NaN or a
 // non-positive/non-finite wheelbase or track gives NaN.
 double ackermann_curvature_from_mean_angle(double mean_angle, double wheelbase_m, double track_m);
+
+// ---- Readings beyond PROTOCOL.md's list ------------------------------------------------------
+
+// Geometry, not a reading: in dual Ackermann at body-centre curvature k, wheel i at (x_i, y_i)
+// rolls |(1 - k y_i, k x_i)| times as fast as the body centre; this is the mean of that factor
+// over the four wheels at (+-L/2, +-W/2). 1 at k = 0; +inf at |k| = inf.
+inline double ackermann_mean_wheel_speed_factor(double curvature, double wheelbase_m,
+                                                double track_m) {
+  const double along = curvature * wheelbase_m / 2.0;
+  return (std::hypot(1.0 - curvature * track_m / 2.0, along) +
+          std::hypot(1.0 + curvature * track_m / 2.0, along)) /
+         2.0;
+}
+
+// Point 7 — 0x111 linear speed (Ackermann and oblique mode) is the speed of the body centre.
+// In oblique mode every wheel rolls at the body's speed, so only Ackermann can tell the readings
+// apart; oblique callers pass curvature 0, where every reading agrees. The curvature and the
+// geometry are unused under this reading: they are parameters so that another reading (e.g. the
+// mean wheel speed, as 0x221 reports) is a change here only.
+inline double body_speed_from_command_speed(double command_speed_mps,
+                                            [[maybe_unused]] double curvature,
+                                            [[maybe_unused]] double wheelbase_m,
+                                            [[maybe_unused]] double track_m) {
+  return command_speed_mps;
+}
+inline double command_speed_from_body_speed(double body_speed_mps,
+                                            [[maybe_unused]] double curvature,
+                                            [[maybe_unused]] double wheelbase_m,
+                                            [[maybe_unused]] double track_m) {
+  return body_speed_mps;
+}
+
+// Point 8 — 0x221 speed in Ackermann mode is the mean of the four wheels' rolling speeds (what
+// the firmware measures), so the body centre moves with vx = speed / mean_i |(1 - k y_i, k x_i)|.
+// At |k| = inf (a corrupt angle of 90 deg or more) the body-centre speed is 0.
+inline double ackermann_body_speed_from_feedback_speed(double feedback_speed_mps, double curvature,
+                                                       double wheelbase_m, double track_m) {
+  const double factor = ackermann_mean_wheel_speed_factor(curvature, wheelbase_m, track_m);
+  return factor > 0.0 ? feedback_speed_mps / factor : 0.0;
+}
+inline double ackermann_feedback_speed_from_body_speed(double body_speed_mps, double curvature,
+                                                       double wheelbase_m, double track_m) {
+  return body_speed_mps * ackermann_mean_wheel_speed_factor(curvature, wheelbase_m, track_m);
+}
+
+// Point 9 — 0x221 speed in spin mode is the wheels' signed tangential speed, counter-clockwise
+// positive (the same quantity 0x111's spin speed commands, point 5, but a reading of its own so
+// that a chassis reporting, say, a yaw rate changes the feedback only).
+inline double spin_yaw_rate_from_feedback_speed(double feedback_speed_mps, double wheelbase_m,
+                                                double track_m) {
+  return feedback_speed_mps / std::hypot(wheelbase_m / 2.0, track_m / 2.0);
+}
+inline double spin_feedback_speed_from_yaw_rate(double yaw_rate_rps, double wheelbase_m,
+                                                double track_m) {
+  return yaw_rate_rps * std::hypot(wheelbase_m / 2.0, track_m / 2.0);
+}
 
 }  // namespace ranger::interpretation

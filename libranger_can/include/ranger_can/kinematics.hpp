@@ -38,10 +38,10 @@ struct KinematicsLimits {
   // The manual names a lower speed limit "when the steering angle > 20 deg" without giving it:
   // applied when |steering| > interpretation::kLargeSteeringThresholdRad (Ackermann and oblique).
   double max_speed_at_large_steering = 1.5;  // m/s
-  double max_ackermann_steering =
-      40.0 * M_PI / 180.0;  // rad, mean front-wheel angle, 0 < x <= 40 deg
-  double max_oblique_steering = 90.0 * M_PI / 180.0;  // rad, 0 < x <= 90 deg
-  double max_spin_wheel_speed = 1.0;                  // m/s wheel tangential speed, 0 < x <= 1
+  // Steering and spin default to the protocol's full 0x111 range (codec.hpp).
+  double max_ackermann_steering = kMaxAckermannSteeringRad;  // rad, mean front-wheel angle
+  double max_oblique_steering = kMaxObliqueSteeringRad;      // rad, direction of travel
+  double max_spin_wheel_speed = kMaxSpinSpeedMps;            // m/s wheel tangential speed
 
   // Every field finite, positive and within the protocol's range; the message names the field.
   Status validate() const;
@@ -71,8 +71,9 @@ struct KinematicsSolution {
 // Computes the 0x111 command that realises `twist` as closely as `mode` allows, clamped to
 // `limits` (saturate, never wrap). Errors: kNotFinite when a twist component is NaN/inf (the
 // message names it). Pure function.
-//  * Ackermann: linear_speed = vx (body-centre speed), steering = the mean front-wheel angle for
-//    curvature wz/vx (interpretation::ackermann_mean_front_angle). A turn tighter than the
+//  * Ackermann: linear_speed = vx (0x111 is read as the body-centre speed: interpretation point
+//    7), steering = the mean front-wheel angle for curvature wz/vx
+//    (interpretation::ackermann_mean_front_angle). A turn tighter than the
 //    steering limit is clamped to the limit with the curvature's sign kept (kSteeringSaturated);
 //    vx = 0 with wz != 0 gives zero speed and full lock towards wz (kRotationDropped).
 //  * Oblique: linear_speed = +-|(vx, vy)|, steering = direction of travel folded into

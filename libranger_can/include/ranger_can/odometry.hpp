@@ -90,11 +90,12 @@ BodyTwist fit_body_twist(const std::array<WheelMeasurement, kWheelCount>& wheels
 
 // The body twist from 0x221 in `mode` (pure function):
 //  * Ackermann: the steering is the mean front-wheel angle -> curvature k
-//    (interpretation::ackermann_curvature_from_mean_angle); 0x221's speed is the mean of the
-//    four wheel speeds, so vx = speed / mean_i |(1 - k*y_i, k*x_i)| and wz = k * vx.
+//    (interpretation::ackermann_curvature_from_mean_angle); 0x221's speed is read as the mean of
+//    the four wheel speeds (interpretation point 8), so vx = speed / mean_i |(1 - k*y_i, k*x_i)|
+//    (interpretation::ackermann_body_speed_from_feedback_speed) and wz = k * vx.
 //  * Oblique: vx = speed*cos(angle), vy = speed*sin(angle) (angle in REP-103 signs).
 //  * Spin: 0x221's speed is read as the wheels' tangential speed, counter-clockwise positive
-//    (like 0x111's spin speed): wz = interpretation::spin_yaw_rate_from_wheel_speed(speed).
+//    (point 9): wz = interpretation::spin_yaw_rate_from_feedback_speed(speed).
 BodyTwist twist_from_motion_feedback(const MotionFeedback& feedback, protocol::MotionMode mode,
                                      const VehicleGeometry& geometry);
 

@@ -20,10 +20,11 @@
 //  * 0x141 starts a switch: the body brakes to rest, then the wheels turn for
 //    `mode_switch_duration`; meanwhile 0x291 reports the mode being left with switching = 1 and
 //    speed commands are ignored. A 0x141 naming the current mode changes nothing.
-//  * 0x221: Ackermann — (alpha+beta)/2 of the front wheels and the mean of the four wheel speeds;
-//    oblique — the mean of the four wheel angles and of the four speeds; spin — the mean of the
-//    absolute wheel angles and (reading, as the vendor's driver expects) the signed tangential
-//    wheel speed, counter-clockwise positive.
+//  * 0x111's linear speed is the body centre's (interpretation point 7).
+//  * 0x221: Ackermann — (alpha+beta)/2 of the front wheels and the mean of the four wheel speeds
+//    (point 8); oblique — the mean of the four wheel angles and of the four speeds; spin — the
+//    mean of the absolute wheel angles and (point 9, as the vendor's driver expects) the signed
+//    tangential wheel speed, counter-clockwise positive.
 //  * Motion is refused (the chassis brakes to rest and ignores 0x111's motion) while: not in CAN
 //    mode, e-stop, a critical error bit (protocol::is_critical_error), battery under-voltage
 //    (set whenever SOC < 10 %, latched until 0x441 0x09 / 0x00 finds the SOC back at >= 10 %),

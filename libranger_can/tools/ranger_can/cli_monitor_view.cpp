@@ -31,11 +31,18 @@ std::string fmt(const char* format, double v) {
   return buf;
 }
 
-// An angle in the manual's sign (positive = right) shown unambiguously: "12.50 deg left".
-std::string steering_text(double manual_rad) {
-  const double rep = interpretation::rep103_from_manual_steering(manual_rad) * kRadToDeg;
+// A REP-103 angle shown unambiguously: "12.50 deg left".
+std::string rep103_steering_text(double rep103_rad) {
+  const double rep = rep103_rad * kRadToDeg;
   if (std::abs(rep) < 0.005) return "  0.00 deg straight";
   return fmt("%6.2f deg ", std::abs(rep)) + (rep > 0 ? "left " : "right");
+}
+// 0x221's and 0x111's angles in the manual's signs; each frame has its own reading.
+std::string steering_text(double manual_rad) {
+  return rep103_steering_text(interpretation::rep103_from_manual_steering(manual_rad));
+}
+std::string command_steering_text(double manual_rad) {
+  return rep103_steering_text(interpretation::rep103_from_manual_command_steering(manual_rad));
 }
 std::string wheel_angle_text(double manual_rad) {
   const double rep = interpretation::rep103_from_manual_wheel_angle(manual_rad) * kRadToDeg;
@@ -238,7 +245,8 @@ std::string ChassisMonitor::render_text(std::string_view iface, const BusStatus&
   if (motion_command_) {
     const auto& c = motion_command_->value;
     host += fmt("0x111 speed %+.3f m/s", c.linear_speed) + "  steer " +
-            steering_text(c.steering_angle) + fmt("  spin %+.3f m/s", c.spin_speed) + "  (" +
+            command_steering_text(c.steering_angle) + fmt("  spin %+.3f m/s", c.spin_speed) +
+            "  (" +
             age_text(motion_command_->received, now) +
             fmt(", %.1f/s)", rate(protocol::kMotionCommandId, now));
   } else {

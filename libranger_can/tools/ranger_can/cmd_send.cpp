@@ -91,13 +91,15 @@ Result<Message> parse_command(const std::vector<std::string>& w) {
     auto v = parse_double_in("motion V", w[1], -interpretation::kMaxLinearSpeedMps,
                              interpretation::kMaxLinearSpeedMps);
     if (!v) return v.error();
-    auto steer = parse_double_in("motion STEER_DEG", w[2], -90.0, 90.0);
+    constexpr double kRadPerDeg = M_PI / 180.0;  // the user's unit, not the wire's
+    auto steer = parse_double_in("motion STEER_DEG", w[2], -kMaxObliqueSteeringRad / kRadPerDeg,
+                                 kMaxObliqueSteeringRad / kRadPerDeg);
     if (!steer) return steer.error();
-    auto spin = parse_double_in("motion SPIN", w[3], -1.0, 1.0);
+    auto spin = parse_double_in("motion SPIN", w[3], -kMaxSpinSpeedMps, kMaxSpinSpeedMps);
     if (!spin) return spin.error();
     MotionCommand m;
     m.linear_speed = *v;
-    m.steering_angle = interpretation::manual_from_rep103_steering(*steer * M_PI / 180.0);
+    m.steering_angle = interpretation::manual_from_rep103_command_steering(*steer * kRadPerDeg);
     m.spin_speed = *spin;
     return Message{m};
   }

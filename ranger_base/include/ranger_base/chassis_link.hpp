@@ -51,8 +51,8 @@ struct ChassisLinkOptions {
 
 // A 0x111 the controller has just sent, for cmd_vel_out and latency measurements.
 struct MotionCommandEvent {
-  std::chrono::system_clock::time_point sent;  // wall time right after the send
-  ranger::MotionCommand command;               // as on the wire (manual signs)
+  std::chrono::system_clock::time_point sent;          // wall time right after the send
+  ranger::MotionCommand command;                       // as on the wire (manual signs)
   std::optional<ranger::KinematicsSolution> solution;  // mode and achieved twist (REP-103)
 };
 
@@ -104,11 +104,14 @@ class ChassisLink {
   // Runs `f` on the virtual chassis with its loop held off (fault injection in tests). False when
   // there is no virtual chassis.
   bool with_sim(const std::function<void(ranger::sim::VirtualChassis&)>& f);
+  // The in-process network of the virtual chassis (link down/up, error frames in tests); null
+  // when not in sim mode.
+  ranger::LoopbackNetwork* sim_network() { return network_.get(); }
 
  private:
   void loop();
-  void try_open(ranger::Timestamp now);        // lock held
-  void drain_and_tick(ranger::Timestamp now);  // lock held
+  void try_open(ranger::Timestamp now);                                     // lock held
+  void drain_and_tick(ranger::Timestamp now);                               // lock held
   void handle_frame(const ranger::CanFrame& frame, ranger::Timestamp now);  // lock held
   void wake();
   void wait(int bus_fd, std::chrono::nanoseconds timeout);

@@ -52,8 +52,7 @@ inline constexpr int kStalePeriods = 3;
 ranger::BodyTwist to_body_twist(const geometry_msgs::Twist& twist);
 // True if a component the chassis ignores (linear.z, angular.x, angular.y) is non-zero.
 bool has_non_planar_components(const geometry_msgs::Twist& twist);
-geometry_msgs::TwistStamped to_twist_stamped(const ranger::BodyTwist& twist,
-                                             const ros::Time& stamp,
+geometry_msgs::TwistStamped to_twist_stamped(const ranger::BodyTwist& twist, const ros::Time& stamp,
                                              const std::string& frame_id);
 
 // ---- odometry, TF, joints ---------------------------------------------------------------------

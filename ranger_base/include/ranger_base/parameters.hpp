@@ -10,8 +10,8 @@
 #include <xmlrpcpp/XmlRpcValue.h>
 
 #include <array>
-#include <cstdint>
 #include <chrono>
+#include <cstdint>
 #include <map>
 #include <optional>
 #include <string>
@@ -54,8 +54,8 @@ struct NodeParameters {
 
   UltrasonicRangeParameters ultrasonic;
 
-  ranger::ControllerConfig controller;  // geometry, limits, cmd_vel_timeout, ...
-  ranger::OdometryConfig odometry;      // geometry (same), source, covariance growth
+  ranger::ControllerConfig controller;    // geometry, limits, cmd_vel_timeout, ...
+  ranger::OdometryConfig odometry;        // geometry (same), source, covariance growth
   ranger::sim::VirtualChassisConfig sim;  // port_name = sim only
   std::uint32_t sim_error_bits = 0;       // 0x211 error bits the virtual chassis boots with
 

@@ -1,0 +1,194 @@
+#!/usr/bin/python3
+"""ranger_base_node over SocketCAN (vcan0) against `ranger_can sim vcan0` in another process
+(node_vcan.test). The bus traffic is recorded with candump and read back through
+`ranger_can decode --json`, so the assertions use the kernel's frame timestamps and the order of
+frames on the bus, and no protocol knowledge of their own.
+
+  * handshake to CAN command mode, driving, odometry against the simulator's ground truth;
+  * SIGINT: the node's last 0x111 is a stop, sent promptly; the chassis comes to rest;
+  * SIGKILL: no stop from the node; the chassis's own 500 ms watchdog trips and it comes to rest.
+
+Waits are bounded only so that a broken build fails instead of hanging.
+"""
+
+import json
+import math
+import os
+import shutil
+import signal
+import subprocess
+import tempfile
+import time
+import unittest
+
+import roslib.packages
+import rospy
+import rostest
+from geometry_msgs.msg import Twist
+from nav_msgs.msg import Odometry
+from ranger_msgs.msg import SystemState
+
+IFACE = "vcan0"
+WATCHDOG_S = 0.5          # the chassis stops 500 ms after the last 0x111 (manual)
+FRAME_PERIOD_S = 0.02     # 0x211 / 0x221 period
+# Allowance for scheduling (the VM emulates its CPU): added to protocol times, never the subject.
+SLACK_S = 0.3
+
+
+def wait_for(condition, timeout=60.0, interval=0.02):
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        value = condition()
+        if value:
+            return value
+        time.sleep(interval)
+    return condition()
+
+
+def find_executable(name, package_dirs=("bin",)):
+    found = shutil.which(name)
+    if found:
+        return found
+    for prefix in os.environ.get("CMAKE_PREFIX_PATH", "").split(os.pathsep):
+        for sub in package_dirs:
+            candidate = os.path.join(prefix, sub, name)
+            if os.access(candidate, os.X_OK):
+                return candidate
+    raise RuntimeError(f"{name} not found on PATH or under CMAKE_PREFIX_PATH")
+
+
+class VcanNode(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("test_node_vcan")
+        cls.tmp = tempfile.mkdtemp(prefix="ranger-vcan-test-")
+        cls.ranger_can = find_executable("ranger_can")
+        cls.node_exe = roslib.packages.find_node("ranger_base", "ranger_base_node")[0]
+        cls.candump_log = os.path.join(cls.tmp, "candump.log")
+        cls.pose_log = os.path.join(cls.tmp, "pose.jsonl")
+        cls.candump = subprocess.Popen(["candump", "-L", IFACE],
+                                       stdout=open(cls.candump_log, "w"))
+        cls.sim = subprocess.Popen([cls.ranger_can, "sim", IFACE, "--no-stdin", "--quiet",
+                                    "--pose-out", cls.pose_log, "--pose-rate", "50"])
+        assert wait_for(lambda: cls.truth() is not None), "ranger_can sim wrote no pose"
+
+    @classmethod
+    def tearDownClass(cls):
+        for p in (cls.sim, cls.candump):
+            p.send_signal(signal.SIGINT)
+            try:
+                p.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                p.kill()
+
+    # ---- helpers ------------------------------------------------------------------------------
+
+    @classmethod
+    def truth(cls):
+        """The simulator's latest ground-truth line, or None."""
+        try:
+            with open(cls.pose_log) as f:
+                lines = f.read().splitlines()
+        except FileNotFoundError:
+            return None
+        for line in reversed(lines):
+            try:
+                return json.loads(line)
+            except ValueError:
+                continue  # a line being written
+        return None
+
+    def frames(self):
+        """Every frame recorded so far, decoded by ranger_can (JSON objects, in bus order)."""
+        result = subprocess.run([self.ranger_can, "decode", "--json", self.candump_log],
+                                capture_output=True, text=True, timeout=120)
+        return [json.loads(line) for line in result.stdout.splitlines() if line.strip()]
+
+    def start_node(self, ns):
+        node = subprocess.Popen([self.node_exe, f"__ns:=/{ns}", "__name:=ranger_base_node",
+                                 f"_port_name:={IFACE}"])
+        state = {}
+        sub = rospy.Subscriber(f"/{ns}/system_state", SystemState,
+                               lambda m: state.update(msg=m))
+        odom = {}
+        odom_sub = rospy.Subscriber(f"/{ns}/odom", Odometry, lambda m: odom.update(msg=m))
+        pub = rospy.Publisher(f"/{ns}/cmd_vel", Twist, queue_size=10)
+        self.addCleanup(sub.unregister)
+        self.addCleanup(odom_sub.unregister)
+        self.addCleanup(pub.unregister)
+        self.addCleanup(lambda: node.poll() is None and node.kill())
+        self.assertTrue(wait_for(lambda: "msg" in state and state["msg"].link_up
+                                 and state["msg"].control_mode == SystemState.CONTROL_MODE_CAN
+                                 and pub.get_num_connections() > 0),
+                        "handshake to CAN command mode over vcan0")
+        return node, pub, odom
+
+    def drive_forward(self, pub, speed=0.5):
+        cmd = Twist()
+        cmd.linear.x = speed
+        def moving():
+            pub.publish(cmd)
+            t = self.truth()
+            return t and t["vx"] > 0.8 * speed
+        self.assertTrue(wait_for(moving, interval=0.05), "the chassis should drive")
+        for _ in range(20):  # keep driving for a while (1 s at 20 Hz)
+            pub.publish(cmd)
+            time.sleep(0.05)
+
+    def motion_commands_after(self, frames, t):
+        return [f for f in frames if f["name"] == "motion_command" and f["t"] >= t]
+
+    # ---- tests (run in name order; the simulator carries over) -------------------------------
+
+    def test_1_drive_then_sigint_stops_the_chassis(self):
+        node, pub, odom = self.start_node("sigint")
+        start_truth = self.truth()
+        self.assertTrue(wait_for(lambda: "msg" in odom))
+        start_odom = odom["msg"].pose.pose.position
+        self.drive_forward(pub)
+        # Odometry over the real socket follows the simulator's ground truth.
+        travelled = self.truth()["distance"] - start_truth["distance"]
+        dx_truth = self.truth()["x"] - start_truth["x"]
+        dx_odom = odom["msg"].pose.pose.position.x - start_odom.x
+        self.assertGreater(travelled, 0.3)
+        self.assertAlmostEqual(dx_odom, dx_truth, delta=0.05 + 0.02 * travelled)
+
+        t_signal = time.time()
+        node.send_signal(signal.SIGINT)
+        self.assertEqual(node.wait(timeout=60), 0)
+        self.assertTrue(wait_for(lambda: abs(self.truth()["vx"]) < 1e-3), "chassis at rest")
+        frames = self.frames()
+        commands = [f for f in frames if f["name"] == "motion_command"]
+        self.assertTrue(commands, "the node sent 0x111")
+        last = commands[-1]
+        # The node's last word is a stop, sent when it was told to go.
+        self.assertEqual((last["linear_speed"], last["spin_speed"]), (0.0, 0.0))
+        self.assertGreaterEqual(last["t"], t_signal - FRAME_PERIOD_S)
+        self.assertLessEqual(last["t"], t_signal + WATCHDOG_S)
+        # ... after it was still driving.
+        self.assertTrue(any(c["linear_speed"] > 0.4 for c in commands[:-1]))
+
+    def test_2_sigkill_leaves_the_chassis_watchdog_to_stop_it(self):
+        node, pub, _ = self.start_node("sigkill")
+        self.drive_forward(pub)
+        node.kill()
+        node.wait(timeout=30)
+        self.assertTrue(wait_for(lambda: abs(self.truth()["vx"]) < 1e-3), "chassis at rest")
+        frames = self.frames()
+        commands = [f for f in frames if f["name"] == "motion_command"]
+        last = commands[-1]
+        self.assertGreater(last["linear_speed"], 0.4, "a killed node sends no stop")
+        after = [f for f in frames if f["t"] > last["t"]]
+        tripped = [f for f in after if f["name"] == "system_status"
+                   and "host_communication_lost" in f.get("errors", [])]
+        self.assertTrue(tripped, "the chassis reports the lost host link")
+        delay = tripped[0]["t"] - last["t"]
+        self.assertGreaterEqual(delay, WATCHDOG_S - FRAME_PERIOD_S)
+        self.assertLessEqual(delay, WATCHDOG_S + 2 * FRAME_PERIOD_S + SLACK_S)
+        at_rest = [f for f in after if f["name"] == "motion_feedback"
+                   and abs(f["speed"]) < 1e-3 and f["t"] >= tripped[0]["t"]]
+        self.assertTrue(at_rest, "the chassis comes to rest by itself")
+
+
+if __name__ == "__main__":
+    rostest.rosrun("ranger_base", "node_vcan", VcanNode)
