@@ -171,8 +171,8 @@ def measure(rospy, launch, robots, duration):
     rsp_cpu, rsp_rss = of_role("robot_state_publisher", "cpu_percent"), of_role(
         "robot_state_publisher", "rss_kib")
     per_robot_total = {}
-    for p in per_process:
-        if p["robot"]:
+    for p in per_process:  # the robot's own processes (not the graph's one aggregator)
+        if p["robot"] and p["role"] in ("ranger_base_node", "robot_state_publisher"):
             per_robot_total[p["robot"]] = per_robot_total.get(p["robot"], 0.0) + p["cpu_percent"]
     odom_hz = [(c1 - c0) / wall for c0, c1 in zip(counts0, counts1)]
 

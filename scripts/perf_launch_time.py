@@ -39,7 +39,8 @@ def time_to_command_mode(rospy, ns, start_process):
     stamp = {}
 
     def on_state(msg):
-        if msg.link_up and msg.control_mode == SystemState.CONTROL_MODE_CAN and not reached.is_set():
+        in_can = msg.link_up and msg.control_mode == SystemState.CONTROL_MODE_CAN
+        if in_can and not reached.is_set():
             stamp["t"] = msg.header.stamp.to_sec()
             reached.set()
     sub = rospy.Subscriber(f"/{ns}/system_state", SystemState, on_state, queue_size=100,

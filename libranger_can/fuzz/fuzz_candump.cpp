@@ -20,10 +20,12 @@ using ranger::CanFrame;
 
 void check_well_formed(const ranger::LogEntry& e) {
   FUZZ_CHECK(e.frame.dlc <= CanFrame::kMaxDlc);
-  for (std::size_t i = e.frame.dlc; i < CanFrame::kMaxDlc; ++i) FUZZ_CHECK(e.frame.data[i] == 0);
+  for (std::size_t i = e.frame.dlc; i < CanFrame::kMaxDlc; ++i)
+    FUZZ_CHECK(e.frame.data[i] == 0);
   FUZZ_CHECK(e.frame.id <= (e.frame.is_error ? 0x1FFFFFFFu : 0x7FFu));
   FUZZ_CHECK(!e.iface.empty() && e.iface.size() <= 15);
-  for (char c : e.iface) FUZZ_CHECK(c != ' ' && c != '\t' && c != '\n' && c != '#');
+  for (char c : e.iface)
+    FUZZ_CHECK(c != ' ' && c != '\t' && c != '\n' && c != '#');
   if (!e.has_timestamp) FUZZ_CHECK(e.frame.stamp.count() == 0);
 }
 

@@ -93,9 +93,12 @@ void put_i16(CanFrame& f, int at, int v) {
 // A wheel or body speed in mm/s: mostly at or near standstill, sometimes anything.
 int speed_mmps(FuzzedDataProvider& in) {
   switch (in.ConsumeIntegralInRange<int>(0, 3)) {
-    case 0: return 0;
-    case 1: return in.ConsumeIntegralInRange<int>(-30, 30);
-    default: return in.ConsumeIntegral<std::int16_t>();
+    case 0:
+      return 0;
+    case 1:
+      return in.ConsumeIntegralInRange<int>(-30, 30);
+    default:
+      return in.ConsumeIntegral<std::int16_t>();
   }
 }
 
@@ -115,11 +118,17 @@ CanFrame make_frame(FuzzedDataProvider& in) {
       f.data[3] = 0xE0;
       std::uint32_t bits = 0;
       switch (in.ConsumeIntegralInRange<int>(0, 5)) {
-        case 0: bits = 1u << in.ConsumeIntegralInRange<int>(0, 31); break;
-        case 1: bits = in.ConsumeIntegral<std::uint32_t>(); break;
-        default: break;
+        case 0:
+          bits = 1u << in.ConsumeIntegralInRange<int>(0, 31);
+          break;
+        case 1:
+          bits = in.ConsumeIntegral<std::uint32_t>();
+          break;
+        default:
+          break;
       }
-      for (int i = 0; i < 4; ++i) f.data[4 + i] = static_cast<std::uint8_t>(bits >> (24 - 8 * i));
+      for (int i = 0; i < 4; ++i)
+        f.data[4 + i] = static_cast<std::uint8_t>(bits >> (24 - 8 * i));
       break;
     }
     case 3:
@@ -133,7 +142,8 @@ CanFrame make_frame(FuzzedDataProvider& in) {
     case 5: {  // 0x281 wheel speeds
       f.id = protocol::kWheelSpeedsId;
       f.dlc = 8;
-      for (int i = 0; i < 4; ++i) put_i16(f, 2 * i, speed_mmps(in));
+      for (int i = 0; i < 4; ++i)
+        put_i16(f, 2 * i, speed_mmps(in));
       break;
     }
     case 6: {  // 0x221 motion feedback
@@ -155,14 +165,16 @@ CanFrame make_frame(FuzzedDataProvider& in) {
       f.id = kIds[in.ConsumeIntegralInRange<std::size_t>(0, kIds.size() - 1)];
       const int dlc = protocol::expected_dlc(f.id);
       f.dlc = static_cast<std::uint8_t>(dlc >= 0 ? dlc : 8);
-      for (std::size_t i = 0; i < f.dlc; ++i) f.data[i] = in.ConsumeIntegral<std::uint8_t>();
+      for (std::size_t i = 0; i < f.dlc; ++i)
+        f.data[i] = in.ConsumeIntegral<std::uint8_t>();
       break;
     }
     default: {  // garbage: foreign IDs, wrong DLCs, error frames
       f.id = in.ConsumeIntegral<std::uint32_t>() & 0x1FFFFFFFu;
       f.dlc = in.ConsumeIntegralInRange<std::uint8_t>(0, 8);
       f.is_error = in.ConsumeBool();
-      for (std::size_t i = 0; i < f.dlc; ++i) f.data[i] = in.ConsumeIntegral<std::uint8_t>();
+      for (std::size_t i = 0; i < f.dlc; ++i)
+        f.data[i] = in.ConsumeIntegral<std::uint8_t>();
       break;
     }
   }
@@ -188,7 +200,8 @@ void record(const CanFrame& f, Timestamp now, ChassisSaid& said) {
   } else if (const auto* w = std::get_if<ranger::WheelSpeedsFeedback>(&*message)) {
     said.wheels_time = now;
     said.max_wheel_speed = 0.0;
-    for (double v : w->speeds) said.max_wheel_speed = std::max(said.max_wheel_speed, std::abs(v));
+    for (double v : w->speeds)
+      said.max_wheel_speed = std::max(said.max_wheel_speed, std::abs(v));
   } else if (const auto* mf = std::get_if<ranger::MotionFeedback>(&*message)) {
     said.motion_time = now;
     said.motion_speed = std::abs(mf->speed);
@@ -232,8 +245,8 @@ class Harness {
         }
         case 3:
         case 4: {  // the clock moves on, the loop ticks
-          static constexpr std::int64_t kSteps[] = {0, 1, 5, 10, 19, 20, 21, 50, 99, 100, 101,
-                                                    499, 500, 501, 1000, 1500, 5000};
+          static constexpr std::int64_t kSteps[] = {0,   1,   5,   10,  19,  20,   21,   50,  99,
+                                                    100, 101, 499, 500, 501, 1000, 1500, 5000};
           const std::int64_t ms = in.ConsumeBool()
                                       ? kSteps[in.ConsumeIntegralInRange<std::size_t>(
                                             0, sizeof(kSteps) / sizeof(kSteps[0]) - 1)]
@@ -242,7 +255,9 @@ class Harness {
           tick();
           break;
         }
-        case 5: tick(); break;
+        case 5:
+          tick();
+          break;
         case 6:
         case 7: {  // a command from the caller
           ranger::MotionRequest request;
@@ -284,12 +299,16 @@ class Harness {
               if (code > protocol::kMaxErrorClearCode) FUZZ_CHECK(!st.ok());
               break;
             }
-            default: (void)ctl_.set_ultrasonic(in.ConsumeBool(), now_); break;
+            default:
+              (void)ctl_.set_ultrasonic(in.ConsumeBool(), now_);
+              break;
           }
           check_sent(false);
           break;
         }
-        case 10: bus_.refuse(in.ConsumeBool()); break;
+        case 10:
+          bus_.refuse(in.ConsumeBool());
+          break;
         default:
           if (in.ConsumeIntegralInRange<int>(0, 7) == 0) {
             ctl_.shutdown(now_);
@@ -369,7 +388,8 @@ class Harness {
         }
         break;
       }
-      default: break;
+      default:
+        break;
     }
   }
 
@@ -384,10 +404,10 @@ class Harness {
     FUZZ_CHECK(!shut_down_);
     FUZZ_CHECK(said_.status_time.has_value());
     FUZZ_CHECK(now_ - *said_.status_time <= config_.link_timeout);
-    FUZZ_CHECK(said_.control_mode == 0x01);                    // CAN command mode
-    FUZZ_CHECK(said_.vehicle_status != 0x01);                  // not e-stopped
+    FUZZ_CHECK(said_.control_mode == 0x01);    // CAN command mode
+    FUZZ_CHECK(said_.vehicle_status != 0x01);  // not e-stopped
     FUZZ_CHECK(!protocol::is_critical_error(said_.error_bits));
-    FUZZ_CHECK(said_.have_mode && said_.switching == 0x00);    // mode known, not switching
+    FUZZ_CHECK(said_.have_mode && said_.switching == 0x00);  // mode known, not switching
     const auto& solution = ctl_.state().last_solution;
     FUZZ_CHECK(solution.has_value());
     FUZZ_CHECK(static_cast<std::uint8_t>(solution->mode) == said_.motion_mode);

@@ -82,20 +82,26 @@ CanFrame canonical(CanFrame f) {
 // Commands whose decoded value a host may not send: the only frames that may fail to re-encode.
 bool unsendable_command(const CanFrame& f) {
   switch (f.id) {
-    case protocol::kMotionModeCommandId: return f.data[0] > 2;
-    case protocol::kControlModeCommandId: return f.data[0] != 0 && f.data[0] != 1;
-    case protocol::kErrorClearCommandId: return f.data[0] > protocol::kMaxErrorClearCode;
-    default: return false;
+    case protocol::kMotionModeCommandId:
+      return f.data[0] > 2;
+    case protocol::kControlModeCommandId:
+      return f.data[0] != 0 && f.data[0] != 1;
+    case protocol::kErrorClearCommandId:
+      return f.data[0] > protocol::kMaxErrorClearCode;
+    default:
+      return false;
   }
 }
 
 void check_tables(FuzzedDataProvider& in, std::uint32_t id) {
   FUZZ_CHECK(!protocol::frame_name(id).empty());
   const auto word = in.ConsumeIntegral<std::uint32_t>();
-  for (const auto& name : protocol::error_bit_names(word)) FUZZ_CHECK(!name.empty());
+  for (const auto& name : protocol::error_bit_names(word))
+    FUZZ_CHECK(!name.empty());
   (void)protocol::is_critical_error(word);
   const auto byte = in.ConsumeIntegral<std::uint8_t>();
-  for (const auto& name : protocol::driver_status_names(byte)) FUZZ_CHECK(!name.empty());
+  for (const auto& name : protocol::driver_status_names(byte))
+    FUZZ_CHECK(!name.empty());
   for (const auto& name : protocol::bms_status_names(byte, static_cast<std::uint8_t>(word))) {
     FUZZ_CHECK(!name.empty());
   }
@@ -121,7 +127,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                   : in.ConsumeIntegralInRange<std::uint8_t>(0, 15);
   frame.is_error = in.ConsumeIntegralInRange<int>(0, 31) == 0;
   const std::size_t valid = std::min<std::size_t>(frame.dlc, CanFrame::kMaxDlc);
-  for (std::size_t i = 0; i < valid; ++i) frame.data[i] = in.ConsumeIntegral<std::uint8_t>();
+  for (std::size_t i = 0; i < valid; ++i)
+    frame.data[i] = in.ConsumeIntegral<std::uint8_t>();
   // The same frame with garbage past its DLC (which the CanFrame contract says is zero).
   CanFrame dirty = frame;
   for (std::size_t i = valid; i < CanFrame::kMaxDlc; ++i) {

@@ -13,6 +13,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 
 #include "fuzz_input.hpp"
 #include "ranger_can/codec.hpp"
@@ -28,6 +30,8 @@ using ranger::fuzz::sign_of;
 using ranger::protocol::MotionMode;
 
 constexpr double kRadToCentiDeg = 18000.0 / M_PI;
+// RANGER_FUZZ_TRACE=1 prints the speed limiter's steps (for reading a reproducer).
+const bool kTrace = std::getenv("RANGER_FUZZ_TRACE") != nullptr;
 // 0x111 limits on the wire (manual 3.2 and interpretation.hpp open point 1).
 constexpr int kWireMaxLinear = 2600;    // mm/s
 constexpr int kWireMaxSpin = 1000;      // mm/s
@@ -45,8 +49,8 @@ Wire111 wire_fields(const ranger::CanFrame& f) {
 
 // The value the wire must carry for `value` * `scale` saturated at +-limit.
 int expected_wire(double value, double scale, int limit) {
-  const double scaled = std::clamp(value * scale, -static_cast<double>(limit),
-                                   static_cast<double>(limit));
+  const double scaled =
+      std::clamp(value * scale, -static_cast<double>(limit), static_cast<double>(limit));
   return static_cast<int>(std::lround(scaled));
 }
 
@@ -125,15 +129,15 @@ void fuzz_solve(FuzzedDataProvider& in) {
   FUZZ_CHECK(finite(solution->achieved));
 
   constexpr double kEps = 1e-9;
-  const double max_speed = std::min(limits.max_linear_speed,
-                                    ranger::interpretation::kMaxLinearSpeedMps);
+  const double max_speed =
+      std::min(limits.max_linear_speed, ranger::interpretation::kMaxLinearSpeedMps);
   FUZZ_CHECK(std::abs(cmd.linear_speed) <= max_speed + kEps);
   if (std::abs(cmd.steering_angle) > ranger::interpretation::kLargeSteeringThresholdRad + kEps) {
     FUZZ_CHECK(std::abs(cmd.linear_speed) <= limits.max_speed_at_large_steering + kEps);
   }
   FUZZ_CHECK(std::abs(cmd.spin_speed) <= limits.max_spin_wheel_speed + kEps);
-  const double max_steering = mode == MotionMode::kOblique ? limits.max_oblique_steering
-                                                           : limits.max_ackermann_steering;
+  const double max_steering =
+      mode == MotionMode::kOblique ? limits.max_oblique_steering : limits.max_ackermann_steering;
   FUZZ_CHECK(std::abs(cmd.steering_angle) <= max_steering + kEps);
 
   check_encoding(cmd);
@@ -171,8 +175,17 @@ void fuzz_speed_limiter(FuzzedDataProvider& in) {
     const double target = consume_double(in);
     const double dt = consume_double(in);
     const double out = limiter.limit(target, previous, dt);
-    // (Targets near DBL_MAX may legitimately overflow `target - previous`: not a driver input.)
-    if (std::abs(target) < 1e150) FUZZ_CHECK(std::isfinite(out));
+    if (kTrace) {
+      std::fprintf(stderr, "limits v[%g, %g]%s a[%g, %g]%s: limit(%g, %g, %g) = %g\n",
+                   limits.min_velocity, limits.max_velocity,
+                   limits.has_velocity_limits ? "" : " off", limits.min_acceleration,
+                   limits.max_acceleration, limits.has_acceleration_limits ? "" : " off", target,
+                   previous, dt, out);
+    }
+    // Targets near DBL_MAX may legitimately overflow `target - previous` (not a driver input);
+    // such a step ends the sequence.
+    if (std::abs(target) >= 1e150 && !std::isfinite(out)) break;
+    FUZZ_CHECK(std::isfinite(out));
     if (limits.has_velocity_limits) {
       FUZZ_CHECK(out >= limits.min_velocity && out <= limits.max_velocity);
     }
@@ -186,9 +199,15 @@ void fuzz_speed_limiter(FuzzedDataProvider& in) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   FuzzedDataProvider in(data, size);
   switch (in.ConsumeIntegralInRange<int>(0, 2)) {
-    case 0: fuzz_solve(in); break;
-    case 1: fuzz_encode(in); break;
-    default: fuzz_speed_limiter(in); break;
+    case 0:
+      fuzz_solve(in);
+      break;
+    case 1:
+      fuzz_encode(in);
+      break;
+    default:
+      fuzz_speed_limiter(in);
+      break;
   }
   return 0;
 }

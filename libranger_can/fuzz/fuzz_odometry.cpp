@@ -32,8 +32,8 @@ bool finite3(const std::array<double, 3>& a) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   FuzzedDataProvider in(data, size);
   ranger::OdometryConfig config;
-  config.source = in.ConsumeBool() ? ranger::OdometrySource::kWheels
-                                   : ranger::OdometrySource::kMotion;
+  config.source =
+      in.ConsumeBool() ? ranger::OdometrySource::kWheels : ranger::OdometrySource::kMotion;
   ranger::Odometry odometry(config);
 
   std::int64_t stamp = in.ConsumeIntegralInRange<std::int64_t>(-kStampLimit, kStampLimit);
@@ -45,17 +45,28 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         protocol::kMotionModeFeedbackId, protocol::kSystemStatusId};
     f.id = kIds[in.ConsumeIntegralInRange<std::size_t>(0, 4)];
     const int dlc = protocol::expected_dlc(f.id);
-    f.dlc = in.ConsumeIntegralInRange<int>(0, 15) == 0 ? in.ConsumeIntegralInRange<std::uint8_t>(0, 8)
-                                                       : static_cast<std::uint8_t>(dlc);
-    for (std::size_t i = 0; i < f.dlc; ++i) f.data[i] = in.ConsumeIntegral<std::uint8_t>();
+    f.dlc = in.ConsumeIntegralInRange<int>(0, 15) == 0
+                ? in.ConsumeIntegralInRange<std::uint8_t>(0, 8)
+                : static_cast<std::uint8_t>(dlc);
+    for (std::size_t i = 0; i < f.dlc; ++i)
+      f.data[i] = in.ConsumeIntegral<std::uint8_t>();
     if (f.id == protocol::kMotionModeFeedbackId && in.ConsumeBool()) f.data[0] %= 3;
 
     switch (in.ConsumeIntegralInRange<int>(0, 7)) {
-      case 0: break;  // same instant
-      case 1: stamp = in.ConsumeIntegralInRange<std::int64_t>(-kStampLimit, kStampLimit); break;
-      case 2: stamp = 0; break;  // "unknown"
-      case 3: stamp -= in.ConsumeIntegralInRange<std::int64_t>(0, 1000000000); break;
-      default: stamp += in.ConsumeIntegralInRange<std::int64_t>(0, 600000000); break;
+      case 0:
+        break;  // same instant
+      case 1:
+        stamp = in.ConsumeIntegralInRange<std::int64_t>(-kStampLimit, kStampLimit);
+        break;
+      case 2:
+        stamp = 0;
+        break;  // "unknown"
+      case 3:
+        stamp -= in.ConsumeIntegralInRange<std::int64_t>(0, 1000000000);
+        break;
+      default:
+        stamp += in.ConsumeIntegralInRange<std::int64_t>(0, 600000000);
+        break;
     }
     stamp = std::clamp(stamp, -kStampLimit, kStampLimit);
     f.stamp = ranger::Timestamp{stamp};
@@ -64,15 +75,17 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const ranger::OdometryState& s = odometry.state();
     if (kTrace) {  // RANGER_FUZZ_TRACE=1: what happened, for reading a reproducer
       std::fprintf(stderr, "%lld %03X [%d]", static_cast<long long>(stamp), f.id, f.dlc);
-      for (std::size_t i = 0; i < f.dlc; ++i) std::fprintf(stderr, " %02X", f.data[i]);
-      std::fprintf(stderr, " -> twist %g %g %g pose %g %g %g\n", s.twist.vx, s.twist.vy,
-                   s.twist.wz, s.pose.x, s.pose.y, s.pose.yaw);
+      for (std::size_t i = 0; i < f.dlc; ++i)
+        std::fprintf(stderr, " %02X", f.data[i]);
+      std::fprintf(stderr, " -> twist %g %g %g pose %g %g %g\n", s.twist.vx, s.twist.vy, s.twist.wz,
+                   s.pose.x, s.pose.y, s.pose.yaw);
     }
     FUZZ_CHECK(std::isfinite(s.pose.x) && std::isfinite(s.pose.y) && std::isfinite(s.pose.yaw));
     FUZZ_CHECK(s.pose.yaw > -M_PI && s.pose.yaw <= M_PI);
     FUZZ_CHECK(std::isfinite(s.twist.vx) && std::isfinite(s.twist.vy) && std::isfinite(s.twist.wz));
     FUZZ_CHECK(finite3(s.pose_variance) && finite3(s.twist_variance));
-    for (int i = 0; i < 3; ++i) FUZZ_CHECK(s.pose_variance[i] >= previous.pose_variance[i]);
+    for (int i = 0; i < 3; ++i)
+      FUZZ_CHECK(s.pose_variance[i] >= previous.pose_variance[i]);
     FUZZ_CHECK(std::isfinite(s.distance) && s.distance >= previous.distance);
     FUZZ_CHECK(s.steps == previous.steps + (advanced ? 1 : 0));
     previous = s;

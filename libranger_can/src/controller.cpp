@@ -511,7 +511,7 @@ void ChassisController::run_motion(Timestamp now) {
                                limiter_vy_.limit(target.vy, previous.vy, dt),
                                limiter_wz_.limit(target.wz, previous.wz, dt)};
     Result<KinematicsSolution> solution =
-        solve_kinematics(state_.limited, *state_.motion_mode, config_.geometry, config_.limits);
+        selector_.solve(state_.limited, *state_.motion_mode, config_.geometry, config_.limits);
     if (solution) {
       command = solution->command;
       state_.last_solution = *solution;

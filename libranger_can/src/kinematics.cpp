@@ -95,13 +95,21 @@ void solve_ackermann(const BodyTwist& t, const VehicleGeometry& g, const Kinemat
 }
 
 void solve_oblique(const BodyTwist& t, const VehicleGeometry& g, const KinematicsLimits& limits,
-                   KinematicsSolution& s) {
+                   const ObliqueSideHint& hint, KinematicsSolution& s) {
   if (std::fabs(t.wz) > kEps) s.flags |= kRotationDropped;
   double speed = std::hypot(t.vx, t.vy);
   double direction = 0.0;  // REP-103
   if (speed > kEps) {
     direction = std::atan2(t.vy, t.vx);
     if (fold_half_plane(direction)) speed = -speed;  // a backwards crab
+    // Near +-90 deg the two folds are the same wheel line, a hair apart in direction but 180 deg
+    // apart for the wheels: take the hinted side (beyond 90 deg the limit below clamps it).
+    const bool hint_applies = hint.side != 0.0 && hint.band > 0.0 && hint.band < M_PI / 2;
+    if (hint_applies && std::fabs(direction) >= M_PI / 2 - hint.band &&
+        sign(direction) != sign(hint.side)) {
+      direction += sign(hint.side) * M_PI;
+      speed = -speed;
+    }
     const double max_steer = limits.max_oblique_steering;
     if (std::fabs(direction) > max_steer) {
       direction = sign(direction) * max_steer;
@@ -177,7 +185,8 @@ double max_ackermann_curvature(double max_steering, const VehicleGeometry& geome
 
 Result<KinematicsSolution> solve_kinematics(const BodyTwist& twist, MotionMode mode,
                                             const VehicleGeometry& geometry,
-                                            const KinematicsLimits& limits) {
+                                            const KinematicsLimits& limits,
+                                            const ObliqueSideHint& oblique_hint) {
   const struct {
     const char* name;
     double value;
@@ -199,7 +208,7 @@ Result<KinematicsSolution> solve_kinematics(const BodyTwist& twist, MotionMode m
       solve_ackermann(twist, geometry, limits, s);
       break;
     case MotionMode::kOblique:
-      solve_oblique(twist, geometry, limits, s);
+      solve_oblique(twist, geometry, limits, oblique_hint, s);
       break;
     case MotionMode::kSpin:
       solve_spin(twist, geometry, limits, s);
@@ -227,8 +236,8 @@ BodyTwist twist_from_command(const MotionCommand& command, MotionMode mode,
     }
     case MotionMode::kOblique: {
       const double direction = interp::rep103_from_manual_command_steering(command.steering_angle);
-      const double speed = interp::body_speed_from_command_speed(command.linear_speed, 0.0,
-                                                                 geometry.wheelbase, geometry.track);
+      const double speed = interp::body_speed_from_command_speed(
+          command.linear_speed, 0.0, geometry.wheelbase, geometry.track);
       return BodyTwist{speed * std::cos(direction), speed * std::sin(direction), 0.0};
     }
     case MotionMode::kSpin:
@@ -286,6 +295,11 @@ Status ModeSelectorConfig::validate() const {
   if (confirm_time.count() < 0 || min_dwell.count() < 0) {
     return Error{Errc::kOutOfRange, "mode selection: confirm_time and min_dwell must be >= 0"};
   }
+  if (!(oblique_side_band >= 0.0 && oblique_side_band < M_PI / 2)) {
+    return Error{Errc::kOutOfRange,
+                 "mode selection: oblique_side_band = " + std::to_string(oblique_side_band) +
+                     " is not in [0, pi/2) rad"};
+  }
   return ok_status();
 }
 
@@ -336,9 +350,27 @@ MotionMode ModeSelector::select(const BodyTwist& twist, MotionMode current, Time
   return current;
 }
 
+Result<KinematicsSolution> ModeSelector::solve(const BodyTwist& twist, MotionMode mode,
+                                               const VehicleGeometry& geometry,
+                                               const KinematicsLimits& limits) {
+  Result<KinematicsSolution> solution = solve_kinematics(
+      twist, mode, geometry, limits, ObliqueSideHint{oblique_side_, config_.oblique_side_band});
+  if (!solution) return solution;
+  if (solution->mode != MotionMode::kOblique) {
+    oblique_side_ = 0.0;
+  } else if (solution->command.linear_speed != 0.0) {
+    // A stopped command (steering 0) names no side: the previous one is kept.
+    const double steering =
+        interp::rep103_from_manual_command_steering(solution->command.steering_angle);
+    oblique_side_ = steering > 0.0 ? 1.0 : (steering < 0.0 ? -1.0 : 0.0);
+  }
+  return solution;
+}
+
 void ModeSelector::reset() {
   have_current_ = false;
   have_candidate_ = false;
+  oblique_side_ = 0.0;
 }
 
 }  // namespace ranger

@@ -234,8 +234,8 @@ Result<CanFrame> LoopbackBus::receive(std::chrono::nanoseconds timeout) {
   // A poll (timeout <= 0) never touches the condition variable: even an already expired timed
   // wait costs a futex round trip, which dominates lock-step simulations that poll every tick.
   const bool poll = timeout <= std::chrono::nanoseconds::zero();
-  const auto deadline = poll ? std::chrono::steady_clock::time_point{}
-                             : std::chrono::steady_clock::now() + timeout;
+  const auto deadline =
+      poll ? std::chrono::steady_clock::time_point{} : std::chrono::steady_clock::now() + timeout;
   std::unique_lock<std::mutex> lock(wire_->mutex);
   Endpoint& ep = *endpoint_;
   const bool noticed_loss = wire_->refresh(ep);

@@ -104,10 +104,10 @@ BodyTwist twist_from_motion_feedback(const MotionFeedback& feedback, MotionMode 
         // A reported angle of 90 deg or more (a corrupt frame): the limit of the formula below
         // as k grows, a rotation about the body centre at the wheels' speed; inf * 0 would make
         // the twist NaN.
-        return BodyTwist{0.0, 0.0,
-                         std::copysign(1.0, k) *
-                             interp::spin_yaw_rate_from_feedback_speed(
-                                 feedback.speed, geometry.wheelbase, geometry.track)};
+        return BodyTwist{
+            0.0, 0.0,
+            std::copysign(1.0, k) * interp::spin_yaw_rate_from_feedback_speed(
+                                        feedback.speed, geometry.wheelbase, geometry.track)};
       }
       const double vx = interp::ackermann_body_speed_from_feedback_speed(
           feedback.speed, k, geometry.wheelbase, geometry.track);

@@ -578,9 +578,8 @@ Message VirtualChassis::motion_feedback() const {
       fb.steering_angle = interpretation::manual_from_rep103_steering(mean_front);
       const double curvature = interpretation::ackermann_curvature_from_mean_angle(
           motion_.steering(), g.wheelbase, g.track);
-      fb.speed = interpretation::ackermann_feedback_speed_from_body_speed(motion_.twist().vx,
-                                                                          curvature, g.wheelbase,
-                                                                          g.track);
+      fb.speed = interpretation::ackermann_feedback_speed_from_body_speed(
+          motion_.twist().vx, curvature, g.wheelbase, g.track);
       break;
     }
     case MotionMode::kOblique: {
@@ -596,8 +595,8 @@ Message VirtualChassis::motion_feedback() const {
       // Spin: the fixed angle (mean of |angles|) and (point 9) the signed tangential speed.
       for (const auto& s : w)
         fb.steering_angle += std::abs(s.angle) / kWheelCount;
-      fb.speed = interpretation::spin_feedback_speed_from_yaw_rate(motion_.twist().wz,
-                                                                   g.wheelbase, g.track);
+      fb.speed = interpretation::spin_feedback_speed_from_yaw_rate(motion_.twist().wz, g.wheelbase,
+                                                                   g.track);
       break;
     }
   }

@@ -14,6 +14,7 @@
 
 #include "cli_commands.hpp"
 #include "cli_json.hpp"
+#include "support/cli_run.hpp"
 
 namespace ranger::cli {
 namespace {
@@ -34,24 +35,11 @@ std::string read_file(const std::string& path) {
   return s.str();
 }
 
-std::vector<std::string> lines_of(const std::string& text) {
-  std::vector<std::string> lines;
-  std::istringstream in(text);
-  for (std::string l; std::getline(in, l);)
-    lines.push_back(l);
-  return lines;
-}
-
-struct Outcome {
-  int rc;
-  std::string out, err;
-};
+using Outcome = test::CliOutcome;
+using test::lines_of;
 
 Outcome run(const Args& args, const std::string& input = "") {
-  std::istringstream in(input);
-  std::ostringstream out, err;
-  const int rc = run_decode(args, Io{in, out, err});
-  return {rc, out.str(), err.str()};
+  return test::run_cli(run_decode, args, input);
 }
 
 // A strict JSON (RFC 8259) recogniser: enough to prove every output line parses.

@@ -7,12 +7,12 @@
 #include <cstdio>
 #include <fstream>
 #include <regex>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include "cli_commands.hpp"
 #include "ranger_can/candump_log.hpp"
+#include "support/cli_run.hpp"
 #include "support/synthetic_feedback.hpp"
 
 namespace ranger::cli {
@@ -21,24 +21,11 @@ namespace {
 using namespace std::chrono_literals;
 using protocol::MotionMode;
 
-struct Outcome {
-  int rc;
-  std::string out, err;
-};
+using Outcome = test::CliOutcome;
+using test::lines_of;
 
 Outcome run(const Args& args, const std::string& input = "") {
-  std::istringstream in(input);
-  std::ostringstream out, err;
-  const int rc = run_odom(args, Io{in, out, err});
-  return {rc, out.str(), err.str()};
-}
-
-std::vector<std::string> lines_of(const std::string& text) {
-  std::vector<std::string> lines;
-  std::istringstream in(text);
-  for (std::string l; std::getline(in, l);)
-    lines.push_back(l);
-  return lines;
+  return test::run_cli(run_odom, args, input);
 }
 
 struct FinalPose {
@@ -151,6 +138,9 @@ TEST(CliOdom, UsageErrorsAndHelp) {
   const Outcome missing = run({"/nonexistent/ranger.log"});
   EXPECT_EQ(missing.rc, 1);
   EXPECT_NE(missing.err.find("cannot open"), std::string::npos);
+  const Outcome directory = run({RANGER_DATA_DIR});  // a read error, reported, never thrown
+  EXPECT_EQ(directory.rc, 1);
+  EXPECT_NE(directory.err.find("is a directory"), std::string::npos) << directory.err;
 }
 
 TEST(CliOdom, BadLinesAreReportedAndLogsWithoutTimestampsFail) {

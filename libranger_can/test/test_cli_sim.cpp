@@ -10,7 +10,6 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
-#include <sstream>
 #include <string>
 #include <thread>
 
@@ -22,6 +21,7 @@
 #include "ranger_can/interpretation.hpp"
 #include "ranger_can/loopback_bus.hpp"
 #include "ranger_can/virtual_chassis.hpp"
+#include "support/cli_run.hpp"
 #include "support/fake_bus.hpp"
 
 namespace ranger::cli {
@@ -29,16 +29,10 @@ namespace {
 
 using namespace std::chrono_literals;
 
-struct CliRun {
-  int code;
-  std::string out, err;
-};
+using CliRun = test::CliOutcome;
 
-CliRun run(int (*command)(const Args&, Io), const Args& args, const std::string& input = "") {
-  std::istringstream in(input);
-  std::ostringstream out, err;
-  const int code = command(args, Io{in, out, err});
-  return {code, out.str(), err.str()};
+CliRun run(test::CliCommand command, const Args& args, const std::string& input = "") {
+  return test::run_cli(command, args, input);
 }
 
 bool contains(const std::string& hay, const std::string& needle) {
@@ -67,21 +61,21 @@ TEST(CliSim, BadArgumentsAreUsageErrorsNamingTheArgument) {
   };
   for (const auto& c : cases) {
     const CliRun r = run(run_sim, c.args);
-    EXPECT_EQ(r.code, 2) << c.mentions;
+    EXPECT_EQ(r.rc, 2) << c.mentions;
     EXPECT_TRUE(contains(r.err, c.mentions)) << r.err;
   }
-  EXPECT_EQ(run(run_sim, {"--help"}).code, 0);
+  EXPECT_EQ(run(run_sim, {"--help"}).rc, 0);
   EXPECT_TRUE(contains(run(run_sim, {"--help"}).out, "estop on|off"));
 }
 
 TEST(CliMonitor, BadArgumentsAreUsageErrors) {
-  EXPECT_EQ(run(run_monitor, {}).code, 2);
+  EXPECT_EQ(run(run_monitor, {}).rc, 2);
   const CliRun r = run(run_monitor, {"vcan0", "--rate", "0"});
-  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.rc, 2);
   EXPECT_TRUE(contains(r.err, "--rate")) << r.err;
-  EXPECT_EQ(run(run_monitor, {"vcan0", "--count", "x"}).code, 2);
-  EXPECT_EQ(run(run_monitor, {"vcan0", "--bogus"}).code, 2);
-  EXPECT_EQ(run(run_monitor, {"--help"}).code, 0);
+  EXPECT_EQ(run(run_monitor, {"vcan0", "--count", "x"}).rc, 2);
+  EXPECT_EQ(run(run_monitor, {"vcan0", "--bogus"}).rc, 2);
+  EXPECT_EQ(run(run_monitor, {"--help"}).rc, 0);
 }
 
 TEST(CliSend, BadArgumentsAreUsageErrorsNamingTheArgument) {
@@ -107,7 +101,7 @@ TEST(CliSend, BadArgumentsAreUsageErrorsNamingTheArgument) {
   };
   for (const auto& c : cases) {
     const CliRun r = run(run_send, c.args);
-    EXPECT_EQ(r.code, 2) << c.mentions;
+    EXPECT_EQ(r.rc, 2) << c.mentions;
     EXPECT_TRUE(contains(r.err, c.mentions)) << r.err;
   }
 }
@@ -135,14 +129,14 @@ TEST(CliSend, DryRunPrintsTheExactFrame) {
   };
   for (const auto& c : cases) {
     const CliRun r = run(run_send, c.args);
-    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(r.rc, 0) << r.err;
     EXPECT_TRUE(contains(r.out, c.frame)) << r.out << " expected " << c.frame;
   }
 }
 
 TEST(CliSend, UnreachableInterfaceIsARuntimeFailure) {
   const CliRun r = run(run_send, {"ranger_no_such_if0", "control", "can"});
-  EXPECT_EQ(r.code, 1);
+  EXPECT_EQ(r.rc, 1);
   EXPECT_TRUE(contains(r.err, "ranger_no_such_if0")) << r.err;
 }
 
@@ -312,7 +306,7 @@ TEST(CliSession, SimSendAndMonitorWorkTogetherOnALoopbackInterface) {
   ASSERT_GT(network->endpoint_count(), 0u);
 
   const CliRun sent = run(run_send, {"vsim_cli0", "control", "can"});
-  EXPECT_EQ(sent.code, 0) << sent.err;
+  EXPECT_EQ(sent.rc, 0) << sent.err;
   EXPECT_TRUE(contains(sent.out, "vsim_cli0 421#01")) << sent.out;
 
   // The monitor sees the chassis in CAN mode (retrying while the change propagates); a 1 s
@@ -320,7 +314,7 @@ TEST(CliSession, SimSendAndMonitorWorkTogetherOnALoopbackInterface) {
   std::string json;
   for (int attempt = 0; attempt < 20; ++attempt) {
     const CliRun mon = run(run_monitor, {"vsim_cli0", "--once", "--window", "1.0", "--json"});
-    ASSERT_EQ(mon.code, 0) << mon.err;
+    ASSERT_EQ(mon.rc, 0) << mon.err;
     json = mon.out;
     if (contains(json, "\"control_mode\":\"can\"")) break;
   }
@@ -333,7 +327,7 @@ TEST(CliSession, SimSendAndMonitorWorkTogetherOnALoopbackInterface) {
     control << "quit\n";
   }
   sim.join();
-  EXPECT_EQ(sim_run.code, 0) << sim_run.err;
+  EXPECT_EQ(sim_run.rc, 0) << sim_run.err;
   EXPECT_TRUE(contains(sim_run.out, "control mode standby -> can (0x421)")) << sim_run.out;
   EXPECT_TRUE(contains(sim_run.out, "stopped;")) << sim_run.out;
 

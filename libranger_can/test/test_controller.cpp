@@ -14,6 +14,7 @@
 
 #include "ranger_can/codec.hpp"
 #include "ranger_can/controller.hpp"
+#include "ranger_can/interpretation.hpp"
 #include "ranger_can/protocol.hpp"
 #include "support/fake_bus.hpp"
 
@@ -542,6 +543,29 @@ TEST(ControllerModeSwitch, ForcedModeAndRetryThenReportWhenNeverConfirmed) {
   rig.run(40ms);
   EXPECT_FALSE(rig.state().mode_switch_failed);
   EXPECT_TRUE(is_moving(rig.motion_frames().back()));
+}
+
+TEST(ControllerModeSwitch, ObliqueCrabWithNoisyVxNeverSwingsTheWheels) {
+  Rig rig;
+  rig.connect_in_can_mode(MotionMode::kOblique);
+  MotionRequest req;
+  req.mode = MotionMode::kOblique;
+  for (int i = 0; i < 20; ++i) {
+    req.twist = {i % 2 == 0 ? 1e-3 : -1e-3, 0.5, 0};  // sideways to the left, noisy vx
+    ASSERT_TRUE(rig.ctl->set_command(req, rig.now).ok());
+    rig.run(20ms);
+  }
+  int moving = 0;
+  for (const CanFrame& f : rig.motion_frames()) {
+    const MotionCommand c = motion_of(f);
+    if (c.linear_speed == 0.0) continue;
+    ++moving;
+    // One wheel line throughout: about 90 deg left, driven forwards.
+    EXPECT_GT(interpretation::rep103_from_manual_command_steering(c.steering_angle),
+              89.0 * M_PI / 180.0);
+    EXPECT_GT(c.linear_speed, 0.0);
+  }
+  EXPECT_GE(moving, 15);
 }
 
 TEST(ControllerModeSwitch, ChassisReportedSwitchingRefusesMotion) {

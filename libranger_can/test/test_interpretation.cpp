@@ -117,8 +117,8 @@ TEST(Interpretation, AckermannFeedbackSpeedIsTheMeanWheelSpeed) {
   EXPECT_NEAR(ackermann_body_speed_from_feedback_speed(-mean, -k, kL, kW), -vx, 1e-15);
   EXPECT_EQ(ackermann_mean_wheel_speed_factor(0.0, kL, kW), 1.0);  // straight: all alike
   // A corrupt 90-degree angle (infinite curvature) leaves the body centre at rest, never NaN.
-  EXPECT_EQ(ackermann_body_speed_from_feedback_speed(
-                0.5, std::numeric_limits<double>::infinity(), kL, kW),
+  EXPECT_EQ(ackermann_body_speed_from_feedback_speed(0.5, std::numeric_limits<double>::infinity(),
+                                                     kL, kW),
             0.0);
 }
 

@@ -367,6 +367,88 @@ TEST(ModeSelector, ConfigValidation) {
   EXPECT_TRUE(c.validate().ok());
   c.lateral_exit = 0.1;  // exit above enter: no hysteresis
   EXPECT_FALSE(c.validate().ok());
+  ModeSelectorConfig band;
+  band.oblique_side_band = M_PI / 2;  // would reach straight ahead
+  EXPECT_FALSE(band.validate().ok());
+  band.oblique_side_band = std::nan("");
+  EXPECT_FALSE(band.validate().ok());
+}
+
+// ---- Oblique side hysteresis near +-90 deg ---------------------------------------------------
+
+double rep103_steering(const KinematicsSolution& s) {
+  return interp::rep103_from_manual_command_steering(s.command.steering_angle);
+}
+
+KinematicsSolution solve_with(ModeSelector& selector, BodyTwist t) {
+  Result<KinematicsSolution> r =
+      selector.solve(t, MotionMode::kOblique, VehicleGeometry{}, KinematicsLimits{});
+  EXPECT_TRUE(r.ok()) << (r.ok() ? "" : r.error().message);
+  return r.ok() ? *r : KinematicsSolution{};
+}
+
+TEST(KinematicsOblique, PureSolutionFlipsTheWheelsOnNoisyVx) {
+  // The problem the hysteresis solves: stateless, the sign of a 1 mm/s vx swings the wheels.
+  EXPECT_GT(rep103_steering(solve({1e-3, 0.5, 0}, MotionMode::kOblique)), 89 * kDeg);
+  EXPECT_LT(rep103_steering(solve({-1e-3, 0.5, 0}, MotionMode::kOblique)), -89 * kDeg);
+}
+
+TEST(KinematicsOblique, SideHintKeepsTheWheelLineWithTheSpeedNegated) {
+  const Result<KinematicsSolution> r =
+      solve_kinematics({-1e-3, 0.5, 0}, MotionMode::kOblique, VehicleGeometry{}, KinematicsLimits{},
+                       ObliqueSideHint{+1.0, 5 * kDeg});
+  ASSERT_TRUE(r.ok());
+  EXPECT_NEAR(rep103_steering(*r), 90 * kDeg, kTol);  // 90.1 deg, clamped to the limit
+  EXPECT_NEAR(r->command.linear_speed, std::hypot(1e-3, 0.5), kTol);
+  EXPECT_TRUE(r->flags & kSteeringSaturated);
+  EXPECT_NEAR(r->achieved.vy, 0.5, 1e-5);  // still moving left
+}
+
+TEST(ModeSelector, ObliqueNoiseAroundNinetyDegreesDoesNotSwingTheWheels) {
+  ModeSelector selector;
+  const double first = rep103_steering(solve_with(selector, {1e-3, 0.5, 0}));
+  ASSERT_GT(first, 89 * kDeg);
+  for (int i = 0; i < 20; ++i) {
+    const double vx = i % 2 == 0 ? -1e-3 : 1e-3;
+    const KinematicsSolution s = solve_with(selector, {vx, 0.5, 0});
+    SCOPED_TRACE(i);
+    EXPECT_GT(rep103_steering(s), 89 * kDeg);  // never flips to about -90 deg
+    EXPECT_GT(s.command.linear_speed, 0.0);
+    EXPECT_NEAR(s.achieved.vy, 0.5, 1e-5);
+  }
+  // Reversing to the right inside the band: same wheel line, negative speed.
+  const KinematicsSolution right = solve_with(selector, {1e-3, -0.5, 0});
+  EXPECT_GT(rep103_steering(right), 89 * kDeg);
+  EXPECT_LT(right.command.linear_speed, 0.0);
+  EXPECT_NEAR(right.achieved.vy, -0.5, 1e-5);
+}
+
+TEST(ModeSelector, ObliqueDirectionChangeBeyondTheBandFlips) {
+  ModeSelector selector;
+  ASSERT_GT(rep103_steering(solve_with(selector, {1e-3, 0.5, 0})), 89 * kDeg);
+  // 80 deg to the right of forward: outside the 5 deg band, the pure solution wins.
+  const KinematicsSolution s =
+      solve_with(selector, {0.5 * std::cos(-80 * kDeg), 0.5 * std::sin(-80 * kDeg), 0});
+  EXPECT_NEAR(rep103_steering(s), -80 * kDeg, kTol);
+  EXPECT_GT(s.command.linear_speed, 0.0);
+  // ...and that is now the side the band keeps.
+  EXPECT_LT(rep103_steering(solve_with(selector, {-1e-3, 0.5, 0})), -89 * kDeg);
+}
+
+TEST(ModeSelector, ObliqueSideIsForgottenOnResetAndInOtherModes) {
+  ModeSelector selector;
+  solve_with(selector, {1e-3, 0.5, 0});
+  selector.reset();
+  EXPECT_LT(rep103_steering(solve_with(selector, {-1e-3, 0.5, 0})), -89 * kDeg);
+  ASSERT_TRUE(
+      selector.solve({0.5, 0, 0}, MotionMode::kAckermann, VehicleGeometry{}, KinematicsLimits{}));
+  EXPECT_GT(rep103_steering(solve_with(selector, {1e-3, 0.5, 0})), 89 * kDeg);
+  // A zero band is the pure function.
+  ModeSelectorConfig off;
+  off.oblique_side_band = 0.0;
+  ModeSelector pure(off);
+  solve_with(pure, {1e-3, 0.5, 0});
+  EXPECT_LT(rep103_steering(solve_with(pure, {-1e-3, 0.5, 0})), -89 * kDeg);
 }
 
 }  // namespace

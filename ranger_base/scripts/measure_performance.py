@@ -131,11 +131,11 @@ def wait_for_command_mode(rospy, ns):
         sys.exit("the node did not reach CAN command mode")
 
 
-def measure_load(rospy, duration):
+def measure_load(rospy, duration, extra_args=()):
     from diagnostic_msgs.msg import DiagnosticArray
     from geometry_msgs.msg import Twist
     ns = "perf_load"
-    node = start_node("ranger_base_node", f"__ns:=/{ns}", "_publish_rate:=50")
+    node = start_node("ranger_base_node", f"__ns:=/{ns}", "_publish_rate:=50", *extra_args)
     try:
         wait_for_command_mode(rospy, ns)
         pub = rospy.Publisher(f"/{ns}/cmd_vel", Twist, queue_size=1)
@@ -256,6 +256,9 @@ def main():
     parser.add_argument("--duration", type=float, default=30.0, help="load phase, s")
     parser.add_argument("--samples", type=int, default=400, help="latency samples")
     parser.add_argument("--json", help="also write the figures to this file")
+    parser.add_argument("--node-arg", action="append", default=[],
+                        help="extra node argument for the load phase, e.g. _publish_rate:=10")
+    parser.add_argument("--skip-latency", action="store_true")
     args = parser.parse_args()
 
     env = Environment()
@@ -266,8 +269,9 @@ def main():
         figures = {"machine": machine(),
                    "command": " ".join([os.path.relpath(sys.argv[0])] + sys.argv[1:]),
                    "mode": "port_name:=sim (in-process virtual chassis, loopback bus)",
-                   "load": measure_load(rospy, args.duration),
-                   "latency_cmd_vel_to_0x111": measure_latency(rospy, args.samples)}
+                   "load": measure_load(rospy, args.duration, args.node_arg)}
+        if not args.skip_latency:
+            figures["latency_cmd_vel_to_0x111"] = measure_latency(rospy, args.samples)
     finally:
         env.close()
 

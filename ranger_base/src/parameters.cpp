@@ -259,6 +259,8 @@ NodeParameters read_all(Reader& r) {
   c.cmd_timeout = r.seconds("cmd_vel_timeout", c.cmd_timeout, closed(0.02, 60.0));
   c.auto_command_mode = r.flag("auto_command_mode", c.auto_command_mode);
   c.link_timeout = r.seconds("link_timeout", c.link_timeout, closed(0.02, 10.0));
+  c.min_command_interval =
+      r.seconds("min_command_interval", c.min_command_interval, closed(0.001, 0.02));
   c.mode_switch_timeout =
       r.seconds("mode_switch_timeout", c.mode_switch_timeout, closed(0.1, 30.0));
   c.mode_switch_max_attempts =
@@ -282,12 +284,12 @@ NodeParameters read_all(Reader& r) {
       r.number("max_linear_speed", k.max_linear_speed, open_closed(0.0, vmax), "m/s");
   k.max_speed_at_large_steering = r.number(
       "max_speed_at_large_steering", k.max_speed_at_large_steering, open_closed(0.0, vmax), "m/s");
-  k.max_ackermann_steering = r.number("max_ackermann_steering", k.max_ackermann_steering,
-                                      open_closed(0.0, ranger::kMaxAckermannSteeringRad),
-                                      "rad (40 deg)");
-  k.max_oblique_steering = r.number("max_oblique_steering", k.max_oblique_steering,
-                                    open_closed(0.0, ranger::kMaxObliqueSteeringRad),
-                                    "rad (90 deg)");
+  k.max_ackermann_steering =
+      r.number("max_ackermann_steering", k.max_ackermann_steering,
+               open_closed(0.0, ranger::kMaxAckermannSteeringRad), "rad (40 deg)");
+  k.max_oblique_steering =
+      r.number("max_oblique_steering", k.max_oblique_steering,
+               open_closed(0.0, ranger::kMaxObliqueSteeringRad), "rad (90 deg)");
   k.max_spin_wheel_speed = r.number("max_spin_wheel_speed", k.max_spin_wheel_speed,
                                     open_closed(0.0, ranger::kMaxSpinSpeedMps), "m/s");
 
@@ -309,6 +311,9 @@ NodeParameters read_all(Reader& r) {
       r.number("mode_selection/rotation_exit", m.rotation_exit, closed(0.0, 10.0), "rad/s");
   m.confirm_time = r.seconds("mode_selection/confirm_time", m.confirm_time, closed(0.0, 10.0));
   m.min_dwell = r.seconds("mode_selection/min_dwell", m.min_dwell, closed(0.0, 60.0));
+  m.oblique_side_band =
+      r.number("mode_selection/oblique_side_band", m.oblique_side_band,
+               Interval{0.0, ranger::kMaxObliqueSteeringRad, false, true}, "rad (< 90 deg)");
 
   // ---- odometry
   const std::string source = r.text("odometry_source", "wheels");

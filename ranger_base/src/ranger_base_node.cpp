@@ -48,7 +48,7 @@ int main(int argc, char** argv) {
   {
     ranger_base::RangerNode node(nh, private_nh, std::move(*params));
     node.start();
-    ros::WallRate idle(50.0);
+    ros::WallRate idle(20.0);  // how often a signal or ros::ok() is looked at
     while (ros::ok() && g_signal == 0)
       idle.sleep();
     if (g_signal != 0) ROS_INFO("signal %d: stopping the chassis", static_cast<int>(g_signal));

@@ -9,8 +9,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cmath>
 #include <chrono>
+#include <cmath>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -43,7 +43,7 @@ class LoopbackFaultRig {
         chassis_(*chassis_bus_, chassis_config, clock_.now()),
         controller_(std::make_unique<ChassisController>(*driver_bus_, controller_config)),
         audit_(controller_config) {
-    observer_bus_->set_filter({});   // the observer hears every ID
+    observer_bus_->set_filter({});    // the observer hears every ID
     noise_bus_->set_filter({0x7FE});  // the noise source listens to nothing anyone sends
   }
   // The controller sends its stop when destroyed: it goes first, while its bus exists.
@@ -76,7 +76,8 @@ class LoopbackFaultRig {
   }
   void run_for(std::chrono::nanoseconds d) {
     const Timestamp end = now() + d;
-    while (now() < end) step();
+    while (now() < end)
+      step();
   }
   // Steps until `done()` holds (true) or `timeout` passed (false).
   bool run_until(const std::function<bool()>& done, std::chrono::nanoseconds timeout) {

@@ -49,13 +49,13 @@ bool host_id(std::uint32_t id) {
 class Faults : public ::testing::Test {
  protected:
   void TearDown() override {
-    for (const std::string& v : rig_.audit().violations()) ADD_FAILURE() << "wire audit: " << v;
+    for (const std::string& v : rig_.audit().violations())
+      ADD_FAILURE() << "wire audit: " << v;
   }
   std::uint64_t host_frames_on_wire(Timestamp from) const {
-    return static_cast<std::uint64_t>(
-        std::count_if(rig_.trace().begin(), rig_.trace().end(), [&](const CanFrame& f) {
-          return !f.is_error && f.stamp >= from && host_id(f.id);
-        }));
+    return static_cast<std::uint64_t>(std::count_if(
+        rig_.trace().begin(), rig_.trace().end(),
+        [&](const CanFrame& f) { return !f.is_error && f.stamp >= from && host_id(f.id); }));
   }
 
   LoopbackFaultRig rig_;
@@ -193,8 +193,8 @@ TEST_F(Faults, ChassisSilentForOneSecondIsDetectedAfterLinkTimeoutAndResumesWith
   ASSERT_TRUE(rig_.drive({0.6, 0, 0}, 0.6));
   const Timestamp t0 = rig_.now();
   rig_.chassis().silence_for(1s);
-  ASSERT_TRUE(rig_.run_until([&] { return rig_.state().refusal == MotionRefusal::kLinkLost; },
-                             500ms));
+  ASSERT_TRUE(
+      rig_.run_until([&] { return rig_.state().refusal == MotionRefusal::kLinkLost; }, 500ms));
   const auto statuses = rig_.wire(protocol::kSystemStatusId, t0 - 100ms, t0 + 1ms);
   ASSERT_FALSE(statuses.empty());
   const auto detected_after = rig_.now() - statuses.back().stamp;
@@ -209,7 +209,8 @@ TEST_F(Faults, ChassisSilentForOneSecondIsDetectedAfterLinkTimeoutAndResumesWith
   // declared the host lost.
   const auto commands = rig_.wire(protocol::kMotionCommandId, t_detect + 6ms, rig_.now());
   EXPECT_GE(commands.size(), 40u);
-  for (const CanFrame& f : commands) EXPECT_EQ(motion_of(f).linear_speed, 0.0);
+  for (const CanFrame& f : commands)
+    EXPECT_EQ(motion_of(f).linear_speed, 0.0);
   EXPECT_EQ(rig_.snapshot().speed, 0.0);
   EXPECT_FALSE(rig_.snapshot().host_link_lost);
 
@@ -238,7 +239,9 @@ struct RefusingFault {
   bool host_silent;                     // no host frames at all while it lasts (remote control)
 };
 
-std::ostream& operator<<(std::ostream& os, const RefusingFault& f) { return os << f.name; }
+std::ostream& operator<<(std::ostream& os, const RefusingFault& f) {
+  return os << f.name;
+}
 
 class RefusingFaults : public Faults, public ::testing::WithParamInterface<RefusingFault> {};
 
@@ -266,8 +269,8 @@ TEST_P(RefusingFaults, StopsMotionOnTheWireAtOnceAndResumesWhenCleared) {
     EXPECT_TRUE(rig_.wire(protocol::kControlModeCommandId, t_detect).empty());
   } else {
     ASSERT_FALSE(after.empty());
-    EXPECT_LE(after.front().stamp - t_detect, rig_.controller().config().min_command_interval +
-                                                  LoopbackFaultRig::kStep);
+    EXPECT_LE(after.front().stamp - t_detect,
+              rig_.controller().config().min_command_interval + LoopbackFaultRig::kStep);
     for (const CanFrame& f : after) {
       EXPECT_EQ(motion_of(f).linear_speed, 0.0);
       EXPECT_EQ(motion_of(f).spin_speed, 0.0);
@@ -362,9 +365,10 @@ TEST_F(Faults, ErrorBitsSetAndClearedByTheChassisAreReportedAndOnlyCriticalOnesS
   // Two critical bits at once, cleared one after the other: motion resumes only after both.
   const int over_current = protocol::error_bit_index(6, 7);
   rig_.chassis().set_error_bits((1u << kSafetyEdge) | (1u << over_current));
-  ASSERT_TRUE(rig_.run_until(
-      [&] { return rig_.state().refusal == MotionRefusal::kCriticalError; }, 40ms));
-  for (const std::string& name : protocol::error_bit_names((1u << kSafetyEdge) | (1u << over_current))) {
+  ASSERT_TRUE(
+      rig_.run_until([&] { return rig_.state().refusal == MotionRefusal::kCriticalError; }, 40ms));
+  for (const std::string& name :
+       protocol::error_bit_names((1u << kSafetyEdge) | (1u << over_current))) {
     EXPECT_TRUE(has_fault(rig_.state(), name)) << name;
   }
   rig_.run_for(1s);
@@ -418,8 +422,8 @@ TEST_F(Faults, NonFiniteCommandsAreRefusedAndStopTheVehicleOnTheNextFrame) {
     rig_.run_for(10ms);
     const auto next = rig_.wire(protocol::kMotionCommandId, t_bad);
     ASSERT_FALSE(next.empty());
-    EXPECT_LE(next.front().stamp - t_bad, rig_.controller().config().min_command_interval +
-                                              LoopbackFaultRig::kStep);
+    EXPECT_LE(next.front().stamp - t_bad,
+              rig_.controller().config().min_command_interval + LoopbackFaultRig::kStep);
     EXPECT_EQ(motion_of(next.front()).linear_speed, 0.0);
     ASSERT_TRUE(rig_.run_until([&] { return rig_.snapshot().speed == 0.0; }, 2s));
     const ControllerState& s = rig_.state();
@@ -509,7 +513,8 @@ TEST_F(Faults, KilledDriverChassisStopsWithinFiveHundredMillisecondsOfTheLastCom
   for (const CanFrame& f : feedback) {
     const double v = speed_of_0x221(f);
     if (f.stamp < t_last + watchdog) {
-      EXPECT_EQ(v, 1.0) << "slower before the watchdog, at +" << (f.stamp - t_last).count() << " ns";
+      EXPECT_EQ(v, 1.0) << "slower before the watchdog, at +" << (f.stamp - t_last).count()
+                        << " ns";
     }
     if (first_slower.count() == 0 && v < 1.0) first_slower = f.stamp;
     if (first_stopped.count() == 0 && v == 0.0) first_stopped = f.stamp;

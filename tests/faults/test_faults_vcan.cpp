@@ -16,6 +16,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <fcntl.h>
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
@@ -23,7 +24,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <fcntl.h>
 #include <functional>
 #include <memory>
 #include <string>
@@ -50,7 +50,9 @@ std::string interface_name() {
   return env && *env ? env : "vcan0";
 }
 
-std::string errno_text() { return std::system_category().message(errno); }
+std::string errno_text() {
+  return std::system_category().message(errno);
+}
 
 // Writes an error frame onto the interface through a raw socket, as a CAN controller reports one.
 void write_error_frame(const CanFrame& f) {
@@ -68,7 +70,8 @@ void write_error_frame(const CanFrame& f) {
   ASSERT_TRUE(ok) << "cannot write an error frame to " << interface_name() << ": " << why;
 }
 
-std::unique_ptr<SocketCanBus> open_or_fail(std::vector<std::uint32_t> filter = protocol::all_ids()) {
+std::unique_ptr<SocketCanBus> open_or_fail(
+    std::vector<std::uint32_t> filter = protocol::all_ids()) {
   SocketCanOptions o;
   o.filter = std::move(filter);
   auto bus = SocketCanBus::open(interface_name(), o);
@@ -119,8 +122,8 @@ class VcanFaultRig {
 
   bool run_until(const std::function<bool()>& done, std::chrono::nanoseconds timeout) {
     if (!runner_) return false;
-    const Timestamp end = clock_.now() + std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                             timeout * kTimingSlack);
+    const Timestamp end =
+        clock_.now() + std::chrono::duration_cast<std::chrono::nanoseconds>(timeout * kTimingSlack);
     while (clock_.now() < end) {
       step();
       EXPECT_TRUE(runner_->running()) << runner_->failure();
@@ -130,7 +133,8 @@ class VcanFaultRig {
   }
   void run_for(std::chrono::nanoseconds d) {
     const Timestamp end = clock_.now() + d;
-    while (clock_.now() < end) step();
+    while (clock_.now() < end)
+      step();
   }
   void command(const BodyTwist& twist) {
     request_ = twist;
@@ -145,7 +149,8 @@ class VcanFaultRig {
       status = std::system(shell_command.c_str());
       done = true;
     });
-    while (!done) step();
+    while (!done)
+      step();
     t.join();
     if (status != 0) {
       ADD_FAILURE() << "`" << shell_command << "` failed (status " << status
@@ -170,8 +175,8 @@ class VcanFaultRig {
     if (run_until([&] { return snapshot().speed >= min_speed; }, 10s)) {
       return ::testing::AssertionSuccess();
     }
-    return ::testing::AssertionFailure() << "chassis at " << snapshot().speed << " m/s; refusal "
-                                         << to_string(state().refusal);
+    return ::testing::AssertionFailure()
+           << "chassis at " << snapshot().speed << " m/s; refusal " << to_string(state().refusal);
   }
 
  private:
@@ -206,7 +211,8 @@ class VcanFaultRig {
 class VcanFaults : public ::testing::Test {
  protected:
   void TearDown() override {
-    for (const std::string& v : rig_.audit().violations()) ADD_FAILURE() << "wire audit: " << v;
+    for (const std::string& v : rig_.audit().violations())
+      ADD_FAILURE() << "wire audit: " << v;
   }
   InterfaceGuard guard_;
   VcanFaultRig rig_;
@@ -218,8 +224,8 @@ TEST_F(VcanFaults, BusOffFromAnErrorFrameStopsTheChassisAndRestartResumes) {
 
   // The controller reports bus-off; then nothing is acknowledged (a plug qdisc holds every frame).
   write_error_frame(can_error::make(can_error::kBusOff));
-  ASSERT_TRUE(rig_.run_until(
-      [&] { return rig_.driver_bus().status().state == BusState::kBusOff; }, 2s));
+  ASSERT_TRUE(
+      rig_.run_until([&] { return rig_.driver_bus().status().state == BusState::kBusOff; }, 2s));
   ASSERT_TRUE(rig_.run("tc qdisc add dev " + interface_name() + " root plug limit 512"));
   ASSERT_TRUE(rig_.run_until([&] { return rig_.state().refusal == MotionRefusal::kLinkLost; }, 2s));
   ASSERT_TRUE(rig_.run_until([&] { return rig_.snapshot().speed == 0.0; }, 3s))
@@ -229,12 +235,13 @@ TEST_F(VcanFaults, BusOffFromAnErrorFrameStopsTheChassisAndRestartResumes) {
   // Restart: the queue drains, traffic flows again, the controller reports error-active again
   // (the restart report is written once frames flow: right after the qdisc is removed the kernel
   // may still drop a frame), motion resumes.
-  ASSERT_TRUE(rig_.run("tc qdisc change dev " + interface_name() + " root plug release_indefinite"));
+  ASSERT_TRUE(
+      rig_.run("tc qdisc change dev " + interface_name() + " root plug release_indefinite"));
   ASSERT_TRUE(rig_.run("tc qdisc del dev " + interface_name() + " root"));
   ASSERT_TRUE(rig_.run_until([&] { return rig_.state().link == LinkState::kConnected; }, 3s));
   write_error_frame(can_error::make(can_error::kRestarted));
-  ASSERT_TRUE(rig_.run_until(
-      [&] { return rig_.driver_bus().status().state == BusState::kActive; }, 2s))
+  ASSERT_TRUE(
+      rig_.run_until([&] { return rig_.driver_bus().status().state == BusState::kActive; }, 2s))
       << "bus " << to_string(rig_.driver_bus().status().state) << " ("
       << rig_.driver_bus().status().detail << ")";
   ASSERT_TRUE(rig_.run_until([&] { return rig_.snapshot().speed >= 0.45; }, 5s))
@@ -263,9 +270,7 @@ TEST_F(VcanFaults, InterfaceDownAndUpStopsTheChassisThenReopensAndResumes) {
 
   ASSERT_TRUE(rig_.run("ip link set dev " + interface_name() + " up"));
   ASSERT_TRUE(rig_.run_until(
-      [&] {
-        return rig_.state().link == LinkState::kConnected && rig_.snapshot().speed >= 0.45;
-      },
+      [&] { return rig_.state().link == LinkState::kConnected && rig_.snapshot().speed >= 0.45; },
       5s))
       << "refusal " << to_string(rig_.state().refusal);
   EXPECT_EQ(rig_.driver_bus().status().state, BusState::kActive);
@@ -280,7 +285,8 @@ class Process {
  public:
   Process(const std::vector<std::string>& argv, const std::string& log) {
     std::vector<char*> args;
-    for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+    for (const std::string& a : argv)
+      args.push_back(const_cast<char*>(a.c_str()));
     args.push_back(nullptr);
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
@@ -383,7 +389,8 @@ TEST(VcanFaultsProcess, SigkilledDriverLeavesTheChassisToStopByItsWatchdog) {
   EXPECT_TRUE(sim.alive()) << "the simulated chassis must outlive its driver";
   const int sim_status = sim.kill_and_wait(SIGTERM);
   EXPECT_TRUE(WIFEXITED(sim_status) && WEXITSTATUS(sim_status) == 0) << "status " << sim_status;
-  for (const std::string& v : audit.violations()) ADD_FAILURE() << "wire audit: " << v;
+  for (const std::string& v : audit.violations())
+    ADD_FAILURE() << "wire audit: " << v;
 }
 
 }  // namespace

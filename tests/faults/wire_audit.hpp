@@ -89,7 +89,8 @@ class WireAudit {
     if (status_->control_mode_raw != static_cast<std::uint8_t>(protocol::ControlMode::kCan)) {
       return violation(f, "motion while the chassis is not in CAN command mode");
     }
-    if (status_->vehicle_status_raw == static_cast<std::uint8_t>(protocol::VehicleStatus::kEmergencyStop)) {
+    if (status_->vehicle_status_raw ==
+        static_cast<std::uint8_t>(protocol::VehicleStatus::kEmergencyStop)) {
       return violation(f, "motion during an emergency stop");
     }
     if (protocol::is_critical_error(status_->error_bits)) {
@@ -104,8 +105,8 @@ class WireAudit {
 
   void violation(const CanFrame& f, const std::string& what) {
     char head[64];
-    std::snprintf(head, sizeof head, "t=%.3f s 0x%03X: ",
-                  std::chrono::duration<double>(f.stamp).count(), f.id);
+    std::snprintf(head, sizeof head,
+                  "t=%.3f s 0x%03X: ", std::chrono::duration<double>(f.stamp).count(), f.id);
     violations_.push_back(head + what);
   }
 

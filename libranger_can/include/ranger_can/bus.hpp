@@ -37,13 +37,13 @@ std::string_view to_string(BusState s);
 
 struct BusStatistics {
   std::uint64_t tx_frames = 0;
-  std::uint64_t rx_frames = 0;       // delivered data frames (after filtering)
-  std::uint64_t tx_dropped = 0;      // send() found the queue full (kWouldBlock)
-  std::uint64_t rx_dropped = 0;      // frames the kernel or queue dropped before we read them
-  std::uint64_t error_frames = 0;    // error frames seen
+  std::uint64_t rx_frames = 0;            // delivered data frames (after filtering)
+  std::uint64_t tx_dropped = 0;           // send() found the queue full (kWouldBlock)
+  std::uint64_t rx_dropped = 0;           // frames the kernel or queue dropped before we read them
+  std::uint64_t error_frames = 0;         // error frames seen
   std::uint64_t controller_problems = 0;  // CAN_ERR_CRTL reports (overflow, warning, passive)
-  std::uint64_t restarts = 0;        // controller restarted after bus-off (CAN_ERR_RESTARTED)
-  std::uint64_t reopens = 0;         // times the interface was reopened after going down
+  std::uint64_t restarts = 0;             // controller restarted after bus-off (CAN_ERR_RESTARTED)
+  std::uint64_t reopens = 0;              // times the interface was reopened after going down
 };
 
 struct BusStatus {

@@ -33,13 +33,13 @@ namespace ranger::sim {
 
 struct MotionLimits {
   double max_linear_speed = interpretation::kMaxLinearSpeedMps;  // m/s, Ackermann and oblique
-  double max_spin_speed = kMaxSpinSpeedMps;              // m/s wheel speed (0x111's range)
+  double max_spin_speed = kMaxSpinSpeedMps;                      // m/s wheel speed (0x111's range)
   double max_ackermann_angle = kMaxAckermannSteeringRad;  // rad, mean front angle (0x111's range)
   double max_oblique_angle = kMaxObliqueSteeringRad;      // rad (0x111's range)
-  double acceleration = 1.0;                         // m/s^2 when speeding up
-  double deceleration = 2.0;                         // m/s^2 when slowing down or stopping
-  double emergency_deceleration = 6.0;               // m/s^2 for e-stop and power cut
-  double steering_rate = 90.0 * M_PI / 180.0;        // rad/s of the body steering quantity
+  double acceleration = 1.0;                              // m/s^2 when speeding up
+  double deceleration = 2.0;                              // m/s^2 when slowing down or stopping
+  double emergency_deceleration = 6.0;                    // m/s^2 for e-stop and power cut
+  double steering_rate = 90.0 * M_PI / 180.0;             // rad/s of the body steering quantity
 };
 
 // What the chassis has been asked to do, REP-103 signs (VirtualChassis converts from the wire).

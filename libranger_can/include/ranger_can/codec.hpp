@@ -34,7 +34,7 @@ struct MotionCommand {
 inline constexpr double kMaxAckermannSteeringRad = 40.0 * M_PI / 180.0;  // +-4000 x 0.01 deg
 inline constexpr double kMaxObliqueSteeringRad = 90.0 * M_PI / 180.0;    // +-9000 x 0.01 deg
 inline constexpr double kMaxSpinSpeedMps = 1.0;                          // +-1000 mm/s
-struct MotionModeCommand {  // 0x141
+struct MotionModeCommand {                                               // 0x141
   protocol::MotionMode mode = protocol::MotionMode::kAckermann;
 };
 struct ControlModeCommand {  // 0x421; the only host-settable modes are standby and CAN

@@ -32,6 +32,8 @@ struct CanFrame {
 inline bool operator==(const CanFrame& a, const CanFrame& b) {
   return a.id == b.id && a.dlc == b.dlc && a.data == b.data && a.is_error == b.is_error;
 }
-inline bool operator!=(const CanFrame& a, const CanFrame& b) { return !(a == b); }
+inline bool operator!=(const CanFrame& a, const CanFrame& b) {
+  return !(a == b);
+}
 
 }  // namespace ranger

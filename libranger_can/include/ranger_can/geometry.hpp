@@ -38,10 +38,14 @@ struct VehicleGeometry {
   WheelPosition wheel_position(int wheel) const {
     const double hx = wheelbase / 2.0, hy = track / 2.0;
     switch (wheel) {
-      case kRightFront: return {hx, -hy};
-      case kRightRear: return {-hx, -hy};
-      case kLeftRear: return {-hx, hy};
-      default: return {hx, hy};
+      case kRightFront:
+        return {hx, -hy};
+      case kRightRear:
+        return {-hx, -hy};
+      case kLeftRear:
+        return {-hx, hy};
+      default:
+        return {hx, hy};
     }
   }
   // Distance from the body centre to each wheel (all equal on the symmetric RANGER).

@@ -68,6 +68,13 @@ struct KinematicsSolution {
   std::uint32_t flags = kKinematicsExact;  // KinematicsFlag bits
 };
 
+// Which way an oblique command's wheels should point when the direction of travel is near
+// +-90 deg, where the fold into [-90, 90] deg is ambiguous (see ModeSelector::solve).
+struct ObliqueSideHint {
+  double side = 0.0;  // sign of the preferred REP-103 steering: +1, -1, or 0 (no preference)
+  double band = 0.0;  // rad: the hint applies while the direction is within this of +-90 deg
+};
+
 // Computes the 0x111 command that realises `twist` as closely as `mode` allows, clamped to
 // `limits` (saturate, never wrap). Errors: kNotFinite when a twist component is NaN/inf (the
 // message names it). Pure function.
@@ -77,11 +84,14 @@ struct KinematicsSolution {
 //    steering limit is clamped to the limit with the curvature's sign kept (kSteeringSaturated);
 //    vx = 0 with wz != 0 gives zero speed and full lock towards wz (kRotationDropped).
 //  * Oblique: linear_speed = +-|(vx, vy)|, steering = direction of travel folded into
-//    [-90, 90] deg (a reverse crab is a negative speed); wz is dropped.
+//    [-90, 90] deg (a reverse crab is a negative speed); wz is dropped. Within `oblique_hint.band`
+//    of +-90 deg the steering takes the hinted side instead (the same wheel line, the speed
+//    negated; clamped to the oblique steering limit, kSteeringSaturated).
 //  * Spin: spin_speed = wz * hypot(L/2, W/2) (interpretation open point 5); vx, vy dropped.
 Result<KinematicsSolution> solve_kinematics(const BodyTwist& twist, protocol::MotionMode mode,
                                             const VehicleGeometry& geometry,
-                                            const KinematicsLimits& limits);
+                                            const KinematicsLimits& limits,
+                                            const ObliqueSideHint& oblique_hint = {});
 
 // The body twist a 0x111 command produces in `mode` (the inverse of solve_kinematics for
 // commands within the limits): what the simulator applies and what tests compare against.
@@ -123,13 +133,20 @@ struct ModeSelectorConfig {
   // noisy teleop), and the chassis stays in a mode at least min_dwell after entering it.
   std::chrono::nanoseconds confirm_time = std::chrono::milliseconds(100);
   std::chrono::nanoseconds min_dwell = std::chrono::milliseconds(1000);
+  // Oblique mode: while the direction of travel is within this band of +-90 deg, the wheels keep
+  // the side of the previous oblique command (rad, 0 <= x < 90 deg; 0 disables).
+  double oblique_side_band = 5.0 * M_PI / 180.0;
 
   Status validate() const;
 };
 
-// Chooses the motion mode for a stream of twists: lateral velocity -> oblique, pure rotation ->
-// spin, otherwise dual Ackermann. A zero twist never causes a switch, and oblique is kept while
-// the request has no rotation (oblique drives straight too), so teleop does not flap.
+// The choices with memory for a stream of twists, so that noisy teleop does not flap:
+//  * the motion mode (select): lateral velocity -> oblique, pure rotation -> spin, otherwise dual
+//    Ackermann. A zero twist never causes a switch, and oblique is kept while the request has no
+//    rotation (oblique drives straight too).
+//  * in oblique mode, the side the wheels point to (solve): a pure lateral request with a tiny
+//    noisy vx would otherwise swing the wheels by 180 deg (+89.9 deg <-> -89.9 deg with the speed
+//    negated) at every sign change of vx.
 // Deterministic: time comes from the caller.
 class ModeSelector {
  public:
@@ -143,7 +160,14 @@ class ModeSelector {
   // chassis has been in `current` for min_dwell (the selector notices changes of `current`).
   protocol::MotionMode select(const BodyTwist& twist, protocol::MotionMode current, Timestamp now);
 
-  // Forgets pending candidates and dwell timing (e.g. after the link was lost).
+  // solve_kinematics with the oblique side hysteresis: while the direction of travel is within
+  // config().oblique_side_band of +-90 deg, the steering keeps the sign of the previous moving
+  // oblique command; beyond the band the pure solution (and its side) is taken. A non-oblique
+  // solution forgets the side (a mode switch turns the wheels to the new mode's neutral).
+  Result<KinematicsSolution> solve(const BodyTwist& twist, protocol::MotionMode mode,
+                                   const VehicleGeometry& geometry, const KinematicsLimits& limits);
+
+  // Forgets pending candidates, dwell timing and the oblique side (e.g. after the link was lost).
   void reset();
 
   const ModeSelectorConfig& config() const { return config_; }
@@ -156,6 +180,7 @@ class ModeSelector {
   bool have_candidate_ = false;
   protocol::MotionMode candidate_ = protocol::MotionMode::kAckermann;
   Timestamp candidate_since_{0};
+  double oblique_side_ = 0.0;  // sign of the last moving oblique command's steering, 0 = none
 };
 
 }  // namespace ranger

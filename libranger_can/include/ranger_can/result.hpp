@@ -10,18 +10,18 @@
 namespace ranger {
 
 enum class Errc {
-  kUnknownId,       // frame ID not part of the RANGER protocol
-  kBadDlc,          // frame has a DLC other than the one the protocol defines for its ID
-  kOutOfRange,      // a value lies outside what the protocol can express (after saturation rules)
-  kNotFinite,       // NaN or infinity where a number was required
-  kInvalidArgument, // any other bad input (unknown enum value, empty name, ...)
-  kParseError,      // malformed text input (candump line, CLI argument)
-  kIoError,         // an OS call failed; message carries errno's text
-  kNoSuchInterface, // network interface does not exist
-  kNotCanInterface, // interface exists but is not CAN
-  kInterfaceDown,   // interface exists but is down or vanished
-  kWouldBlock,      // the transmit queue is full; the frame was dropped, not queued
-  kTimeout,         // nothing arrived in time
+  kUnknownId,        // frame ID not part of the RANGER protocol
+  kBadDlc,           // frame has a DLC other than the one the protocol defines for its ID
+  kOutOfRange,       // a value lies outside what the protocol can express (after saturation rules)
+  kNotFinite,        // NaN or infinity where a number was required
+  kInvalidArgument,  // any other bad input (unknown enum value, empty name, ...)
+  kParseError,       // malformed text input (candump line, CLI argument)
+  kIoError,          // an OS call failed; message carries errno's text
+  kNoSuchInterface,  // network interface does not exist
+  kNotCanInterface,  // interface exists but is not CAN
+  kInterfaceDown,    // interface exists but is down or vanished
+  kWouldBlock,       // the transmit queue is full; the frame was dropped, not queued
+  kTimeout,          // nothing arrived in time
   kPermissionDenied,
 };
 
@@ -34,7 +34,7 @@ struct Error {
 template <typename T>
 class Result {
  public:
-  Result(T value) : v_(std::move(value)) {}    // NOLINT(google-explicit-constructor)
+  Result(T value) : v_(std::move(value)) {}      // NOLINT(google-explicit-constructor)
   Result(Error error) : v_(std::move(error)) {}  // NOLINT(google-explicit-constructor)
 
   bool ok() const { return v_.index() == 0; }
@@ -57,6 +57,8 @@ class Result {
 // For calls that produce nothing but may fail.
 struct Ok {};
 using Status = Result<Ok>;
-inline Status ok_status() { return Ok{}; }
+inline Status ok_status() {
+  return Ok{};
+}
 
 }  // namespace ranger

@@ -246,8 +246,7 @@ std::string ChassisMonitor::render_text(std::string_view iface, const BusStatus&
     const auto& c = motion_command_->value;
     host += fmt("0x111 speed %+.3f m/s", c.linear_speed) + "  steer " +
             command_steering_text(c.steering_angle) + fmt("  spin %+.3f m/s", c.spin_speed) +
-            "  (" +
-            age_text(motion_command_->received, now) +
+            "  (" + age_text(motion_command_->received, now) +
             fmt(", %.1f/s)", rate(protocol::kMotionCommandId, now));
   } else {
     host += st.yellow("no 0x111 seen");

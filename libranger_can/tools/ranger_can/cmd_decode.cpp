@@ -1,28 +1,17 @@
-// `ranger_can decode [FILE] [--json]`: candump logs in, one decoded line per frame out.
-//
-// Robust by construction: lines are read with a length bound (a file without newlines cannot
-// exhaust memory), every line goes through the bounds-checked candump parser, and a bad line is
-// reported on stderr with its number while decoding goes on.
-#include <cerrno>
-#include <cstring>
-#include <exception>
-#include <filesystem>
-#include <fstream>
-#include <istream>
+// `ranger_can decode [FILE] [--json]`: candump logs in, one decoded line per frame out. Reading
+// (bounded lines, numbered errors, read errors reported) is cli_input's.
+#include <optional>
 #include <ostream>
 #include <string>
-#include <system_error>
 
 #include "cli_commands.hpp"
 #include "cli_frame_format.hpp"
+#include "cli_input.hpp"
 #include "ranger_can/candump_log.hpp"
 
 namespace ranger::cli {
 
 namespace {
-
-// Longer than any line candump writes (about 100 characters with -x and -a).
-constexpr std::size_t kMaxLineLength = 4096;
 
 constexpr const char* kUsage =
     "usage: ranger_can decode [FILE|-] [--json]\n"
@@ -46,95 +35,27 @@ constexpr const char* kUsage =
     "  --json      one JSON object per line\n"
     "  -h, --help  this text\n";
 
-enum class LineRead { kLine, kTooLong, kEnd };
-
-// Reads one line into `line` (without its newline), bounded by kMaxLineLength; an over-long line
-// is consumed to its end and reported as kTooLong.
-LineRead read_line(std::istream& in, std::string& line) {
-  line.clear();
-  std::streambuf* buf = in.rdbuf();
-  if (buf == nullptr) return LineRead::kEnd;
-  bool any = false;
-  bool too_long = false;
-  for (;;) {
-    int c;
-    try {  // a filebuf throws on a read error (e.g. EISDIR); report it like istream would
-      c = buf->sbumpc();
-    } catch (const std::exception&) {
-      in.setstate(std::ios::badbit);
-      return LineRead::kEnd;
-    }
-    if (c == std::char_traits<char>::eof()) {
-      in.setstate(std::ios::eofbit);
-      if (!any) return LineRead::kEnd;
-      break;
-    }
-    any = true;
-    if (c == '\n') break;
-    if (line.size() < kMaxLineLength) {
-      line += static_cast<char>(c);
-    } else {
-      too_long = true;
-    }
-  }
-  return too_long ? LineRead::kTooLong : LineRead::kLine;
-}
-
-bool is_blank(const std::string& s) {
-  for (char c : s) {
-    if (c != ' ' && c != '\t' && c != '\r') return false;
-  }
-  return true;
-}
-
 int decode_stream(std::istream& in, bool json, Io io) {
-  std::string line;
   std::string out;
-  std::size_t line_no = 0;
-  std::size_t malformed = 0;
-  for (;;) {
-    const LineRead r = read_line(in, line);
-    if (r == LineRead::kEnd) break;
-    ++line_no;
-    if (r == LineRead::kTooLong) {
-      io.err << "ranger_can decode: line " << line_no << ": longer than " << kMaxLineLength
-             << " characters, skipped\n";
-      ++malformed;
-      continue;
-    }
-    if (is_blank(line)) continue;
-    const Result<LogEntry> entry = parse_candump_line(line);
-    if (!entry) {
-      io.err << "ranger_can decode: line " << line_no << ": " << entry.error().message << "\n";
-      ++malformed;
-      continue;
-    }
+  const CandumpReadSummary summary = read_candump(in, "decode", io.err, [&](const LogEntry& e) {
     out.clear();
     if (json) {
-      append_frame_json(out, entry->frame, entry->iface);
+      append_frame_json(out, e.frame, e.iface);
     } else {
-      append_frame_text(out, entry->frame, entry->iface);
+      append_frame_text(out, e.frame, e.iface);
     }
     out += '\n';
     io.out << out;
-  }
+  });
   io.out.flush();
-  if (malformed > 0) {
-    io.err << "ranger_can decode: " << malformed << " malformed line(s) skipped\n";
-  }
-  if (in.bad()) {
-    io.err << "ranger_can decode: read error after line " << line_no << "\n";
-    return 1;
-  }
-  return 0;
+  return report_candump_end(summary, "decode", io.err) ? 0 : 1;
 }
 
 }  // namespace
 
 int run_decode(const Args& args, Io io) {
   bool json = false;
-  std::string path;
-  bool have_path = false;
+  std::optional<std::string> path;
   for (const std::string& a : args) {
     if (a == "-h" || a == "--help") {
       io.out << kUsage;
@@ -145,29 +66,16 @@ int run_decode(const Args& args, Io io) {
     } else if (a.size() > 1 && a[0] == '-') {
       io.err << "ranger_can decode: unknown option '" << a << "'\n\n" << kUsage;
       return 2;
-    } else if (have_path) {
-      io.err << "ranger_can decode: more than one input file ('" << path << "', '" << a << "')\n\n"
+    } else if (path) {
+      io.err << "ranger_can decode: more than one input file ('" << *path << "', '" << a << "')\n\n"
              << kUsage;
       return 2;
     } else {
       path = a;
-      have_path = true;
     }
   }
-
-  if (!have_path || path == "-") return decode_stream(io.in, json, io);
-
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) {
-    io.err << "ranger_can decode: cannot read '" << path << "': is a directory\n";
-    return 1;
-  }
-  std::ifstream file(path, std::ios::binary);
-  if (!file) {
-    io.err << "ranger_can decode: cannot open '" << path << "': " << std::strerror(errno) << "\n";
-    return 1;
-  }
-  return decode_stream(file, json, io);
+  return with_input(path, "decode", io,
+                    [&](std::istream& in) { return decode_stream(in, json, io); });
 }
 
 }  // namespace ranger::cli

@@ -1,15 +1,14 @@
 // `ranger_can odom [FILE]`: replays a candump log through the driver's odometry (the very
 // ranger::Odometry class the ROS node runs) and prints the pose as JSON lines.
-#include <cerrno>
-#include <cstring>
-#include <fstream>
 #include <istream>
 #include <limits>
+#include <optional>
 #include <ostream>
 #include <string>
 
 #include "cli_args.hpp"
 #include "cli_commands.hpp"
+#include "cli_input.hpp"
 #include "cli_json.hpp"
 #include "ranger_can/candump_log.hpp"
 #include "ranger_can/odometry.hpp"
@@ -17,8 +16,6 @@
 namespace ranger::cli {
 
 namespace {
-
-constexpr std::size_t kMaxLineLength = 4096;  // longer than any candump line
 
 constexpr const char* kUsage =
     "usage: ranger_can odom [FILE|-] [--source wheels|motion] [--wheelbase M] [--track M]\n"
@@ -50,39 +47,9 @@ constexpr const char* kUsage =
     "Exit status: 0 success; 1 the input could not be read or had no timestamped frames; 2 "
     "usage.\n";
 
-enum class LineRead { kLine, kTooLong, kEnd };
-
-LineRead read_line(std::istream& in, std::string& line) {
-  line.clear();
-  std::streambuf* buf = in.rdbuf();
-  if (buf == nullptr) return LineRead::kEnd;
-  bool any = false, too_long = false;
-  for (;;) {
-    const int c = buf->sbumpc();
-    if (c == std::char_traits<char>::eof()) {
-      in.setstate(std::ios::eofbit);
-      if (!any) return LineRead::kEnd;
-      break;
-    }
-    any = true;
-    if (c == '\n') break;
-    if (line.size() < kMaxLineLength) {
-      line += static_cast<char>(c);
-    } else {
-      too_long = true;
-    }
-  }
-  return too_long ? LineRead::kTooLong : LineRead::kLine;
-}
-
-bool is_blank(const std::string& s) {
-  return s.find_first_not_of(" \t\r") == std::string::npos;
-}
-
 struct Options {
   OdometryConfig config;
-  std::string path;
-  bool have_path = false;
+  std::optional<std::string> path;  // absent: standard input
   long every = 1;
   bool quiet = false;
 };
@@ -106,47 +73,25 @@ void append_pose(std::string& out, const OdometryState& s, bool with_twist) {
 
 int replay(std::istream& in, const Options& opt, Io io) {
   Odometry odom(opt.config);
-  std::string line, out;
-  std::size_t line_no = 0, malformed = 0, timestamped = 0;
+  std::string out;
+  std::size_t timestamped = 0;
   std::uint64_t steps = 0;
-  for (;;) {
-    const LineRead r = read_line(in, line);
-    if (r == LineRead::kEnd) break;
-    ++line_no;
-    if (r == LineRead::kTooLong) {
-      io.err << "ranger_can odom: line " << line_no << ": longer than " << kMaxLineLength
-             << " characters, skipped\n";
-      ++malformed;
-      continue;
-    }
-    if (is_blank(line)) continue;
-    const Result<LogEntry> entry = parse_candump_line(line);
-    if (!entry) {
-      io.err << "ranger_can odom: line " << line_no << ": " << entry.error().message << "\n";
-      ++malformed;
-      continue;
-    }
-    if (entry->has_timestamp) ++timestamped;
-    if (!odom.on_frame(entry->frame)) continue;
+  const CandumpReadSummary summary = read_candump(in, "odom", io.err, [&](const LogEntry& e) {
+    if (e.has_timestamp) ++timestamped;
+    if (!odom.on_frame(e.frame)) return;
     ++steps;
     if (!opt.quiet && steps % static_cast<std::uint64_t>(opt.every) == 0) {
       out.clear();
       append_pose(out, odom.state(), true);
       io.out << out;
     }
-  }
+  });
   out.clear();
   append_pose(out, odom.state(), false);
   io.out << out;
   io.out.flush();
-  if (malformed > 0) {
-    io.err << "ranger_can odom: " << malformed << " malformed line(s) skipped\n";
-  }
-  if (in.bad()) {
-    io.err << "ranger_can odom: read error after line " << line_no << "\n";
-    return 1;
-  }
-  if (timestamped == 0 && line_no > 0) {
+  if (!report_candump_end(summary, "odom", io.err)) return 1;
+  if (timestamped == 0 && summary.lines > 0) {
     io.err << "ranger_can odom: the log has no timestamps; record it with 'candump -L' (or -ta)\n";
     return 1;
   }
@@ -187,22 +132,15 @@ int run_odom(const Args& args, Io io) {
       opt.quiet = true;
     } else if (a.size() > 1 && a[0] == '-') {
       return usage_error("unknown option '" + a + "'");
-    } else if (opt.have_path) {
-      return usage_error("more than one input file ('" + opt.path + "', '" + a + "')");
+    } else if (opt.path) {
+      return usage_error("more than one input file ('" + *opt.path + "', '" + a + "')");
     } else {
       opt.path = a;
-      opt.have_path = true;
     }
   }
   if (Status st = opt.config.validate(); !st) return usage_error(st.error().message);
 
-  if (!opt.have_path || opt.path == "-") return replay(io.in, opt, io);
-  std::ifstream file(opt.path, std::ios::binary);
-  if (!file) {
-    io.err << "ranger_can odom: cannot open '" << opt.path << "': " << std::strerror(errno) << "\n";
-    return 1;
-  }
-  return replay(file, opt, io);
+  return with_input(opt.path, "odom", io, [&](std::istream& in) { return replay(in, opt, io); });
 }
 
 }  // namespace ranger::cli

@@ -24,8 +24,8 @@ constexpr SubCommand kCommands[] = {
 
 void usage(std::ostream& os) {
   os << "usage: ranger_can <command> [options]\n\ncommands:\n";
-  for (const auto& c : kCommands) os << "  " << c.name << std::string(10 - std::strlen(c.name), ' ')
-                                     << c.summary << "\n";
+  for (const auto& c : kCommands)
+    os << "  " << c.name << std::string(10 - std::strlen(c.name), ' ') << c.summary << "\n";
   os << "\n'ranger_can <command> --help' describes a command.\n";
 }
 

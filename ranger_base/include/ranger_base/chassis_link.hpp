@@ -1,7 +1,7 @@
 // The node's CAN side: one thread that owns the bus, libranger_can's ChassisController, the
-// odometry and the joint tracker. It waits on the bus's fd (or a wake-up from a command) with a
-// timeout of at most one keep-alive period, feeds every received frame to the controller and the
-// odometry, and ticks the controller. ROS callbacks never touch the bus: they post commands
+// odometry and the joint tracker. It wakes when the controller's next tick is due (at most every
+// 20 ms) or when a command arrives, feeds every frame received meanwhile to the controller and
+// the odometry, and ticks the controller. ROS callbacks never touch the bus: they post commands
 // through the mutex-protected API below (the controller only records them; the CAN thread sends)
 // and read copies of the state through snapshot().
 //
@@ -114,7 +114,7 @@ class ChassisLink {
   void drain_and_tick(ranger::Timestamp now);                               // lock held
   void handle_frame(const ranger::CanFrame& frame, ranger::Timestamp now);  // lock held
   void wake();
-  void wait(int bus_fd, std::chrono::nanoseconds timeout);
+  void wait(std::chrono::nanoseconds timeout);  // until a command wakes us, at most `timeout`
 
   const ChassisLinkOptions options_;
   const ranger::Clock& clock_;
