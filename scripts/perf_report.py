@@ -31,6 +31,8 @@ KINDS = {
     "mem": (10.0, "resident memory (VmRSS): stable"),
     "wall": (30.0, "wall clock: includes waiting for a CPU on a loaded machine; noisy, compare "
                    "only runs at similar load"),
+    "vm": (100.0, "wall clock inside the qemu TCG VM: measures the emulator as much as the code; "
+                  "indicative only"),
     "count": (0.0, "a count: any change matters"),
 }
 
@@ -267,6 +269,7 @@ def bus_rows(r, raw):
         return
     out = read_text(os.path.join(raw, "vcan.out")) or ""
     place = "in the qemu VM" if where == "vm" else "native"
+    kind = "vm" if where == "vm" else "wall"
 
     def key_label(bus):  # bench_bus_vcan names the bus "loopback" or by its interface
         if bus == "loopback":
@@ -278,7 +281,7 @@ def bus_rows(r, raw):
         if m:
             key, label = key_label(m.group(1))
             r.add("bus", f"{key}.throughput_fps", f"{label}: throughput", int(m.group(5)),
-                  "frames/s", "wall", "vcan", better="higher",
+                  "frames/s", kind, "vcan", better="higher",
                   detail=f"{m.group(2)} received, {m.group(3)} rx + {m.group(4)} tx dropped")
             found = found or m.group(1) != "loopback"
         m = LAT_LINE.match(line)
@@ -286,7 +289,7 @@ def bus_rows(r, raw):
             key, label = key_label(m.group(1))
             for p, g in (("p50", 3), ("p99", 4)):
                 r.add("bus", f"{key}.latency_{p}_us", f"{label}: latency {p}",
-                      float(m.group(g)), "us", "wall", "vcan",
+                      float(m.group(g)), "us", kind, "vcan",
                       detail=f"{m.group(2)} samples, max {float(m.group(5)):.0f} us")
     if not found:
         r.failed("bus", f"bus.vcan_{where}.throughput_fps", "vcan0", "vcan",
@@ -599,6 +602,8 @@ def main():
     ap.add_argument("--raw", required=True)
     ap.add_argument("--build-dir", required=True)
     ap.add_argument("--results", required=True)
+    ap.add_argument("--previous", help="the run to compare with (default: --results as it is "
+                    "before being overwritten); for re-rendering a raw directory")
     ap.add_argument("--markdown", required=True)
     ap.add_argument("--command", default="scripts/perf.sh")
     ap.add_argument("--repo", default=".")
@@ -609,7 +614,7 @@ def main():
         if line.strip():
             s = json.loads(line)
             steps[s["step"]] = s
-    previous = read_json(args.results)  # before it is overwritten
+    previous = read_json(args.previous or args.results)  # before it is overwritten
     machine = machine_info(args.build_dir, args.repo)
     started = min((s["started"] for s in steps.values()), default=0)
     ended = max((s["started"] + s["seconds"] for s in steps.values()), default=0)

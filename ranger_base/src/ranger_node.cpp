@@ -10,6 +10,8 @@
 #include <sensor_msgs/JointState.h>
 #include <sensor_msgs/Range.h>
 
+#include <pthread.h>
+
 #include <chrono>
 #include <cmath>
 #include <string>
@@ -95,19 +97,11 @@ void RangerNode::start() {
   set_motion_mode_srv_ =
       service_nh_.advertiseService("set_motion_mode", &RangerNode::on_set_motion_mode, this);
 
-  publish_timer_ = nh_.createSteadyTimer(ros::WallDuration(1.0 / params_.publish_rate),
-                                         &RangerNode::on_publish_timer, this);
-  state_timer_ = nh_.createSteadyTimer(ros::WallDuration(1.0 / params_.state_publish_rate),
-                                       &RangerNode::on_state_timer, this);
-  diagnostics_timer_ =
-      nh_.createSteadyTimer(ros::WallDuration(0.25), &RangerNode::on_diagnostics_timer, this);
-
-  spinner_ = std::make_unique<ros::AsyncSpinner>(1);
   cmd_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &cmd_queue_);
   service_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &service_queue_);
-  spinner_->start();
   cmd_spinner_->start();
   service_spinner_->start();
+  publisher_ = std::thread([this] { publish_loop(); });
   ROS_INFO("ranger_base_node: %s, publishing odom at %.1f Hz (%s -> %s%s)",
            params_.is_sim() ? "in-process virtual chassis (port_name = sim)"
                             : ("CAN interface " + params_.port_name).c_str(),
@@ -121,12 +115,14 @@ void RangerNode::shutdown() {
   // Commands stop first: no cmd_vel may restart the chassis after the stop.
   cmd_vel_sub_.shutdown();
   link_->stop();  // zero 0x111, then the CAN thread ends
-  publish_timer_.stop();
-  state_timer_.stop();
-  diagnostics_timer_.stop();
+  {
+    std::lock_guard<std::mutex> lock(publisher_mutex_);
+    publisher_stop_ = true;
+  }
+  publisher_wake_.notify_all();
+  if (publisher_.joinable()) publisher_.join();
   if (cmd_spinner_) cmd_spinner_->stop();
   if (service_spinner_) service_spinner_->stop();
-  if (spinner_) spinner_->stop();
 }
 
 void RangerNode::on_cmd_vel(const geometry_msgs::Twist::ConstPtr& msg) {
@@ -156,7 +152,45 @@ void RangerNode::on_motion_command(const MotionCommandEvent& e) {
       to_twist_stamped(zero ? ranger::BodyTwist{} : achieved, stamp, params_.base_frame));
 }
 
-void RangerNode::on_publish_timer(const ros::SteadyTimerEvent&) {
+void RangerNode::publish_loop() {
+  ::pthread_setname_np(::pthread_self(), "ranger_publish");
+  using Clock = std::chrono::steady_clock;
+  const auto period = [](double rate) {
+    return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / rate));
+  };
+  struct Task {
+    Clock::duration period;
+    void (RangerNode::*publish)();
+    Clock::time_point due;
+  };
+  const auto start = Clock::now();
+  Task tasks[] = {{period(params_.publish_rate), &RangerNode::publish_motion, start},
+                  {period(params_.state_publish_rate), &RangerNode::publish_states, start},
+                  {period(4.0), &RangerNode::publish_diagnostics, start}};
+  std::unique_lock<std::mutex> lock(publisher_mutex_);
+  while (!publisher_stop_) {
+    const auto now = Clock::now();
+    Clock::time_point next = Clock::time_point::max();
+    for (auto& task : tasks) {
+      if (now >= task.due) {
+        lock.unlock();
+        try {
+          (this->*task.publish)();
+        } catch (const std::exception& e) {  // nothing may escape the thread
+          ROS_ERROR_THROTTLE(5.0, "publishing failed: %s", e.what());
+        }
+        lock.lock();
+        // Fixed rate; after a stall, resume from now instead of publishing a burst.
+        task.due += task.period;
+        if (task.due < now) task.due = now + task.period;
+      }
+      next = std::min(next, task.due);
+    }
+    publisher_wake_.wait_until(lock, next, [this] { return publisher_stop_; });
+  }
+}
+
+void RangerNode::publish_motion() {
   const LinkSnapshot s = link_->snapshot();
   const ros::Time stamp = ros::Time::now();
   const nav_msgs::Odometry odom = to_odometry(s.odometry, params_, stamp);
@@ -168,7 +202,7 @@ void RangerNode::on_publish_timer(const ros::SteadyTimerEvent&) {
   }
 }
 
-void RangerNode::on_state_timer(const ros::SteadyTimerEvent&) {
+void RangerNode::publish_states() {
   const LinkSnapshot s = link_->snapshot();
   const ros::Time stamp = ros::Time::now();
   const TimeMapper time(stamp, s.now);
@@ -238,7 +272,7 @@ void RangerNode::log_state_changes(const LinkSnapshot& s) {
   }
 }
 
-void RangerNode::on_diagnostics_timer(const ros::SteadyTimerEvent&) {
+void RangerNode::publish_diagnostics() {
   diagnostics_->refresh();
   updater_.update();
 }

@@ -129,8 +129,7 @@ TEST_F(ChassisLinkSim, InterfaceGoingDownIsReportedAndRecovered) {
   link_->sim_network()->set_link_up(false);  // `ip link set sim down`: the adapter is unplugged
   ASSERT_TRUE(wait_until([&] {
     const auto s = link_->snapshot();
-    return s.bus.state == ranger::BusState::kDown &&
-           s.controller.link == ranger::LinkState::kStale;
+    return s.bus.state == ranger::BusState::kDown && s.controller.link == ranger::LinkState::kStale;
   }));
   EXPECT_EQ(link_->snapshot().controller.refusal, ranger::MotionRefusal::kLinkLost);
   link_->sim_network()->set_link_up(true);

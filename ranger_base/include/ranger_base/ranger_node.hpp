@@ -2,10 +2,12 @@
 // ChassisLink. All topic and service names are relative (the node works under a namespace);
 // only /tf and /diagnostics are global, by their own conventions.
 //
-// Threads: the CAN thread lives in ChassisLink. Here, three callback queues are each spun by one
-// thread: cmd_vel (so a command is never queued behind publishing), the publish timers (global
-// queue), and the services (which may wait for the chassis to confirm). Every callback reads the
-// link through snapshot() or posts to it; none touches the bus.
+// Threads: the CAN thread lives in ChassisLink. Publishing runs on one thread of its own that
+// sleeps until the next publication is due (odometry/TF/joints at publish_rate, states at
+// state_publish_rate, diagnostics): one wake-up per publication, no timer-to-spinner hand-off.
+// Two callback queues are each spun by one thread: cmd_vel (never queued behind anything) and
+// the services (which may wait for the chassis to confirm). Every callback and publication reads
+// the link through snapshot() or posts to it; none touches the bus.
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
@@ -18,8 +20,11 @@
 #include <tf2_ros/transform_broadcaster.h>
 
 #include <array>
+#include <condition_variable>
 #include <memory>
+#include <mutex>
 #include <optional>
+#include <thread>
 
 #include <ranger_can/clock.hpp>
 
@@ -35,7 +40,7 @@ class RangerNode {
   RangerNode(const ros::NodeHandle& nh, const ros::NodeHandle& private_nh, NodeParameters params);
   ~RangerNode();  // shutdown()
 
-  // Starts the CAN thread, the timers and the spinners.
+  // Starts the CAN thread, the publishing thread and the spinners.
   void start();
   // Stops the chassis (zero 0x111) and the CAN thread, then the ROS side. Idempotent.
   void shutdown();
@@ -44,9 +49,10 @@ class RangerNode {
 
  private:
   void on_cmd_vel(const geometry_msgs::Twist::ConstPtr& msg);
-  void on_publish_timer(const ros::SteadyTimerEvent& event);
-  void on_state_timer(const ros::SteadyTimerEvent& event);
-  void on_diagnostics_timer(const ros::SteadyTimerEvent& event);
+  void publish_loop();
+  void publish_motion();  // odom, TF, joint_states, sim/ground_truth
+  void publish_states();  // ranger_msgs states, battery, ultrasonic
+  void publish_diagnostics();
   void on_motion_command(const MotionCommandEvent& event);  // CAN thread
   bool on_clear_errors(ranger_msgs::ClearErrors::Request& req,
                        ranger_msgs::ClearErrors::Response& res);
@@ -71,14 +77,18 @@ class RangerNode {
   std::array<ros::Publisher, 8> range_pubs_;
   tf2_ros::TransformBroadcaster tf_broadcaster_;
   ros::ServiceServer clear_errors_srv_, set_ultrasonic_srv_, set_motion_mode_srv_;
-  ros::SteadyTimer publish_timer_, state_timer_, diagnostics_timer_;
 
   diagnostic_updater::Updater updater_;
   std::unique_ptr<ChassisDiagnostics> diagnostics_;
 
-  std::unique_ptr<ros::AsyncSpinner> spinner_, cmd_spinner_, service_spinner_;
+  std::unique_ptr<ros::AsyncSpinner> cmd_spinner_, service_spinner_;
 
-  // For logging transitions once instead of every cycle (state timer thread only).
+  std::thread publisher_;
+  std::mutex publisher_mutex_;
+  std::condition_variable publisher_wake_;
+  bool publisher_stop_ = false;  // guarded by publisher_mutex_
+
+  // For logging transitions once instead of every cycle (publishing thread only).
   std::optional<ranger::MotionRefusal> last_refusal_;
   std::optional<ranger::LinkState> last_link_;
   std::string last_bus_error_;
