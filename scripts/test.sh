@@ -7,6 +7,8 @@
 #   dbc       (part of unit) the DBC file cross-checked against the C++ codec with cantools
 #   vcan      suites on real SocketCAN vcan0: natively where the kernel has vcan, else in a qemu VM
 #   ros       the ROS packages' tests (rostest + gtest, launch-file checks) via colcon test
+#   ros_vcan  the node against `ranger_can sim vcan0` over real SocketCAN (native or in the VM):
+#             stop on SIGINT / rosnode kill, the chassis's own stop after SIGKILL
 #   sanitize  ASan+UBSan and TSan builds of the library and its tests
 #   fuzz      every libFuzzer target for a bounded time (RANGER_FUZZ_SECONDS, default 60)
 #
@@ -15,7 +17,7 @@ set -uo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
 results=$root/build/test-results
-stages=${RANGER_STAGES:-unit vcan ros sanitize fuzz}
+stages=${RANGER_STAGES:-unit vcan ros ros_vcan sanitize fuzz}
 failed=()
 passed=()
 
@@ -39,13 +41,17 @@ stage_unit() {
     --output-junit "$results/unit.xml"
 }
 stage_vcan() { scripts/run_vcan_tests.sh build/lib "$results/vcan.xml"; }
+ros_env() {  # the environment every ROS stage runs in (system Python first, our workspace)
+  export PATH=/usr/bin:$PATH
+  if [ -f /opt/ros/noetic/setup.bash ]; then set +u; source /opt/ros/noetic/setup.bash; set -u; fi
+  set +u; source install/setup.bash; set -u
+  export ROS_HOME=${ROS_HOME:-$root/build/ros_home} ROS_HOSTNAME=localhost
+  export ROS_MASTER_URI=http://localhost:11311
+}
+stage_ros_vcan() { (ros_env && scripts/run_vcan_tests.sh build/ws/ranger_base "$results/ros_vcan.xml"); }
 stage_ros() {
   (
-    export PATH=/usr/bin:$PATH
-    if [ -f /opt/ros/noetic/setup.bash ]; then set +u; source /opt/ros/noetic/setup.bash; set -u; fi
-    set +u; source install/setup.bash; set -u
-    export ROS_HOME=${ROS_HOME:-$root/build/ros_home} ROS_HOSTNAME=localhost
-    export ROS_MASTER_URI=http://localhost:11311
+    ros_env
     colcon --log-base build/log test --base-paths . --build-base build/ws --install-base install \
       --event-handlers console_direct+ --executor sequential --return-code-on-test-failure
     local rc=$?

@@ -7,7 +7,8 @@ controller and odometry). A benchmark, not a test: it prints figures, it asserts
      CPU share (of one core) from /proc/<pid>/stat and per thread from /proc/<pid>/task, RSS from
      /proc/<pid>/status. The node process also runs the virtual chassis (its thread is reported
      separately): the driver's own share is the node total minus that thread.
-  2. Latency cmd_vel -> 0x111: a new twist is published every 50 ms; the node (publish_cmd:=true)
+  2. Latency cmd_vel -> 0x111: a new twist is published every 50-70 ms (random, so every phase
+     against the 20 ms keep-alive occurs); the node (publish_cmd:=true)
      stamps each 0x111 with its send time on cmd_vel_out; latency = that stamp - the time the
      twist was published (same host clock). Includes the ROS transport of cmd_vel.
 
@@ -20,6 +21,7 @@ import argparse
 import json
 import os
 import platform
+import random
 import shutil
 import signal
 import socket
@@ -190,11 +192,11 @@ def measure_load(rospy, duration, extra_args=()):
         stop_node(node)
 
 
-def measure_latency(rospy, samples):
+def measure_latency(rospy, samples, extra_args=()):
     from geometry_msgs.msg import Twist, TwistStamped
     ns = "perf_latency"
     node = start_node("ranger_base_node", f"__ns:=/{ns}", "_publish_cmd:=true",
-                      "_cmd_vel_timeout:=1.0")
+                      "_cmd_vel_timeout:=1.0", *extra_args)
     try:
         wait_for_command_mode(rospy, ns)
         lock = threading.Lock()
@@ -219,7 +221,8 @@ def measure_latency(rospy, samples):
             with lock:
                 sent[value] = time.time()  # each value recurs only after 10 s
             pub.publish(cmd)
-            time.sleep(0.05)
+            # 50-70 ms apart, at random: every phase against the node's 20 ms keep-alive occurs.
+            time.sleep(random.uniform(0.05, 0.07))
         time.sleep(0.5)
         sub.unregister()
         data = latencies[20:] if len(latencies) > 40 else latencies  # skip the warm-up
@@ -257,7 +260,7 @@ def main():
     parser.add_argument("--samples", type=int, default=400, help="latency samples")
     parser.add_argument("--json", help="also write the figures to this file")
     parser.add_argument("--node-arg", action="append", default=[],
-                        help="extra node argument for the load phase, e.g. _publish_rate:=10")
+                        help="extra node argument (both phases), e.g. _min_command_interval:=0.001")
     parser.add_argument("--skip-latency", action="store_true")
     args = parser.parse_args()
 
@@ -271,7 +274,8 @@ def main():
                    "mode": "port_name:=sim (in-process virtual chassis, loopback bus)",
                    "load": measure_load(rospy, args.duration, args.node_arg)}
         if not args.skip_latency:
-            figures["latency_cmd_vel_to_0x111"] = measure_latency(rospy, args.samples)
+            figures["latency_cmd_vel_to_0x111"] = measure_latency(rospy, args.samples,
+                                                                  args.node_arg)
     finally:
         env.close()
 

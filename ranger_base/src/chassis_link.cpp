@@ -3,6 +3,7 @@
 #include <poll.h>
 #include <pthread.h>
 #include <sys/eventfd.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -86,14 +87,15 @@ void ChassisLink::wake() {
 }
 
 void ChassisLink::wait(nanoseconds timeout) {
-  // Round up so a sub-millisecond deadline does not become a busy loop of zero-timeout polls.
-  const auto ms = std::chrono::ceil<milliseconds>(std::max(timeout, nanoseconds(0))).count();
+  timeout = std::max(timeout, nanoseconds(0));
+  const timespec ts{static_cast<time_t>(timeout.count() / 1'000'000'000),
+                    static_cast<long>(timeout.count() % 1'000'000'000)};
   if (wake_fd_ < 0) {
-    std::this_thread::sleep_for(milliseconds(ms));
+    ::nanosleep(&ts, nullptr);
     return;
   }
   pollfd fd{wake_fd_, POLLIN, 0};
-  if (::poll(&fd, 1, static_cast<int>(ms)) > 0 && (fd.revents & POLLIN)) {
+  if (::ppoll(&fd, 1, &ts, nullptr) > 0 && (fd.revents & POLLIN)) {
     std::uint64_t value;
     [[maybe_unused]] const auto n = ::read(wake_fd_, &value, sizeof value);
   }
@@ -170,12 +172,16 @@ void ChassisLink::loop() {
         if (!bus_) try_open(now);
         if (bus_) {
           timeout = std::min(timeout, controller_->next_tick_due() - now);
-          // A command posted but not yet sent goes out within min_command_interval of the
-          // previous 0x111 (the controller's rate bound): look again then.
+          // A command posted but not yet sent goes out once min_command_interval has passed
+          // since the previous 0x111 (the controller's rate bound): look again exactly then.
+          // (A moment already past means the last tick had other reasons not to send: then the
+          // normal schedule applies, so this can never spin.)
           const auto& st = controller_->state();
+          const auto sendable =
+              st.last_motion_command_time + options_.controller.min_command_interval - now;
           if (st.refusal == ranger::MotionRefusal::kNone && st.has_command &&
-              st.last_command_time > st.last_motion_command_time) {
-            timeout = std::min(timeout, options_.controller.min_command_interval);
+              st.last_command_time > st.last_motion_command_time && sendable > nanoseconds(0)) {
+            timeout = std::min(timeout, sendable);
           }
         }
       }

@@ -34,6 +34,7 @@ constexpr double kCmdVelTimeout = 0.3;         // s
 constexpr double kPublishPeriod = 0.02;        // s (publish_rate 50)
 constexpr double kMaxLinearSpeed = 1.0;        // m/s
 constexpr double kMinCommandInterval = 0.005;  // s, ControllerConfig default
+constexpr double kKeepAlivePeriod = 0.02;      // s
 
 template <typename M>
 class Latest {
@@ -91,6 +92,9 @@ class NodeSim : public ::testing::Test {
 
   static void TearDownTestSuite() {
     spinner_->stop();
+    // Destroyed here, not at exit: a static spinner outliving roscpp's own statics is a
+    // heap-use-after-free in ~AsyncSpinner (found by the ASan build of the ROS tests).
+    spinner_.reset();
     subs_.clear();
     cmd_pub_.shutdown();
     nh_.reset();
@@ -354,13 +358,15 @@ TEST_F(NodeSim, AFloodOfCommandsIsRateBoundedAndTheNodeStaysResponsive) {
   const ros::Time end = ros::Time::now();
   ros::WallDuration(0.2).sleep();
   const auto commands = commands_since(start);
-  // 0x111 never goes out faster than min_command_interval apart, whatever arrives.
+  // Whatever arrives, changed commands go out at most every min_command_interval, plus the
+  // 20 ms keep-alive: the bus load stays bounded.
   int in_window = 0;
   for (const auto& c : commands) {
     if (c.header.stamp <= end) ++in_window;
   }
   const double window = (end - start).toSec();
-  EXPECT_LE(in_window, static_cast<int>(window / kMinCommandInterval) + 2);
+  EXPECT_LE(in_window,
+            static_cast<int>(window / kMinCommandInterval + window / kKeepAlivePeriod) + 2);
   // Still alive and obeying: the latest command drives the chassis.
   ASSERT_TRUE(drive_until(
       twist(0.3, 0, 0), [] { return std::abs(truth_.get()->twist.twist.linear.x - 0.3) < 0.02; }));
