@@ -9,7 +9,7 @@
 #   ros       the ROS packages' tests (rostest + gtest, launch-file checks) via colcon test
 #   ros_vcan  the node against `ranger_can sim vcan0` over real SocketCAN (native or in the VM):
 #             stop on SIGINT / rosnode kill, the chassis's own stop after SIGKILL
-#   sanitize  ASan+UBSan and TSan builds of the library and its tests
+#   sanitize  ASan+UBSan and TSan builds of the library and its tests, ASan build of the ROS node
 #   fuzz      every libFuzzer target for a bounded time (RANGER_FUZZ_SECONDS, default 60)
 #
 # RANGER_STAGES="unit ros" runs a subset (default: all of the above, in that order).

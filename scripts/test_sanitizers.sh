@@ -1,96 +1,157 @@
 #!/usr/bin/env bash
-# Builds libranger_can, its unit tests and the system suites in tests/ twice — with AddressSanitizer
-# + UndefinedBehaviorSanitizer (build/asan) and with ThreadSanitizer (build/tsan) — and runs every
-# CTest case that needs no kernel CAN support (label != vcan) in each. Any sanitizer report fails
-# the run: the process halts at the first report (halt_on_error, -fno-sanitize-recover=all), and
-# reports are also written to files so that one raised in a child process (the CLI, the virtual
-# chassis) fails the run even when the test that spawned it ignored its exit status.
+# Sanitizer builds, each run through its tests; any sanitizer report fails the run.
 #
-# Usage: scripts/test_sanitizers.sh [address|thread]...     (default: address thread)
+#   address  libranger_can, its tool, its unit tests and the system suites in tests/ with
+#            AddressSanitizer + UndefinedBehaviorSanitizer (build/asan); every CTest case that
+#            needs no kernel CAN support (label != vcan).
+#   thread   the same with ThreadSanitizer (build/tsan).
+#   ros      the ROS packages up to ranger_base (libranger_can, ranger_msgs, ranger_base) with
+#            ASan + UBSan in a colcon workspace of their own (build/asan-ws, build/asan-install),
+#            then ranger_base's gtests and rostests (the node itself runs instrumented).
+#
+# Usage: scripts/test_sanitizers.sh [address|thread|ros]...     (default: all three)
 # Environment: RANGER_JOBS (default 2), CXX (default: the system compiler), RANGER_RESULTS
-#   (directory for JUnit reports asan.xml / tsan.xml; default build/test-results).
-# With RANGER_SANITIZE_VCAN=1 the `vcan` suites of the ASan build also run, natively or in the
-# qemu VM (scripts/run_vcan_tests.sh).
+#   (directory for the JUnit reports asan.xml, tsan.xml, asan-ros/; default build/test-results).
+#   RANGER_SANITIZE_VCAN=1 also runs the `vcan` suites of the ASan build, natively or in the qemu
+#   VM (scripts/run_vcan_tests.sh; it adds several minutes).
+#
+# A report fails the run twice over: the process halts at the first report (halt_on_error,
+# -fno-sanitize-recover=all), and every instrumented process also writes its reports to
+# <build dir>/sanitizer-reports/, so that a report raised in a child process (the CLI run by the
+# CLI tests, the node run by rostest) fails the run even when whatever started it ignored its exit
+# status. No suppressions are used.
+#
+# ThreadSanitizer is not applied to the ROS node: roscpp and Boost are not instrumented, and TSan
+# needs every thread's code instrumented to report anything meaningful.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
 kinds=("$@")
-[ ${#kinds[@]} -gt 0 ] || kinds=(address thread)
+[ ${#kinds[@]} -gt 0 ] || kinds=(address thread ros)
 jobs=${RANGER_JOBS:-2}
 results=${RANGER_RESULTS:-$root/build/test-results}
 generator=()
 command -v ninja >/dev/null && generator=(-G Ninja)
 mkdir -p build "$results" && touch build/COLCON_IGNORE
 
-# Flags shared by both builds. -O1 keeps the runs quick while stack traces stay exact; asserts
-# stay on (no NDEBUG).
+# -O1 keeps the runs quick while stack traces stay exact; asserts stay on (no NDEBUG).
 common_flags="-O1 -g -fno-omit-frame-pointer"
+asan_flags="-fsanitize=address,undefined -fno-sanitize-recover=all"
+tsan_flags="-fsanitize=thread"
 
-failed=()
-for kind in "${kinds[@]}"; do
-  case $kind in
-    address)
-      dir=build/asan
-      flags="-fsanitize=address,undefined -fno-sanitize-recover=all"
-      ;;
-    thread)
-      dir=build/tsan
-      flags="-fsanitize=thread"
-      ;;
-    *) echo "test_sanitizers.sh: unknown sanitizer '$kind' (expected address or thread)" >&2; exit 2 ;;
-  esac
-  name=$(basename "$dir")
+# Points every sanitizer at a report directory (emptied first).
+set_sanitizer_env() {  # report_dir
+  rm -rf "$1" && mkdir -p "$1"
+  export ASAN_OPTIONS="halt_on_error=1:detect_leaks=1:strict_string_checks=1:detect_stack_use_after_return=1:check_initialization_order=1:strict_init_order=1:log_path=$1/asan"
+  export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1:log_path=$1/ubsan"
+  export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:log_path=$1/tsan"
+}
+# Prints the reports in a directory; fails when there is any.
+check_reports() {  # name report_dir
+  shopt -s nullglob
+  local files=("$2"/*)
+  shopt -u nullglob
+  [ ${#files[@]} -eq 0 ] && return 0
+  echo "== $1: ${#files[@]} SANITIZER REPORT(S):"
+  local f
+  for f in "${files[@]}"; do
+    echo "---- $f"
+    head -n 60 "$f"
+  done
+  return 1
+}
+
+# libranger_can + tests/ with one sanitizer, via plain CMake from the repository root.
+run_cmake_build() {  # name dir RANGER_SANITIZE flags
+  local name=$1 dir=$2 sanitize=$3 flags=$4 start=$SECONDS rc=0
   echo "== $name: configure + build ($dir)"
-  start=$SECONDS
   # RANGER_SANITIZE instruments libranger_can's directory; the system suites in tests/ are a
   # sibling directory, so the same flags also go in CMAKE_CXX_FLAGS to instrument them too.
   if ! cmake -S . -B "$dir" "${generator[@]}" -DCMAKE_BUILD_TYPE=Debug \
-    -DRANGER_SANITIZE="$kind" -DRANGER_BUILD_BENCHMARKS=OFF -DRANGER_BUILD_TESTS=ON \
+    -DRANGER_SANITIZE="$sanitize" -DRANGER_BUILD_BENCHMARKS=OFF -DRANGER_BUILD_TESTS=ON \
     -DCMAKE_CXX_FLAGS="$common_flags $flags" \
     -DCMAKE_EXE_LINKER_FLAGS="$flags" -DCMAKE_SHARED_LINKER_FLAGS="$flags" >/dev/null ||
     ! cmake --build "$dir" -j "$jobs"; then
     echo "== $name: BUILD FAILED"
-    failed+=("$name")
-    continue
+    return 1
   fi
   echo "== $name: built in $((SECONDS - start)) s"
 
-  reports=$root/$dir/sanitizer-reports
-  rm -rf "$reports" && mkdir -p "$reports"
-  # log_path: every instrumented process writes its reports to $reports/<name>.<pid>.
-  export ASAN_OPTIONS="halt_on_error=1:detect_leaks=1:strict_string_checks=1:detect_stack_use_after_return=1:check_initialization_order=1:strict_init_order=1:log_path=$reports/asan"
-  export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1:log_path=$reports/ubsan"
-  export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:log_path=$reports/tsan"
-
-  echo "== $name: ctest (label != vcan)"
   start=$SECONDS
-  ctest --test-dir "$dir" -LE vcan --output-on-failure -j "$jobs" --timeout 300 \
-    --output-junit "$results/$name.xml"
-  rc=$?
-  if [ "${RANGER_SANITIZE_VCAN:-0}" = 1 ] && [ "$kind" = address ] &&
-    [ -x scripts/run_vcan_tests.sh ]; then
-    echo "== $name: vcan suites"
-    scripts/run_vcan_tests.sh "$dir" --junit "$results/$name-vcan.xml" || rc=1
-  fi
+  (
+    set_sanitizer_env "$root/$dir/sanitizer-reports"
+    echo "== $name: ctest (label != vcan)"
+    rc=0
+    ctest --test-dir "$dir" -LE vcan --output-on-failure -j "$jobs" --timeout 300 \
+      --output-junit "$results/$name.xml" || rc=1
+    if [ "${RANGER_SANITIZE_VCAN:-0}" = 1 ] && [ "$sanitize" = address ]; then
+      echo "== $name: vcan suites"
+      scripts/run_vcan_tests.sh "$dir" --junit "$results/$name-vcan.xml" || rc=1
+    fi
+    exit $rc
+  ) || rc=1
   echo "== $name: tests ran in $((SECONDS - start)) s"
+  check_reports "$name" "$root/$dir/sanitizer-reports" || rc=1
+  return $rc
+}
 
-  shopt -s nullglob
-  files=("$reports"/*)
-  shopt -u nullglob
-  if [ ${#files[@]} -gt 0 ]; then
-    echo "== $name: ${#files[@]} SANITIZER REPORT(S):"
-    for f in "${files[@]}"; do
-      echo "---- $f"
-      head -n 60 "$f"
-    done
-    rc=1
-  fi
-  unset ASAN_OPTIONS UBSAN_OPTIONS TSAN_OPTIONS
-  if [ $rc -ne 0 ]; then
+# ranger_base (and what it needs) with ASan + UBSan in a colcon workspace, then its tests.
+run_ros_build() {
+  local ws=build/asan-ws install=build/asan-install reports=$root/build/asan-ws/sanitizer-reports
+  local start=$SECONDS rc=0
+  echo "== asan-ros: colcon build up to ranger_base ($ws)"
+  (
+    # ROS's Python tools need the system interpreter (python3 on PATH may be a pyenv).
+    export PATH=/usr/bin:$PATH
+    if [ -f /opt/ros/noetic/setup.bash ]; then set +u; source /opt/ros/noetic/setup.bash; set -u; fi
+    colcon --log-base build/log-asan build --base-paths . --packages-up-to ranger_base \
+      --build-base "$ws" --install-base "$install" \
+      --event-handlers console_cohesion- summary+ --parallel-workers 1 \
+      --cmake-args -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=Debug \
+      "-DCMAKE_CXX_FLAGS=$common_flags $asan_flags" \
+      "-DCMAKE_EXE_LINKER_FLAGS=$asan_flags" "-DCMAKE_SHARED_LINKER_FLAGS=$asan_flags" \
+      -DCATKIN_ENABLE_TESTING=ON -DRANGER_BUILD_TESTS=OFF -DRANGER_BUILD_BENCHMARKS=OFF
+  ) || { echo "== asan-ros: BUILD FAILED"; return 1; }
+  echo "== asan-ros: built in $((SECONDS - start)) s"
+
+  start=$SECONDS
+  (
+    export PATH=/usr/bin:$PATH
+    if [ -f /opt/ros/noetic/setup.bash ]; then set +u; source /opt/ros/noetic/setup.bash; set -u; fi
+    set +u; source "$install/setup.bash"; set -u
+    export ROS_HOME=$root/build/asan-ws/ros_home ROS_HOSTNAME=localhost
+    export ROS_MASTER_URI=http://localhost:11311
+    set_sanitizer_env "$reports"
+    colcon --log-base build/log-asan test --base-paths . --packages-select ranger_base \
+      --build-base "$ws" --install-base "$install" --event-handlers console_cohesion- \
+      --executor sequential --return-code-on-test-failure
+    test_rc=$?
+    colcon test-result --test-result-base "$ws" --verbose
+    rm -rf "$results/asan-ros" && mkdir -p "$results/asan-ros"
+    find "$ws" -path '*test_results*' -name '*.xml' -exec cp {} "$results/asan-ros/" \;
+    exit $test_rc
+  ) || rc=1
+  echo "== asan-ros: tests ran in $((SECONDS - start)) s"
+  check_reports asan-ros "$reports" || rc=1
+  return $rc
+}
+
+failed=()
+for kind in "${kinds[@]}"; do
+  case $kind in
+    address) name=asan; run=(run_cmake_build asan build/asan address "$asan_flags") ;;
+    thread) name=tsan; run=(run_cmake_build tsan build/tsan thread "$tsan_flags") ;;
+    ros) name=asan-ros; run=(run_ros_build) ;;
+    *)
+      echo "test_sanitizers.sh: unknown build '$kind' (expected address, thread or ros)" >&2
+      exit 2
+      ;;
+  esac
+  if "${run[@]}"; then
+    echo "== $name: ok, no sanitizer reports"
+  else
     echo "== $name: FAILED"
     failed+=("$name")
-  else
-    echo "== $name: ok, no sanitizer reports"
   fi
 done
 

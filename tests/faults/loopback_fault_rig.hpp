@@ -69,7 +69,12 @@ class LoopbackFaultRig {
       }
       controller_->tick(t);
     }
-    for (auto f = observer_bus_->receive(0ns); f; f = observer_bus_->receive(0ns)) {
+    for (;;) {
+      auto f = observer_bus_->receive(0ns);
+      if (!f) {
+        if (f.error().code == Errc::kInterfaceDown) audit_.forget();
+        break;
+      }
       trace_.push_back(*f);
       audit_.on_frame(*f);
     }

@@ -192,7 +192,12 @@ class VcanFaultRig {
     for (auto f = driver_bus_->receive(wait); f; f = driver_bus_->receive(0ns)) {
       controller_->on_frame(*f, clock_.now());
     }
-    for (auto f = observer_bus_->receive(0ns); f; f = observer_bus_->receive(0ns)) {
+    for (;;) {
+      auto f = observer_bus_->receive(0ns);
+      if (!f) {
+        if (f.error().code == Errc::kInterfaceDown) audit_.forget();
+        break;
+      }
       audit_.on_frame(*f);
     }
   }

@@ -64,6 +64,15 @@ class WireAudit {
     }
   }
 
+  // The observer itself lost the bus (its interface went down): what it knew may be stale and
+  // it may miss frames the driver sees. Motion is not judged again until the observer has seen a
+  // fresh 0x211 and 0x291.
+  void forget() {
+    status_.reset();
+    mode_.reset();
+    blind_ = true;
+  }
+
   const std::vector<std::string>& violations() const { return violations_; }
   std::uint64_t count(std::uint32_t id) const {
     const auto it = counts_.find(id);
@@ -82,6 +91,10 @@ class WireAudit {
   void check_motion(const CanFrame& f, const MotionCommand& c) {
     if (c.linear_speed == 0.0 && c.spin_speed == 0.0) return;
     ++moving_commands_;
+    if (blind_) {
+      if (!status_ || !mode_) return;
+      blind_ = false;
+    }
     if (!status_) return violation(f, "motion before any 0x211");
     if (f.stamp - status_stamp_ > config_.link_timeout + slack_) {
       return violation(f, "motion while the last 0x211 is stale");
@@ -116,6 +129,7 @@ class WireAudit {
   Timestamp status_stamp_{0};
   std::optional<MotionModeFeedback> mode_;
   std::optional<double> soc_;
+  bool blind_ = false;
   std::map<std::uint32_t, std::uint64_t> counts_;
   std::uint64_t error_frames_ = 0;
   std::uint64_t moving_commands_ = 0;
