@@ -5,7 +5,7 @@
 #include <benchmark/benchmark.h>
 
 #include "bus_bench.hpp"
-#include "ranger_can/loopback_bus.hpp"
+#include "ranger_can/transport/loopback_bus.hpp"
 
 namespace {
 

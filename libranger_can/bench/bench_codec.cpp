@@ -16,8 +16,8 @@
 #include <string>
 #include <vector>
 
-#include "ranger_can/codec.hpp"
-#include "ranger_can/protocol.hpp"
+#include "ranger_can/wire/codec.hpp"
+#include "ranger_can/wire/protocol.hpp"
 
 namespace {
 

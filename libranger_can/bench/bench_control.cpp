@@ -9,10 +9,10 @@
 #include <string>
 #include <vector>
 
-#include "ranger_can/codec.hpp"
-#include "ranger_can/controller.hpp"
-#include "ranger_can/kinematics.hpp"
-#include "ranger_can/odometry.hpp"
+#include "ranger_can/wire/codec.hpp"
+#include "ranger_can/control/controller.hpp"
+#include "ranger_can/control/kinematics.hpp"
+#include "ranger_can/control/odometry.hpp"
 
 namespace {
 

@@ -10,8 +10,8 @@
 #include <thread>
 #include <vector>
 
-#include "ranger_can/bus.hpp"
-#include "ranger_can/frame.hpp"
+#include "ranger_can/transport/bus.hpp"
+#include "ranger_can/wire/frame.hpp"
 
 namespace ranger::bench {
 

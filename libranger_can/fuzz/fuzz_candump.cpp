@@ -12,7 +12,7 @@
 #include <string_view>
 
 #include "fuzz_input.hpp"
-#include "ranger_can/candump_log.hpp"
+#include "ranger_can/wire/candump_log.hpp"
 
 namespace {
 

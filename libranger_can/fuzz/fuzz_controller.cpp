@@ -24,10 +24,10 @@
 #include <vector>
 
 #include "fuzz_input.hpp"
-#include "ranger_can/bus.hpp"
-#include "ranger_can/codec.hpp"
-#include "ranger_can/controller.hpp"
-#include "ranger_can/protocol.hpp"
+#include "ranger_can/transport/bus.hpp"
+#include "ranger_can/wire/codec.hpp"
+#include "ranger_can/control/controller.hpp"
+#include "ranger_can/wire/protocol.hpp"
 
 namespace {
 

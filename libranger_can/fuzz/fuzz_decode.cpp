@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "fuzz_input.hpp"
-#include "ranger_can/codec.hpp"
-#include "ranger_can/protocol.hpp"
+#include "ranger_can/wire/codec.hpp"
+#include "ranger_can/wire/protocol.hpp"
 
 namespace {
 

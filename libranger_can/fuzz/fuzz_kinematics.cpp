@@ -17,11 +17,11 @@
 #include <cstdlib>
 
 #include "fuzz_input.hpp"
-#include "ranger_can/codec.hpp"
-#include "ranger_can/interpretation.hpp"
-#include "ranger_can/kinematics.hpp"
-#include "ranger_can/protocol.hpp"
-#include "ranger_can/speed_limiter.hpp"
+#include "ranger_can/wire/codec.hpp"
+#include "ranger_can/wire/interpretation.hpp"
+#include "ranger_can/control/kinematics.hpp"
+#include "ranger_can/wire/protocol.hpp"
+#include "ranger_can/control/speed_limiter.hpp"
 
 namespace {
 

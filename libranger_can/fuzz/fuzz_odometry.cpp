@@ -12,8 +12,8 @@
 #include <cstdlib>
 
 #include "fuzz_input.hpp"
-#include "ranger_can/odometry.hpp"
-#include "ranger_can/protocol.hpp"
+#include "ranger_can/control/odometry.hpp"
+#include "ranger_can/wire/protocol.hpp"
 
 namespace {
 

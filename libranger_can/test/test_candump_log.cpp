@@ -4,7 +4,7 @@
 #include <random>
 #include <string>
 
-#include "ranger_can/candump_log.hpp"
+#include "ranger_can/wire/candump_log.hpp"
 
 namespace ranger {
 namespace {

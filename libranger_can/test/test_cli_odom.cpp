@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "cli_commands.hpp"
-#include "ranger_can/candump_log.hpp"
+#include "ranger_can/wire/candump_log.hpp"
 #include "support/cli_run.hpp"
 #include "support/synthetic_feedback.hpp"
 

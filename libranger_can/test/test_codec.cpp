@@ -12,9 +12,9 @@
 #include <string>
 #include <vector>
 
-#include "ranger_can/codec.hpp"
-#include "ranger_can/interpretation.hpp"
-#include "ranger_can/protocol.hpp"
+#include "ranger_can/wire/codec.hpp"
+#include "ranger_can/wire/interpretation.hpp"
+#include "ranger_can/wire/protocol.hpp"
 
 namespace ranger {
 namespace {

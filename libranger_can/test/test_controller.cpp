@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
-#include "ranger_can/codec.hpp"
-#include "ranger_can/controller.hpp"
-#include "ranger_can/interpretation.hpp"
-#include "ranger_can/protocol.hpp"
+#include "ranger_can/wire/codec.hpp"
+#include "ranger_can/control/controller.hpp"
+#include "ranger_can/wire/interpretation.hpp"
+#include "ranger_can/wire/protocol.hpp"
 #include "support/fake_bus.hpp"
 
 namespace ranger {

@@ -1,5 +1,5 @@
 // Error frames -> bus state: the one interpretation every Bus uses (error_frame.hpp).
-#include "ranger_can/error_frame.hpp"
+#include "ranger_can/transport/error_frame.hpp"
 
 #include <gtest/gtest.h>
 

@@ -9,11 +9,11 @@
 #include <cstdint>
 #include <string>
 
-#include "ranger_can/candump_log.hpp"
-#include "ranger_can/codec.hpp"
-#include "ranger_can/controller.hpp"
-#include "ranger_can/odometry.hpp"
-#include "ranger_can/protocol.hpp"
+#include "ranger_can/wire/candump_log.hpp"
+#include "ranger_can/wire/codec.hpp"
+#include "ranger_can/control/controller.hpp"
+#include "ranger_can/control/odometry.hpp"
+#include "ranger_can/wire/protocol.hpp"
 #include "support/fake_bus.hpp"
 
 namespace ranger {

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <limits>
 
-#include "ranger_can/geometry.hpp"
-#include "ranger_can/interpretation.hpp"
+#include "ranger_can/control/geometry.hpp"
+#include "ranger_can/wire/interpretation.hpp"
 
 namespace ranger::interpretation {
 namespace {

@@ -6,9 +6,9 @@
 #include <cmath>
 #include <limits>
 
-#include "ranger_can/codec.hpp"
-#include "ranger_can/interpretation.hpp"
-#include "ranger_can/kinematics.hpp"
+#include "ranger_can/wire/codec.hpp"
+#include "ranger_can/wire/interpretation.hpp"
+#include "ranger_can/control/kinematics.hpp"
 
 namespace ranger {
 namespace {

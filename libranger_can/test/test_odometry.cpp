@@ -6,10 +6,10 @@
 #include <chrono>
 #include <cmath>
 
-#include "ranger_can/codec.hpp"
-#include "ranger_can/interpretation.hpp"
-#include "ranger_can/kinematics.hpp"
-#include "ranger_can/odometry.hpp"
+#include "ranger_can/wire/codec.hpp"
+#include "ranger_can/wire/interpretation.hpp"
+#include "ranger_can/control/kinematics.hpp"
+#include "ranger_can/control/odometry.hpp"
 #include "support/synthetic_feedback.hpp"
 
 namespace ranger {

@@ -1,7 +1,7 @@
 // What SocketCanBus decides without a CAN socket: the errors for interfaces that are missing or
 // not CAN (these checks precede socket(AF_CAN), so they hold on kernels without CAN), and the
 // conversion of what the kernel hands us. Real sockets: tests/bus (label vcan).
-#include "ranger_can/socketcan_bus.hpp"
+#include "ranger_can/transport/socketcan_bus.hpp"
 
 #include <gtest/gtest.h>
 #include <linux/can.h>
@@ -10,7 +10,7 @@
 
 #include <cstring>
 
-#include "ranger_can/error_frame.hpp"
+#include "ranger_can/transport/error_frame.hpp"
 
 namespace ranger {
 namespace {

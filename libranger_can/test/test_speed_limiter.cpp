@@ -3,7 +3,7 @@
 
 #include <limits>
 
-#include "ranger_can/speed_limiter.hpp"
+#include "ranger_can/control/speed_limiter.hpp"
 
 namespace ranger {
 namespace {

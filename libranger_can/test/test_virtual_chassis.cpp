@@ -8,12 +8,12 @@
 #include <optional>
 #include <vector>
 
-#include "ranger_can/chassis_model.hpp"
-#include "ranger_can/codec.hpp"
-#include "ranger_can/interpretation.hpp"
-#include "ranger_can/kinematics.hpp"
-#include "ranger_can/protocol.hpp"
-#include "ranger_can/virtual_chassis.hpp"
+#include "ranger_can/sim/chassis_model.hpp"
+#include "ranger_can/wire/codec.hpp"
+#include "ranger_can/wire/interpretation.hpp"
+#include "ranger_can/control/kinematics.hpp"
+#include "ranger_can/wire/protocol.hpp"
+#include "ranger_can/sim/virtual_chassis.hpp"
 #include "support/fake_bus.hpp"
 
 namespace ranger::sim {

@@ -11,8 +11,8 @@
 #include <cstring>
 #include <exception>
 
-#include <ranger_can/codec.hpp>
-#include <ranger_can/socketcan_bus.hpp>
+#include <ranger_can/wire/codec.hpp>
+#include <ranger_can/transport/socketcan_bus.hpp>
 
 namespace ranger_base {
 namespace {

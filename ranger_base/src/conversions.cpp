@@ -8,8 +8,8 @@
 #include <cmath>
 #include <limits>
 
-#include <ranger_can/geometry.hpp>
-#include <ranger_can/protocol.hpp>
+#include <ranger_can/control/geometry.hpp>
+#include <ranger_can/wire/protocol.hpp>
 
 namespace ranger_base {
 namespace {

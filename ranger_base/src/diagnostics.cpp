@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <string>
 
-#include <ranger_can/protocol.hpp>
+#include <ranger_can/wire/protocol.hpp>
 
 namespace ranger_base {
 namespace {
@@ -19,10 +19,6 @@ std::string hex(std::uint32_t v, int width) {
   char buf[16];
   std::snprintf(buf, sizeof buf, "0x%0*X", width, v);
   return buf;
-}
-
-double seconds(std::chrono::nanoseconds d) {
-  return std::chrono::duration<double>(d).count();
 }
 
 // A fault that stops the chassis is an ERROR; anything else it reports is a WARN.
@@ -181,7 +177,7 @@ void FrameRateMonitor::diagnose(const LinkSnapshot& s, DiagnosticStatusWrapper& 
     out.summary(DiagnosticStatus::OK, "measuring");
     return;
   }
-  const double dt = seconds(s.now - *previous_time_);
+  const double dt = ranger::seconds(s.now - *previous_time_);
   double total = 0.0;
   for (const auto& [id, count] : s.frames_by_id) {
     const auto before = previous_counts_.count(id) ? previous_counts_.at(id) : 0;

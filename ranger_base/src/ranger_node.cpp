@@ -16,7 +16,7 @@
 #include <cmath>
 #include <string>
 
-#include <ranger_can/protocol.hpp>
+#include <ranger_can/wire/protocol.hpp>
 
 #include "ranger_base/conversions.hpp"
 

@@ -1,6 +1,6 @@
 #include "ranger_base/wheel_joints.hpp"
 
-#include <ranger_can/interpretation.hpp>
+#include <ranger_can/wire/interpretation.hpp>
 
 namespace ranger_base {
 namespace {

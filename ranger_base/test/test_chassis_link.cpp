@@ -8,7 +8,7 @@
 #include <thread>
 
 #include <ranger_can/clock.hpp>
-#include <ranger_can/protocol.hpp>
+#include <ranger_can/wire/protocol.hpp>
 
 #include "ranger_base/chassis_link.hpp"
 

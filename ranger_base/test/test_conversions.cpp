@@ -6,8 +6,8 @@
 #include <cmath>
 #include <set>
 
-#include <ranger_can/geometry.hpp>
-#include <ranger_can/protocol.hpp>
+#include <ranger_can/control/geometry.hpp>
+#include <ranger_can/wire/protocol.hpp>
 
 #include "ranger_base/conversions.hpp"
 

@@ -2,7 +2,7 @@
 #include <diagnostic_msgs/DiagnosticStatus.h>
 #include <gtest/gtest.h>
 
-#include <ranger_can/protocol.hpp>
+#include <ranger_can/wire/protocol.hpp>
 
 #include "ranger_base/diagnostics.hpp"
 

@@ -5,7 +5,7 @@
 #include <sstream>
 #include <string>
 
-#include <ranger_can/interpretation.hpp>
+#include <ranger_can/wire/interpretation.hpp>
 
 #include "ranger_base/parameters.hpp"
 

@@ -1,7 +1,7 @@
 // joint_states from 0x271 / 0x281.
 #include <gtest/gtest.h>
 
-#include <ranger_can/interpretation.hpp>
+#include <ranger_can/wire/interpretation.hpp>
 
 #include "ranger_base/wheel_joints.hpp"
 

@@ -5,7 +5,7 @@ ranger_base's joint_states use).
 Run: /usr/bin/python3 -m pytest test/test_urdf.py     (colcon test runs it through CTest)
 Environment (set by CMakeLists.txt; defaults work from a source checkout):
   RANGER_URDF           the URDF the build generated (checked for staleness and parsed)
-  RANGER_GEOMETRY_HPP   libranger_can/include/ranger_can/geometry.hpp
+  RANGER_GEOMETRY_HPP   libranger_can/include/ranger_can/control/geometry.hpp
 """
 
 import math
@@ -25,7 +25,7 @@ import generate_urdf  # noqa: E402
 
 GEOMETRY_YAML = os.path.join(PACKAGE_DIR, "config", "geometry.yaml")
 GEOMETRY_HPP = os.environ.get("RANGER_GEOMETRY_HPP", os.path.join(
-    PACKAGE_DIR, os.pardir, "libranger_can", "include", "ranger_can", "geometry.hpp"))
+    PACKAGE_DIR, os.pardir, "libranger_can", "include", "ranger_can", "control", "geometry.hpp"))
 BUILT_URDF = os.environ.get("RANGER_URDF")
 TOL = 1e-6
 

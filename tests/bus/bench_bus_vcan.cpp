@@ -8,8 +8,8 @@
 #include <string>
 
 #include "bus_bench.hpp"
-#include "ranger_can/loopback_bus.hpp"
-#include "ranger_can/socketcan_bus.hpp"
+#include "ranger_can/transport/loopback_bus.hpp"
+#include "ranger_can/transport/socketcan_bus.hpp"
 
 int main(int argc, char** argv) {
   std::string interface = "vcan0";

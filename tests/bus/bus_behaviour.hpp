@@ -30,11 +30,11 @@
 #include <thread>
 #include <vector>
 
-#include "ranger_can/bus.hpp"
+#include "ranger_can/transport/bus.hpp"
 #include "ranger_can/clock.hpp"
-#include "ranger_can/error_frame.hpp"
-#include "ranger_can/frame.hpp"
-#include "ranger_can/protocol.hpp"
+#include "ranger_can/transport/error_frame.hpp"
+#include "ranger_can/wire/frame.hpp"
+#include "ranger_can/wire/protocol.hpp"
 
 namespace ranger::bus_test {
 

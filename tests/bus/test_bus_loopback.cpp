@@ -3,7 +3,7 @@
 #include <string>
 
 #include "bus_behaviour.hpp"
-#include "ranger_can/loopback_bus.hpp"
+#include "ranger_can/transport/loopback_bus.hpp"
 
 namespace ranger::bus_test {
 

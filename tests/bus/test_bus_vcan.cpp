@@ -17,7 +17,7 @@
 #include <system_error>
 
 #include "bus_behaviour.hpp"
-#include "ranger_can/socketcan_bus.hpp"
+#include "ranger_can/transport/socketcan_bus.hpp"
 
 namespace ranger::bus_test {
 namespace {

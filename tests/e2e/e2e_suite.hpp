@@ -23,11 +23,11 @@
 #include <optional>
 #include <string>
 
-#include "ranger_can/bus.hpp"
-#include "ranger_can/controller.hpp"
-#include "ranger_can/odometry.hpp"
-#include "ranger_can/protocol.hpp"
-#include "ranger_can/virtual_chassis.hpp"
+#include "ranger_can/transport/bus.hpp"
+#include "ranger_can/control/controller.hpp"
+#include "ranger_can/control/odometry.hpp"
+#include "ranger_can/wire/protocol.hpp"
+#include "ranger_can/sim/virtual_chassis.hpp"
 
 namespace ranger::e2e {
 

@@ -3,7 +3,7 @@
 // then the driver reads, decides and sends. Deterministic, no threads, no sleeping.
 #include "e2e_suite.hpp"
 #include "ranger_can/clock.hpp"
-#include "ranger_can/loopback_bus.hpp"
+#include "ranger_can/transport/loopback_bus.hpp"
 
 namespace ranger::e2e {
 namespace {

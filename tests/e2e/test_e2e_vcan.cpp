@@ -7,8 +7,8 @@
 
 #include "e2e_suite.hpp"
 #include "ranger_can/clock.hpp"
-#include "ranger_can/socketcan_bus.hpp"
-#include "ranger_can/virtual_chassis_runner.hpp"
+#include "ranger_can/transport/socketcan_bus.hpp"
+#include "ranger_can/sim/virtual_chassis_runner.hpp"
 
 namespace ranger::e2e {
 namespace {

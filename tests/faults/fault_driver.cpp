@@ -15,8 +15,8 @@
 #include <string>
 
 #include "ranger_can/clock.hpp"
-#include "ranger_can/controller.hpp"
-#include "ranger_can/socketcan_bus.hpp"
+#include "ranger_can/control/controller.hpp"
+#include "ranger_can/transport/socketcan_bus.hpp"
 
 namespace {
 

@@ -17,9 +17,9 @@
 #include <vector>
 
 #include "ranger_can/clock.hpp"
-#include "ranger_can/controller.hpp"
-#include "ranger_can/loopback_bus.hpp"
-#include "ranger_can/virtual_chassis.hpp"
+#include "ranger_can/control/controller.hpp"
+#include "ranger_can/transport/loopback_bus.hpp"
+#include "ranger_can/sim/virtual_chassis.hpp"
 #include "wire_audit.hpp"
 
 namespace ranger::faults {

@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "loopback_fault_rig.hpp"
-#include "ranger_can/error_frame.hpp"
+#include "ranger_can/transport/error_frame.hpp"
 
 namespace ranger::faults {
 namespace {

@@ -32,10 +32,10 @@
 #include <vector>
 
 #include "ranger_can/clock.hpp"
-#include "ranger_can/controller.hpp"
-#include "ranger_can/error_frame.hpp"
-#include "ranger_can/socketcan_bus.hpp"
-#include "ranger_can/virtual_chassis_runner.hpp"
+#include "ranger_can/control/controller.hpp"
+#include "ranger_can/transport/error_frame.hpp"
+#include "ranger_can/transport/socketcan_bus.hpp"
+#include "ranger_can/sim/virtual_chassis_runner.hpp"
 #include "wire_audit.hpp"
 
 extern char** environ;

@@ -21,10 +21,10 @@
 #include <string>
 #include <vector>
 
-#include "ranger_can/codec.hpp"
-#include "ranger_can/controller.hpp"
-#include "ranger_can/frame.hpp"
-#include "ranger_can/protocol.hpp"
+#include "ranger_can/wire/codec.hpp"
+#include "ranger_can/control/controller.hpp"
+#include "ranger_can/wire/frame.hpp"
+#include "ranger_can/wire/protocol.hpp"
 
 namespace ranger::faults {
 

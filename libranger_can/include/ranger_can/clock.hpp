@@ -6,7 +6,7 @@
 #include <atomic>
 #include <chrono>
 
-#include "ranger_can/frame.hpp"
+#include "ranger_can/types.hpp"
 
 namespace ranger {
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "ranger_can/bus.hpp"
+#include "ranger_can/transport/bus.hpp"
 
 namespace ranger::test {
 

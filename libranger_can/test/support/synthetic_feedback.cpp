@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "ranger_can/interpretation.hpp"
+#include "ranger_can/wire/interpretation.hpp"
 
 namespace ranger::test {
 

@@ -5,11 +5,11 @@
 
 #include <vector>
 
-#include "ranger_can/codec.hpp"
-#include "ranger_can/frame.hpp"
-#include "ranger_can/geometry.hpp"
-#include "ranger_can/kinematics.hpp"
-#include "ranger_can/protocol.hpp"
+#include "ranger_can/wire/codec.hpp"
+#include "ranger_can/wire/frame.hpp"
+#include "ranger_can/control/geometry.hpp"
+#include "ranger_can/control/kinematics.hpp"
+#include "ranger_can/wire/protocol.hpp"
 
 namespace ranger::test {
 

@@ -3,7 +3,7 @@
 #include <map>
 #include <mutex>
 
-#include "ranger_can/socketcan_bus.hpp"
+#include "ranger_can/transport/socketcan_bus.hpp"
 
 namespace ranger::cli {
 

@@ -8,8 +8,8 @@
 #include <memory>
 #include <string>
 
-#include "ranger_can/bus.hpp"
-#include "ranger_can/loopback_bus.hpp"
+#include "ranger_can/transport/bus.hpp"
+#include "ranger_can/transport/loopback_bus.hpp"
 #include "ranger_can/result.hpp"
 
 namespace ranger::cli {

@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <vector>
 
-#include "ranger_can/protocol.hpp"
+#include "ranger_can/wire/protocol.hpp"
 
 namespace ranger::cli {
 

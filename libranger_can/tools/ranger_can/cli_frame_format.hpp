@@ -11,8 +11,8 @@
 #include <string_view>
 
 #include "cli_json.hpp"
-#include "ranger_can/codec.hpp"
-#include "ranger_can/frame.hpp"
+#include "ranger_can/wire/codec.hpp"
+#include "ranger_can/wire/frame.hpp"
 
 namespace ranger::cli {
 

@@ -17,7 +17,7 @@
 #include <string_view>
 
 #include "cli_commands.hpp"
-#include "ranger_can/candump_log.hpp"
+#include "ranger_can/wire/candump_log.hpp"
 
 namespace ranger::cli {
 

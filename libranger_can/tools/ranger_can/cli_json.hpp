@@ -11,7 +11,7 @@
 #include <string>
 #include <string_view>
 
-#include "ranger_can/frame.hpp"
+#include "ranger_can/wire/frame.hpp"
 
 namespace ranger::cli {
 

@@ -7,9 +7,9 @@
 #include <vector>
 
 #include "cli_json.hpp"
-#include "ranger_can/geometry.hpp"
-#include "ranger_can/interpretation.hpp"
-#include "ranger_can/protocol.hpp"
+#include "ranger_can/control/geometry.hpp"
+#include "ranger_can/wire/interpretation.hpp"
+#include "ranger_can/wire/protocol.hpp"
 
 namespace ranger::cli {
 

@@ -12,10 +12,10 @@
 #include <string>
 #include <string_view>
 
-#include "ranger_can/bus.hpp"
-#include "ranger_can/codec.hpp"
-#include "ranger_can/controller.hpp"  // ChassisFeedback, Stamped
-#include "ranger_can/frame.hpp"
+#include "ranger_can/transport/bus.hpp"
+#include "ranger_can/wire/codec.hpp"
+#include "ranger_can/control/controller.hpp"  // ChassisFeedback, Stamped
+#include "ranger_can/wire/frame.hpp"
 
 namespace ranger::cli {
 

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "cli_args.hpp"
-#include "ranger_can/protocol.hpp"
+#include "ranger_can/wire/protocol.hpp"
 
 namespace ranger::cli {
 
@@ -216,7 +216,7 @@ Result<std::string> apply_sim_command(std::string_view line, sim::VirtualChassis
     if (!y) return y.error();
     auto yaw = parse_double("pose YAW", w[3]);
     if (!yaw) return yaw.error();
-    chassis.set_pose(Pose2D{*x, *y, sim::wrap_angle(*yaw)});
+    chassis.set_pose(Pose2D{*x, *y, wrap_angle(*yaw)});
     return std::string();
   }
   if (cmd == "status") return describe_chassis(chassis.snapshot());

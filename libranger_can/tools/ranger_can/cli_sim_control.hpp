@@ -7,7 +7,7 @@
 #include <string_view>
 
 #include "ranger_can/result.hpp"
-#include "ranger_can/virtual_chassis.hpp"
+#include "ranger_can/sim/virtual_chassis.hpp"
 
 namespace ranger::cli {
 

@@ -7,7 +7,7 @@
 #include "cli_commands.hpp"
 #include "cli_frame_format.hpp"
 #include "cli_input.hpp"
-#include "ranger_can/candump_log.hpp"
+#include "ranger_can/wire/candump_log.hpp"
 
 namespace ranger::cli {
 

@@ -10,8 +10,8 @@
 #include "cli_commands.hpp"
 #include "cli_input.hpp"
 #include "cli_json.hpp"
-#include "ranger_can/candump_log.hpp"
-#include "ranger_can/odometry.hpp"
+#include "ranger_can/wire/candump_log.hpp"
+#include "ranger_can/control/odometry.hpp"
 
 namespace ranger::cli {
 

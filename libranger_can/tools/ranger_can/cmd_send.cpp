@@ -11,10 +11,10 @@
 #include "cli_bus.hpp"
 #include "cli_commands.hpp"
 #include "cli_frame_format.hpp"
-#include "ranger_can/candump_log.hpp"
+#include "ranger_can/wire/candump_log.hpp"
 #include "ranger_can/clock.hpp"
-#include "ranger_can/codec.hpp"
-#include "ranger_can/interpretation.hpp"
+#include "ranger_can/wire/codec.hpp"
+#include "ranger_can/wire/interpretation.hpp"
 
 namespace ranger::cli {
 

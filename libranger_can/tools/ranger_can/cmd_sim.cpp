@@ -29,7 +29,7 @@
 #include "cli_signals.hpp"
 #include "cli_sim_control.hpp"
 #include "ranger_can/clock.hpp"
-#include "ranger_can/virtual_chassis_runner.hpp"
+#include "ranger_can/sim/virtual_chassis_runner.hpp"
 
 namespace ranger::cli {
 

@@ -25,14 +25,14 @@
 #include <thread>
 #include <vector>
 
-#include <ranger_can/bus.hpp>
+#include <ranger_can/transport/bus.hpp>
 #include <ranger_can/clock.hpp>
-#include <ranger_can/controller.hpp>
-#include <ranger_can/loopback_bus.hpp>
-#include <ranger_can/odometry.hpp>
+#include <ranger_can/control/controller.hpp>
+#include <ranger_can/transport/loopback_bus.hpp>
+#include <ranger_can/control/odometry.hpp>
 #include <ranger_can/result.hpp>
-#include <ranger_can/virtual_chassis.hpp>
-#include <ranger_can/virtual_chassis_runner.hpp>
+#include <ranger_can/sim/virtual_chassis.hpp>
+#include <ranger_can/sim/virtual_chassis_runner.hpp>
 
 #include "ranger_base/wheel_joints.hpp"
 

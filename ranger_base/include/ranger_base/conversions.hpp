@@ -21,9 +21,9 @@
 #include <string>
 #include <string_view>
 
-#include <ranger_can/controller.hpp>
-#include <ranger_can/odometry.hpp>
-#include <ranger_can/virtual_chassis.hpp>
+#include <ranger_can/control/controller.hpp>
+#include <ranger_can/control/odometry.hpp>
+#include <ranger_can/sim/virtual_chassis.hpp>
 
 #include "ranger_base/parameters.hpp"
 #include "ranger_base/wheel_joints.hpp"

@@ -17,10 +17,10 @@
 #include <string>
 #include <vector>
 
-#include <ranger_can/controller.hpp>
-#include <ranger_can/odometry.hpp>
+#include <ranger_can/control/controller.hpp>
+#include <ranger_can/control/odometry.hpp>
 #include <ranger_can/result.hpp>
-#include <ranger_can/virtual_chassis.hpp>
+#include <ranger_can/sim/virtual_chassis.hpp>
 
 namespace ros {
 class NodeHandle;

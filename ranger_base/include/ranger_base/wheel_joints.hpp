@@ -6,9 +6,9 @@
 
 #include <array>
 
-#include <ranger_can/codec.hpp>
-#include <ranger_can/frame.hpp>
-#include <ranger_can/geometry.hpp>
+#include <ranger_can/wire/codec.hpp>
+#include <ranger_can/wire/frame.hpp>
+#include <ranger_can/control/geometry.hpp>
 
 namespace ranger_base {
 

@@ -1,0 +1,222 @@
+// A virtual RANGER chassis: the chassis side of every frame in the protocol, over any Bus.
+//
+// Deterministic core: the owner feeds received frames with on_frame(frame, now) and calls
+// step(now) often (every few ms); the chassis advances its physics (chassis_model.hpp) to `now`
+// and sends every feedback frame that fell due at the manual's period, each computed from the
+// state at its due time. No clock is read and no thread is started here; VirtualChassisRunner
+// (virtual_chassis_runner.hpp) adds both for the CLI and tests on a real interface.
+//
+// Behaviour (manual section 3.2; readings of the manual's gaps are marked "reading"):
+//  * Boots in standby (or in remote mode if configured). In standby it obeys 0x421 only. In remote
+//    mode it ignores every CAN command, 0x421 included: the remote has the highest priority.
+//    In CAN command mode it obeys 0x111, 0x141, 0x421, 0x441 and 0x451.
+//  * 0x111 acts per the current motion mode, with the signs and units of interpretation.hpp.
+//    Reading: the Ackermann/oblique linear speed is the speed of the body centre.
+//  * Command watchdog: 500 ms after the last 0x111 the chassis stops by itself and sets error
+//    byte 6 bit 1 (host communication lost). Reading: the watchdog arms with the first 0x111 in
+//    CAN mode (a host that only switched modes has not lost anything); the bit describes the link,
+//    so it clears when 0x111 resumes (that 0x111 is obeyed) or on 0x441 code 0x00, which also
+//    disarms the watchdog until the next 0x111.
+//  * 0x141 starts a switch: the body brakes to rest, then the wheels turn for
+//    `mode_switch_duration`; meanwhile 0x291 reports the mode being left with switching = 1 and
+//    speed commands are ignored. A 0x141 naming the current mode changes nothing.
+//  * 0x111's linear speed is the body centre's (interpretation point 7).
+//  * 0x221: Ackermann — (alpha+beta)/2 of the front wheels and the mean of the four wheel speeds
+//    (point 8); oblique — the mean of the four wheel angles and of the four speeds; spin — the
+//    mean of the absolute wheel angles and (point 9, as the vendor's driver expects) the signed
+//    tangential wheel speed, counter-clockwise positive.
+//  * Motion is refused (the chassis brakes to rest and ignores 0x111's motion) while: not in CAN
+//    mode, e-stop, a critical error bit (protocol::is_critical_error), battery under-voltage
+//    (set whenever SOC < 10 %, latched until 0x441 0x09 / 0x00 finds the SOC back at >= 10 %),
+//    ultrasonic avoidance triggered, host communication lost, or switching.
+//  * Vehicle status (0x211 byte 0): e-stop -> emergency stop, any error bit -> abnormal.
+//  * 0x45A goes out after every 0x451 and whenever the setting changes otherwise.
+//
+// Not thread-safe: one thread drives it (VirtualChassisRunner serialises access).
+#pragma once
+
+#include <array>
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "ranger_can/transport/bus.hpp"
+#include "ranger_can/sim/chassis_model.hpp"
+#include "ranger_can/wire/codec.hpp"
+#include "ranger_can/sim/drivetrain_model.hpp"
+#include "ranger_can/wire/frame.hpp"
+#include "ranger_can/control/geometry.hpp"
+#include "ranger_can/wire/protocol.hpp"
+
+namespace ranger::sim {
+
+struct VirtualChassisConfig {
+  VehicleGeometry geometry;
+  MotionLimits limits;
+  DrivetrainConfig drivetrain;
+  std::chrono::nanoseconds mode_switch_duration = std::chrono::milliseconds(500);
+  std::chrono::nanoseconds command_timeout =
+      std::chrono::milliseconds(protocol::kChassisCommandTimeoutMs);
+  double initial_soc = 90.0;         // %
+  bool boot_in_remote_mode = false;  // remote control switched on with SWB in remote position
+  // Ultrasonic sensors 1..8 (raw: >= 0 distance in mm, < 0 a protocol::UltrasonicCode).
+  std::array<std::int16_t, protocol::kUltrasonicCount> ultrasonic{3000, 3000, 3000, 3000,
+                                                                  3000, 3000, 3000, 3000};
+  bool ultrasonic_enabled = false;
+  std::int16_t ultrasonic_stop_distance_mm = 300;  // avoidance triggers below this (if enabled)
+  std::uint32_t garbage_seed = 1;                  // the garbage-frame generator is deterministic
+};
+
+// Something the chassis did that a person watching would want to know.
+struct SimEvent {
+  Timestamp time{0};
+  std::string text;
+};
+
+// Everything observable about the chassis, for the CLI and tests.
+struct ChassisSnapshot {
+  Timestamp time{0};
+  protocol::ControlMode control_mode = protocol::ControlMode::kStandby;
+  protocol::MotionMode motion_mode = protocol::MotionMode::kAckermann;
+  bool switching = false;
+  protocol::MotionMode switch_target = protocol::MotionMode::kAckermann;
+  protocol::VehicleStatus vehicle_status = protocol::VehicleStatus::kNormal;
+  std::uint32_t error_bits = 0;
+  bool emergency_stop = false;
+  bool host_link_lost = false;
+  bool motion_allowed = false;        // would a 0x111 move the chassis now?
+  std::string motion_refused_reason;  // empty when allowed
+  bool silent = false;
+  bool ultrasonic_enabled = false;
+  MotionTarget target;  // REP-103
+  double speed = 0.0;   // model speed (see MotionTarget)
+  double steering = 0.0;
+  BodyTwist twist;
+  WheelStates wheels{};
+  Pose2D pose;                      // ground truth
+  double distance_travelled = 0.0;  // m, path length of the body centre since boot
+  double yaw_travelled = 0.0;       // rad, total |rotation| since boot
+  BatteryTelemetry battery;
+};
+
+struct VirtualChassisCounters {
+  std::uint64_t frames_received = 0;  // frames handed to on_frame
+  std::uint64_t frames_ignored = 0;   // valid commands the current mode does not accept
+  std::uint64_t frames_rejected = 0;  // unknown IDs, bad DLC, feedback IDs, error frames
+  std::uint64_t frames_sent = 0;
+  std::uint64_t send_failures = 0;    // bus refused a frame (e.g. queue full)
+  std::uint64_t motion_commands = 0;  // 0x111 obeyed
+};
+
+class VirtualChassis {
+ public:
+  // `bus` must outlive the chassis. `boot_time` is the time of power-on in the caller's clock.
+  VirtualChassis(Bus& bus, const VirtualChassisConfig& config, Timestamp boot_time);
+
+  // Handles one frame received at `now` (advancing to `now` first). Frames that are not RANGER
+  // commands are counted and ignored.
+  void on_frame(const CanFrame& frame, Timestamp now);
+  // Advances to `now` and sends the feedback that fell due. Time never runs backwards: an
+  // earlier `now` is treated as the last one.
+  void step(Timestamp now);
+  // Convenience: hands every frame waiting on the bus to on_frame, then steps to `now`.
+  void poll(Timestamp now);
+  // The earliest time at which step() has something to do (a feedback frame or a timeout).
+  Timestamp next_deadline() const;
+  Timestamp now() const { return now_; }
+
+  ChassisSnapshot snapshot() const;
+  const ChassisModel& motion() const { return motion_; }
+  const DrivetrainModel& drivetrain() const { return drivetrain_; }
+  const VirtualChassisCounters& counters() const { return counters_; }
+  // Events since the last call, oldest first (bounded: the oldest are dropped beyond 1000).
+  std::vector<SimEvent> take_events();
+
+  // ---- fault injection (each takes effect at the current time; call step() to see frames) ----
+  // The remote control takes over (SWB to remote): control mode remote, CAN commands ignored.
+  void remote_takeover();
+  // SWB back up hands control to CAN command mode; `to_standby` instead models the remote being
+  // switched off (standby, the host must request CAN mode again).
+  void remote_hand_back(bool to_standby = false);
+  // Remote control lost-connection protection: standby, error byte 7 bit 2.
+  void remote_signal_lost();
+  void set_emergency_stop(bool on);
+  // Sets (or clears) any 0x211 error bit, by position in the 32-bit error word.
+  void set_error_bit(int index, bool on);
+  void set_error_bits(std::uint32_t bits);  // replaces the injected set entirely
+  void set_battery_soc(double soc_percent);
+  // Stops sending anything (frames that fall due are skipped) until resumed / for a while.
+  void set_silent(bool silent);
+  void silence_for(std::chrono::nanoseconds duration);
+  // Sends `count` frames a driver must reject (unknown IDs, RANGER IDs with a wrong DLC) at the
+  // next step.
+  void inject_garbage(int count);
+  // While set, a motion-mode switch never completes (0x291 keeps switching = 1).
+  void set_mode_switch_stuck(bool stuck);
+  // Does what 0x441 with `code` does (0x00..0x10); false for an unknown code.
+  bool clear_errors(std::uint8_t code);
+  void set_ultrasonic(int sensor, std::int16_t raw);  // sensor 1..8
+  void set_ultrasonic_enabled(bool enabled);          // the remote's SWC switch (no 0x451 involved)
+  void set_pose(const Pose2D& pose) { motion_.set_pose(pose); }
+
+ private:
+  struct Schedule {
+    std::chrono::nanoseconds period;
+    Timestamp next_due;
+  };
+  enum ScheduleId { kFast, kUltrasonic, kSlow, kBms, kScheduleCount };
+
+  Timestamp next_timed_event() const;  // feedback due, watchdog, end of silence
+  void advance_to(Timestamp t);
+  void integrate(Timestamp t);
+  void send_due(ScheduleId which, Timestamp t);
+  void send(const Message& message, Timestamp t);
+  void send_raw(CanFrame frame, Timestamp t);
+  void update_conditions(Timestamp t);
+  void apply_motion_policy();
+  std::string refusal_reason() const;
+  void event(std::string text);
+
+  void handle_motion_command(const MotionCommand& cmd);
+  void handle_motion_mode(const MotionModeCommand& cmd);
+  void handle_control_mode(const ControlModeCommand& cmd);
+  void handle_ultrasonic_setting(const UltrasonicSettingCommand& cmd);
+  void set_control_mode(protocol::ControlMode mode, const std::string& why);
+
+  std::uint32_t error_word() const;
+  protocol::VehicleStatus vehicle_status() const;
+  bool ultrasonic_triggered() const;
+  Message motion_feedback() const;
+
+  Bus& bus_;
+  VirtualChassisConfig config_;
+  ChassisModel motion_;
+  DrivetrainModel drivetrain_;
+  Timestamp now_;
+
+  protocol::ControlMode control_mode_ = protocol::ControlMode::kStandby;
+  MotionTarget commanded_;  // last obeyed 0x111 in REP-103 terms
+  bool watchdog_armed_ = false;
+  Timestamp last_motion_command_{0};
+  bool host_link_lost_ = false;
+  bool emergency_stop_ = false;
+  std::uint32_t latched_errors_ = 0;  // injected faults and latched conditions
+  bool ultrasonic_enabled_ = false;
+  std::array<std::int16_t, protocol::kUltrasonicCount> ultrasonic_{};
+  bool silent_ = false;
+  std::optional<Timestamp> silent_until_;
+  int garbage_pending_ = 0;
+  std::mt19937 garbage_rng_;
+  std::array<Schedule, kScheduleCount> schedules_;
+  std::uint32_t last_reported_errors_ = 0;
+  std::string last_refusal_;
+
+  VirtualChassisCounters counters_;
+  std::deque<SimEvent> events_;
+};
+
+}  // namespace ranger::sim

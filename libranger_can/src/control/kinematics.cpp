@@ -1,0 +1,376 @@
+#include "ranger_can/control/kinematics.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "ranger_can/wire/interpretation.hpp"
+
+namespace ranger {
+namespace {
+
+using protocol::MotionMode;
+namespace interp = ranger::interpretation;
+
+// Below this a twist component counts as absent (for flags and degenerate geometry only; the
+// mode thresholds live in ModeSelectorConfig).
+constexpr double kEps = 1e-9;
+
+double sign(double v) {
+  return v < 0.0 ? -1.0 : 1.0;
+}
+
+// Folds a direction into [-pi/2, pi/2]; returns whether the rolling speed must be negated.
+bool fold_half_plane(double& angle) {
+  if (angle > M_PI / 2) {
+    angle -= M_PI;
+    return true;
+  }
+  if (angle < -M_PI / 2) {
+    angle += M_PI;
+    return true;
+  }
+  return false;
+}
+
+Status check_limit(const char* name, double value, double max) {
+  if (!std::isfinite(value) || value <= 0.0 || value > max * (1.0 + 1e-9)) {
+    return Error{Errc::kOutOfRange, std::string("kinematics limits: ") + name + " = " +
+                                        std::to_string(value) + " is not in (0, " +
+                                        std::to_string(max) + "]"};
+  }
+  return ok_status();
+}
+
+// The speed limit that applies at a steering angle (the manual's "> 20 degrees" clause).
+double speed_limit_at(double steering, const KinematicsLimits& limits) {
+  double limit = limits.max_linear_speed;
+  if (std::fabs(steering) > interp::kLargeSteeringThresholdRad) {
+    limit = std::min(limit, limits.max_speed_at_large_steering);
+  }
+  return limit;
+}
+
+double saturate_speed(double speed, double limit, std::uint32_t& flags) {
+  if (std::fabs(speed) > limit) {
+    flags |= kSpeedSaturated;
+    return sign(speed) * limit;
+  }
+  return speed;
+}
+
+void solve_ackermann(const BodyTwist& t, const VehicleGeometry& g, const KinematicsLimits& limits,
+                     KinematicsSolution& s) {
+  if (std::fabs(t.vy) > kEps) s.flags |= kLateralDropped;
+  const double max_steer = limits.max_ackermann_steering;
+  double steering = 0.0;       // REP-103: positive = left
+  double command_speed = 0.0;  // 0x111 linear speed
+  double curvature = 0.0;
+  if (std::fabs(t.vx) <= kEps) {
+    // A rotation without forward speed has infinite curvature: Ackermann cannot do it. Turn the
+    // wheels to full lock towards the rotation (ready to drive it) but do not move.
+    if (std::fabs(t.wz) > kEps) {
+      steering = sign(t.wz) * max_steer;
+      s.flags |= kRotationDropped | kSteeringSaturated;
+    }
+  } else {
+    curvature = t.wz / t.vx;
+    const double max_curvature = max_ackermann_curvature(max_steer, g);
+    if (std::fabs(curvature) > max_curvature) {
+      curvature = sign(curvature) * max_curvature;  // sign kept: the turn is only wider
+      s.flags |= kSteeringSaturated;
+    }
+    steering = std::clamp(interp::ackermann_mean_front_angle(curvature, g.wheelbase, g.track),
+                          -max_steer, max_steer);
+    // The speed limits bound the value on the wire; interpretation point 7 relates it to vx.
+    command_speed =
+        saturate_speed(interp::command_speed_from_body_speed(t.vx, curvature, g.wheelbase, g.track),
+                       speed_limit_at(steering, limits), s.flags);
+  }
+  const double speed =
+      interp::body_speed_from_command_speed(command_speed, curvature, g.wheelbase, g.track);
+  s.command.linear_speed = command_speed;
+  s.command.steering_angle = interp::manual_from_rep103_command_steering(steering);
+  s.achieved = BodyTwist{speed, 0.0, curvature * speed};
+}
+
+void solve_oblique(const BodyTwist& t, const VehicleGeometry& g, const KinematicsLimits& limits,
+                   const ObliqueSideHint& hint, KinematicsSolution& s) {
+  if (std::fabs(t.wz) > kEps) s.flags |= kRotationDropped;
+  double speed = std::hypot(t.vx, t.vy);
+  double direction = 0.0;  // REP-103
+  if (speed > kEps) {
+    direction = std::atan2(t.vy, t.vx);
+    if (fold_half_plane(direction)) speed = -speed;  // a backwards crab
+    // Near +-90 deg the two folds are the same wheel line, a hair apart in direction but 180 deg
+    // apart for the wheels: take the hinted side (beyond 90 deg the limit below clamps it).
+    const bool hint_applies = hint.side != 0.0 && hint.band > 0.0 && hint.band < M_PI / 2;
+    if (hint_applies && std::fabs(direction) >= M_PI / 2 - hint.band &&
+        sign(direction) != sign(hint.side)) {
+      direction += sign(hint.side) * M_PI;
+      speed = -speed;
+    }
+    const double max_steer = limits.max_oblique_steering;
+    if (std::fabs(direction) > max_steer) {
+      direction = sign(direction) * max_steer;
+      s.flags |= kSteeringSaturated;
+    }
+    speed = saturate_speed(speed, speed_limit_at(direction, limits), s.flags);
+  } else {
+    speed = 0.0;
+  }
+  // All wheels parallel: curvature 0, where the body and every wheel move alike (point 7).
+  s.command.linear_speed = interp::command_speed_from_body_speed(speed, 0.0, g.wheelbase, g.track);
+  s.command.steering_angle = interp::manual_from_rep103_command_steering(direction);
+  s.achieved = BodyTwist{speed * std::cos(direction), speed * std::sin(direction), 0.0};
+}
+
+void solve_spin(const BodyTwist& t, const VehicleGeometry& g, const KinematicsLimits& limits,
+                KinematicsSolution& s) {
+  if (std::fabs(t.vx) > kEps || std::fabs(t.vy) > kEps) s.flags |= kTranslationDropped;
+  double wheel_speed = interp::spin_wheel_speed_from_yaw_rate(t.wz, g.wheelbase, g.track);
+  if (std::fabs(wheel_speed) > limits.max_spin_wheel_speed) {
+    wheel_speed = sign(wheel_speed) * limits.max_spin_wheel_speed;
+    s.flags |= kSpinSaturated;
+  }
+  s.command.spin_speed = wheel_speed;  // 0x111 spin speed is counter-clockwise positive too
+  s.achieved = BodyTwist{0.0, 0.0,
+                         interp::spin_yaw_rate_from_wheel_speed(wheel_speed, g.wheelbase, g.track)};
+}
+
+}  // namespace
+
+Status KinematicsLimits::validate() const {
+  const struct {
+    const char* name;
+    double value;
+    double max;
+  } checks[] = {
+      {"max_linear_speed", max_linear_speed, interp::kMaxLinearSpeedMps},
+      {"max_speed_at_large_steering", max_speed_at_large_steering, interp::kMaxLinearSpeedMps},
+      {"max_ackermann_steering", max_ackermann_steering, kMaxAckermannSteeringRad},
+      {"max_oblique_steering", max_oblique_steering, kMaxObliqueSteeringRad},
+      {"max_spin_wheel_speed", max_spin_wheel_speed, kMaxSpinSpeedMps},
+  };
+  for (const auto& c : checks) {
+    Status st = check_limit(c.name, c.value, c.max);
+    if (!st) return st;
+  }
+  return ok_status();
+}
+
+std::string kinematics_flags_to_string(std::uint32_t flags) {
+  if (flags == kKinematicsExact) return "exact";
+  static const struct {
+    std::uint32_t bit;
+    const char* name;
+  } kNames[] = {
+      {kSpeedSaturated, "speed_saturated"},   {kSteeringSaturated, "steering_saturated"},
+      {kSpinSaturated, "spin_saturated"},     {kLateralDropped, "lateral_dropped"},
+      {kRotationDropped, "rotation_dropped"}, {kTranslationDropped, "translation_dropped"}};
+  std::string out;
+  for (const auto& n : kNames) {
+    if (flags & n.bit) {
+      if (!out.empty()) out += '|';
+      out += n.name;
+    }
+  }
+  return out.empty() ? "unknown_flags" : out;
+}
+
+double max_ackermann_curvature(double max_steering, const VehicleGeometry& geometry) {
+  return std::fabs(interp::ackermann_curvature_from_mean_angle(std::fabs(max_steering),
+                                                               geometry.wheelbase, geometry.track));
+}
+
+Result<KinematicsSolution> solve_kinematics(const BodyTwist& twist, MotionMode mode,
+                                            const VehicleGeometry& geometry,
+                                            const KinematicsLimits& limits,
+                                            const ObliqueSideHint& oblique_hint) {
+  const struct {
+    const char* name;
+    double value;
+  } components[] = {{"vx", twist.vx}, {"vy", twist.vy}, {"wz", twist.wz}};
+  for (const auto& c : components) {
+    if (!std::isfinite(c.value)) {
+      return Error{Errc::kNotFinite, std::string("kinematics: twist.") + c.name + " is " +
+                                         (std::isnan(c.value) ? "NaN" : "infinite")};
+    }
+  }
+  if (Status st = limits.validate(); !st) return Error{Errc::kInvalidArgument, st.error().message};
+  if (Status st = geometry.validate(); !st)
+    return Error{Errc::kInvalidArgument, st.error().message};
+
+  KinematicsSolution s;
+  s.mode = mode;
+  switch (mode) {
+    case MotionMode::kAckermann:
+      solve_ackermann(twist, geometry, limits, s);
+      break;
+    case MotionMode::kOblique:
+      solve_oblique(twist, geometry, limits, oblique_hint, s);
+      break;
+    case MotionMode::kSpin:
+      solve_spin(twist, geometry, limits, s);
+      break;
+    default:
+      return Error{Errc::kInvalidArgument,
+                   "kinematics: unknown motion mode " + std::to_string(static_cast<int>(mode))};
+  }
+  return s;
+}
+
+BodyTwist twist_from_command(const MotionCommand& command, MotionMode mode,
+                             const VehicleGeometry& geometry) {
+  switch (mode) {
+    case MotionMode::kAckermann: {
+      const double steering = interp::rep103_from_manual_command_steering(command.steering_angle);
+      const double curvature =
+          interp::ackermann_curvature_from_mean_angle(steering, geometry.wheelbase, geometry.track);
+      // A steering of +-90 deg or more (far outside the 0x111 range) has an infinite curvature:
+      // no defined twist, and never a NaN.
+      if (!std::isfinite(curvature)) return BodyTwist{};
+      const double vx = interp::body_speed_from_command_speed(command.linear_speed, curvature,
+                                                              geometry.wheelbase, geometry.track);
+      return BodyTwist{vx, 0.0, curvature * vx};
+    }
+    case MotionMode::kOblique: {
+      const double direction = interp::rep103_from_manual_command_steering(command.steering_angle);
+      const double speed = interp::body_speed_from_command_speed(
+          command.linear_speed, 0.0, geometry.wheelbase, geometry.track);
+      return BodyTwist{speed * std::cos(direction), speed * std::sin(direction), 0.0};
+    }
+    case MotionMode::kSpin:
+      return BodyTwist{0.0, 0.0,
+                       interp::spin_yaw_rate_from_wheel_speed(command.spin_speed,
+                                                              geometry.wheelbase, geometry.track)};
+  }
+  return BodyTwist{};
+}
+
+WheelStates wheel_states_from_twist(const BodyTwist& twist, const VehicleGeometry& geometry,
+                                    const std::array<double, kWheelCount>& hold_angles) {
+  WheelStates wheels{};
+  for (int i = 0; i < kWheelCount; ++i) {
+    const WheelPosition p = geometry.wheel_position(i);
+    const double ux = twist.vx - twist.wz * p.y;
+    const double uy = twist.vy + twist.wz * p.x;
+    double speed = std::hypot(ux, uy);
+    double angle = hold_angles[static_cast<std::size_t>(i)];
+    if (speed > kEps) {
+      angle = std::atan2(uy, ux);
+      if (fold_half_plane(angle)) speed = -speed;
+    } else {
+      speed = 0.0;
+    }
+    wheels[static_cast<std::size_t>(i)] = WheelState{angle, speed};
+  }
+  return wheels;
+}
+
+// ---- ModeSelector --------------------------------------------------------------------------
+
+Status ModeSelectorConfig::validate() const {
+  const struct {
+    const char* name;
+    double value;
+  } values[] = {{"lateral_enter", lateral_enter},   {"lateral_exit", lateral_exit},
+                {"linear_enter", linear_enter},     {"linear_exit", linear_exit},
+                {"rotation_enter", rotation_enter}, {"rotation_exit", rotation_exit}};
+  for (const auto& v : values) {
+    if (!std::isfinite(v.value) || v.value < 0.0) {
+      return Error{Errc::kOutOfRange, std::string("mode selection: ") + v.name + " = " +
+                                          std::to_string(v.value) + " must be finite and >= 0"};
+    }
+  }
+  if (lateral_exit > lateral_enter) {
+    return Error{Errc::kInvalidArgument, "mode selection: lateral_exit must be <= lateral_enter"};
+  }
+  if (rotation_exit > rotation_enter) {
+    return Error{Errc::kInvalidArgument, "mode selection: rotation_exit must be <= rotation_enter"};
+  }
+  if (linear_exit < linear_enter) {
+    return Error{Errc::kInvalidArgument, "mode selection: linear_exit must be >= linear_enter"};
+  }
+  if (confirm_time.count() < 0 || min_dwell.count() < 0) {
+    return Error{Errc::kOutOfRange, "mode selection: confirm_time and min_dwell must be >= 0"};
+  }
+  if (!(oblique_side_band >= 0.0 && oblique_side_band < M_PI / 2)) {
+    return Error{Errc::kOutOfRange,
+                 "mode selection: oblique_side_band = " + std::to_string(oblique_side_band) +
+                     " is not in [0, pi/2) rad"};
+  }
+  return ok_status();
+}
+
+ModeSelector::ModeSelector(ModeSelectorConfig config) : config_(config) {}
+
+MotionMode ModeSelector::classify(const BodyTwist& t, MotionMode current) const {
+  const ModeSelectorConfig& c = config_;
+  const double lateral_threshold =
+      current == MotionMode::kOblique ? c.lateral_exit : c.lateral_enter;
+  const double linear_threshold = current == MotionMode::kSpin ? c.linear_exit : c.linear_enter;
+  const double rotation_threshold =
+      current == MotionMode::kSpin ? c.rotation_exit : c.rotation_enter;
+
+  if (std::fabs(t.vy) > lateral_threshold) return MotionMode::kOblique;
+  if (std::hypot(t.vx, t.vy) <= linear_threshold) {
+    // (Almost) no translation: a rotation is a spin, and standing still never switches.
+    return std::fabs(t.wz) > rotation_threshold ? MotionMode::kSpin : current;
+  }
+  // Translation without a lateral component: oblique drives straight as well, so it is kept
+  // until a real rotation is asked for; otherwise dual Ackermann.
+  if (current == MotionMode::kOblique && std::fabs(t.wz) <= c.rotation_enter) {
+    return MotionMode::kOblique;
+  }
+  return MotionMode::kAckermann;
+}
+
+MotionMode ModeSelector::select(const BodyTwist& twist, MotionMode current, Timestamp now) {
+  if (!have_current_ || current != current_) {
+    // The first mode seen is treated as long established (no dwell at start-up).
+    current_since_ = have_current_ ? now : now - config_.min_dwell;
+    current_ = current;
+    have_current_ = true;
+    have_candidate_ = false;
+  }
+  const MotionMode wanted = classify(twist, current);
+  if (wanted == current) {
+    have_candidate_ = false;
+    return current;
+  }
+  if (!have_candidate_ || candidate_ != wanted) {
+    candidate_ = wanted;
+    candidate_since_ = now;
+    have_candidate_ = true;
+  }
+  if (now - candidate_since_ >= config_.confirm_time && now - current_since_ >= config_.min_dwell) {
+    return wanted;
+  }
+  return current;
+}
+
+Result<KinematicsSolution> ModeSelector::solve(const BodyTwist& twist, MotionMode mode,
+                                               const VehicleGeometry& geometry,
+                                               const KinematicsLimits& limits) {
+  Result<KinematicsSolution> solution = solve_kinematics(
+      twist, mode, geometry, limits, ObliqueSideHint{oblique_side_, config_.oblique_side_band});
+  if (!solution) return solution;
+  if (solution->mode != MotionMode::kOblique) {
+    oblique_side_ = 0.0;
+  } else if (solution->command.linear_speed != 0.0) {
+    // A stopped command (steering 0) names no side: the previous one is kept.
+    const double steering =
+        interp::rep103_from_manual_command_steering(solution->command.steering_angle);
+    oblique_side_ = steering > 0.0 ? 1.0 : (steering < 0.0 ? -1.0 : 0.0);
+  }
+  return solution;
+}
+
+void ModeSelector::reset() {
+  have_current_ = false;
+  have_candidate_ = false;
+  oblique_side_ = 0.0;
+}
+
+}  // namespace ranger

@@ -1,0 +1,267 @@
+#include "ranger_can/control/odometry.hpp"
+
+#include <cmath>
+#include <string>
+#include <type_traits>
+#include <variant>
+
+#include "ranger_can/wire/interpretation.hpp"
+
+namespace ranger {
+namespace {
+
+namespace interp = ranger::interpretation;
+using protocol::MotionMode;
+
+bool known_motion_mode(std::uint8_t raw) {
+  return raw == static_cast<std::uint8_t>(MotionMode::kAckermann) ||
+         raw == static_cast<std::uint8_t>(MotionMode::kOblique) ||
+         raw == static_cast<std::uint8_t>(MotionMode::kSpin);
+}
+
+}  // namespace
+
+std::string_view to_string(OdometrySource s) {
+  return s == OdometrySource::kMotion ? "motion" : "wheels";
+}
+
+Result<OdometrySource> parse_odometry_source(std::string_view text) {
+  if (text == "wheels") return OdometrySource::kWheels;
+  if (text == "motion") return OdometrySource::kMotion;
+  return Error{Errc::kInvalidArgument,
+               "odometry source '" + std::string(text) + "' is neither 'wheels' nor 'motion'"};
+}
+
+Status OdometryConfig::validate() const {
+  if (Status st = geometry.validate(); !st) return st;
+  if (wheel_data_timeout.count() <= 0) {
+    return Error{Errc::kOutOfRange, "odometry: wheel_data_timeout must be > 0"};
+  }
+  if (max_step.count() <= 0) return Error{Errc::kOutOfRange, "odometry: max_step must be > 0"};
+  const struct {
+    const char* name;
+    double value;
+  } variances[] = {{"twist_variance_linear", twist_variance_linear},
+                   {"twist_variance_angular", twist_variance_angular},
+                   {"initial_pose_variance_xy", initial_pose_variance_xy},
+                   {"initial_pose_variance_yaw", initial_pose_variance_yaw},
+                   {"pose_variance_per_meter", pose_variance_per_meter},
+                   {"yaw_variance_per_radian", yaw_variance_per_radian},
+                   {"yaw_variance_per_meter", yaw_variance_per_meter}};
+  for (const auto& v : variances) {
+    if (!std::isfinite(v.value) || v.value < 0.0) {
+      return Error{Errc::kOutOfRange, std::string("odometry: ") + v.name + " = " +
+                                          std::to_string(v.value) + " must be finite and >= 0"};
+    }
+  }
+  return ok_status();
+}
+
+BodyTwist fit_body_twist(const std::array<WheelMeasurement, kWheelCount>& wheels,
+                         const VehicleGeometry& geometry) {
+  // Rows per wheel: [1 0 -y_i] and [0 1 x_i]; normal matrix N = A^T A and right side A^T r.
+  double sx = 0.0, sy = 0.0, sr2 = 0.0;
+  double bu = 0.0, bw = 0.0, bt = 0.0;
+  for (int i = 0; i < kWheelCount; ++i) {
+    const WheelPosition p = geometry.wheel_position(i);
+    const WheelMeasurement& m = wheels[static_cast<std::size_t>(i)];
+    const double u = m.speed * std::cos(m.angle);
+    const double w = m.speed * std::sin(m.angle);
+    sx += p.x;
+    sy += p.y;
+    sr2 += p.x * p.x + p.y * p.y;
+    bu += u;
+    bw += w;
+    bt += p.x * w - p.y * u;
+  }
+  const double n = kWheelCount;
+  // N = [[n, 0, -sy], [0, n, sx], [-sy, sx, sr2]]. Rows 1 and 2 give vx = (bu + sy*wz)/n and
+  // vy = (bw - sx*wz)/n; row 3 (-sy*vx + sx*vy + sr2*wz = bt) then yields wz. The denominator is
+  // the wheels' spread about their centroid: positive unless all wheels sit on one point.
+  const double spread = sr2 - (sx * sx + sy * sy) / n;
+  if (!(spread > 1e-12)) return BodyTwist{};
+  const double wz = (bt + sy * bu / n - sx * bw / n) / spread;
+  return BodyTwist{(bu + sy * wz) / n, (bw - sx * wz) / n, wz};
+}
+
+BodyTwist twist_from_motion_feedback(const MotionFeedback& feedback, MotionMode mode,
+                                     const VehicleGeometry& geometry) {
+  switch (mode) {
+    case MotionMode::kAckermann: {
+      const double steering = interp::rep103_from_manual_steering(feedback.steering_angle);
+      const double k =
+          interp::ackermann_curvature_from_mean_angle(steering, geometry.wheelbase, geometry.track);
+      if (std::isinf(k)) {
+        // A reported angle of 90 deg or more (a corrupt frame): the limit of the formula below
+        // as k grows, a rotation about the body centre at the wheels' speed; inf * 0 would make
+        // the twist NaN.
+        return BodyTwist{
+            0.0, 0.0,
+            std::copysign(1.0, k) * interp::spin_yaw_rate_from_feedback_speed(
+                                        feedback.speed, geometry.wheelbase, geometry.track)};
+      }
+      const double vx = interp::ackermann_body_speed_from_feedback_speed(
+          feedback.speed, k, geometry.wheelbase, geometry.track);
+      return BodyTwist{vx, 0.0, k * vx};
+    }
+    case MotionMode::kOblique: {
+      const double direction = interp::rep103_from_manual_steering(feedback.steering_angle);
+      return BodyTwist{feedback.speed * std::cos(direction), feedback.speed * std::sin(direction),
+                       0.0};
+    }
+    case MotionMode::kSpin:
+      return BodyTwist{0.0, 0.0,
+                       interp::spin_yaw_rate_from_feedback_speed(feedback.speed, geometry.wheelbase,
+                                                                 geometry.track)};
+  }
+  return BodyTwist{};
+}
+
+Pose2D integrate_pose(const Pose2D& pose, const BodyTwist& twist, double dt) {
+  const double dyaw = twist.wz * dt;
+  // Body-frame displacement along the arc of constant (vx, vy, wz): the integral of
+  // R(wz*t) (vx, vy) dt, written with sin(d)/d and (1-cos d)/d to stay exact near d = 0.
+  double s_over, c_over;  // sin(d)/d and (1 - cos(d))/d
+  if (std::fabs(dyaw) < 1e-6) {
+    s_over = 1.0 - dyaw * dyaw / 6.0;
+    c_over = dyaw / 2.0 - dyaw * dyaw * dyaw / 24.0;
+  } else {
+    s_over = std::sin(dyaw) / dyaw;
+    c_over = (1.0 - std::cos(dyaw)) / dyaw;
+  }
+  const double bx = (twist.vx * s_over - twist.vy * c_over) * dt;
+  const double by = (twist.vy * s_over + twist.vx * c_over) * dt;
+  const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);
+  return Pose2D{pose.x + c * bx - s * by, pose.y + s * bx + c * by,
+                wrap_angle(pose.yaw + dyaw)};
+}
+
+Odometry::Odometry(OdometryConfig config) : config_(std::move(config)) {
+  reset();
+}
+
+void Odometry::reset(const Pose2D& pose) {
+  state_ = OdometryState{};
+  state_.pose = Pose2D{pose.x, pose.y, wrap_angle(pose.yaw)};
+  state_.pose_variance = {config_.initial_pose_variance_xy, config_.initial_pose_variance_xy,
+                          config_.initial_pose_variance_yaw};
+  state_.twist_variance = {config_.twist_variance_linear, config_.twist_variance_linear,
+                           config_.twist_variance_angular};
+  state_.active_source = config_.source;
+  anchored_ = false;
+  previous_twist_ = BodyTwist{};
+}
+
+bool Odometry::on_frame(const CanFrame& frame) {
+  if (frame.is_error) return false;
+  switch (frame.id) {
+    case protocol::kMotionFeedbackId:
+    case protocol::kSteeringAnglesId:
+    case protocol::kWheelSpeedsId:
+    case protocol::kMotionModeFeedbackId:
+      break;
+    default:
+      return false;  // not odometry input: skip the decoding
+  }
+  Result<Message> message = decode(frame);
+  if (!message) return false;
+  return on_message(*message, frame.stamp);
+}
+
+bool Odometry::on_message(const Message& message, Timestamp stamp) {
+  return std::visit(
+      [&](const auto& m) -> bool {
+        using T = std::decay_t<decltype(m)>;
+        if constexpr (std::is_same_v<T, SteeringAnglesFeedback>) {
+          return on_steering_angles(m, stamp);
+        } else if constexpr (std::is_same_v<T, WheelSpeedsFeedback>) {
+          return on_wheel_speeds(m, stamp);
+        } else if constexpr (std::is_same_v<T, MotionFeedback>) {
+          return on_motion_feedback(m, stamp);
+        } else if constexpr (std::is_same_v<T, MotionModeFeedback>) {
+          return on_motion_mode(m, stamp);
+        } else {
+          return false;
+        }
+      },
+      message);
+}
+
+bool Odometry::on_steering_angles(const SteeringAnglesFeedback& m, Timestamp stamp) {
+  angles_ = m;
+  angles_stamp_ = stamp;
+  have_angles_ = true;
+  return false;
+}
+
+bool Odometry::on_motion_mode(const MotionModeFeedback& m, Timestamp) {
+  if (known_motion_mode(m.mode_raw)) mode_ = m.mode;
+  return false;
+}
+
+bool Odometry::wheels_fresh(Timestamp stamp) const {
+  const auto fresh = [&](Timestamp t) {
+    const auto age = stamp - t;
+    return (age < Timestamp{0} ? -age : age) <= config_.wheel_data_timeout;
+  };
+  return have_angles_ && have_speeds_ && fresh(angles_stamp_) && fresh(speeds_stamp_);
+}
+
+bool Odometry::on_wheel_speeds(const WheelSpeedsFeedback& m, Timestamp stamp) {
+  have_speeds_ = true;
+  speeds_stamp_ = stamp;
+  if (config_.source != OdometrySource::kWheels || !wheels_fresh(stamp)) return false;
+  std::array<WheelMeasurement, kWheelCount> wheels{};
+  for (std::size_t i = 0; i < wheels.size(); ++i) {
+    wheels[i].angle = interp::rep103_from_manual_wheel_angle(angles_.angles[i]);
+    wheels[i].speed = m.speeds[i];
+  }
+  return step(fit_body_twist(wheels, config_.geometry), stamp, OdometrySource::kWheels);
+}
+
+bool Odometry::on_motion_feedback(const MotionFeedback& m, Timestamp stamp) {
+  const bool fallback = config_.source == OdometrySource::kWheels;
+  if (fallback && wheels_fresh(stamp)) return false;  // the per-wheel fit drives the pose
+  const bool advanced =
+      step(twist_from_motion_feedback(m, mode_, config_.geometry), stamp, OdometrySource::kMotion);
+  if (advanced && fallback) ++state_.fallback_steps;
+  return advanced;
+}
+
+bool Odometry::step(const BodyTwist& twist, Timestamp stamp, OdometrySource source) {
+  if (!std::isfinite(twist.vx) || !std::isfinite(twist.vy) || !std::isfinite(twist.wz)) {
+    ++state_.skipped_steps;  // never let one bad estimate poison the pose
+    return false;
+  }
+  state_.twist = twist;
+  state_.active_source = source;
+  const auto reanchor = [&]() {
+    anchored_ = stamp.count() != 0;
+    state_.stamp = stamp;
+    previous_twist_ = twist;
+    ++state_.skipped_steps;
+    return false;
+  };
+  if (stamp.count() == 0 || !anchored_) return reanchor();
+  const auto elapsed = stamp - state_.stamp;
+  if (elapsed.count() == 0) return false;  // a second frame of the same instant: nothing to add
+  if (elapsed.count() < 0 || elapsed > config_.max_step) return reanchor();
+
+  const double dt = seconds(elapsed);
+  const BodyTwist mean{(previous_twist_.vx + twist.vx) / 2.0, (previous_twist_.vy + twist.vy) / 2.0,
+                       (previous_twist_.wz + twist.wz) / 2.0};
+  state_.pose = integrate_pose(state_.pose, mean, dt);
+  const double ds = std::hypot(mean.vx, mean.vy) * dt;
+  const double dyaw = std::fabs(mean.wz) * dt;
+  state_.distance += ds;
+  state_.pose_variance[0] += config_.pose_variance_per_meter * ds;
+  state_.pose_variance[1] += config_.pose_variance_per_meter * ds;
+  state_.pose_variance[2] +=
+      config_.yaw_variance_per_radian * dyaw + config_.yaw_variance_per_meter * ds;
+  state_.stamp = stamp;
+  previous_twist_ = twist;
+  ++state_.steps;
+  return true;
+}
+
+}  // namespace ranger

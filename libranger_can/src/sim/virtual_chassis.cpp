@@ -1,0 +1,713 @@
+#include "ranger_can/sim/virtual_chassis.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <type_traits>
+#include <utility>
+
+#include "ranger_can/wire/interpretation.hpp"
+
+namespace ranger::sim {
+
+namespace {
+
+using namespace std::chrono_literals;
+using protocol::ControlMode;
+using protocol::error_bit_index;
+using protocol::MotionMode;
+
+std::uint32_t bit(int byte, int b) {
+  return 1u << error_bit_index(byte, b);
+}
+
+// 0x211 error bits the chassis itself drives (positions per PROTOCOL.md).
+const std::uint32_t kBatteryUnderVoltage = bit(7, 0);
+const std::uint32_t kUltrasonicTriggered = bit(7, 1);
+const std::uint32_t kRemoteLost = bit(7, 2);
+const std::uint32_t kHostCommLost = bit(6, 1);
+const std::uint32_t kDriverStatusError = bit(6, 0);
+const std::uint32_t kOverTemperature = bit(6, 6);
+const std::uint32_t kOverCurrent = bit(6, 7);
+
+// Communication fault bit of motor driver n = 1..8.
+std::uint32_t motor_comm_bit(int n) {
+  return n <= 4 ? bit(7, 2 + n) : bit(6, n - 3);
+}
+// Steering calibration fault of steering motor n = 5..8 (byte 5 bits 0..3).
+std::uint32_t steering_calib_bit(int n) {
+  return bit(5, n - 5);
+}
+
+// Driver status bits of 0x261-0x268 byte 5 (PROTOCOL.md).
+constexpr std::uint8_t kDriverSupplyLow = 1u << 0;
+constexpr std::uint8_t kDriverMotorOverTemp = 1u << 1;
+constexpr std::uint8_t kDriverOverCurrent = 1u << 2;
+constexpr std::uint8_t kDriverOverTemp = 1u << 3;
+constexpr std::uint8_t kDriverError = 1u << 5;
+constexpr std::uint8_t kDriverDisabled = 1u << 6;
+// BMS alarm/warning status 1, bit 2: under-voltage.
+constexpr std::uint8_t kBmsUnderVoltage = 1u << 2;
+
+constexpr double kLowBatteryCutoffSoc = 10.0;   // manual: under 10 % the drivers lose power
+constexpr double kLowBatteryWarningSoc = 15.0;  // manual: under 15 % the lights flash
+constexpr std::size_t kMaxEvents = 1000;
+
+std::string names_of(std::uint32_t bits) {
+  std::string out;
+  for (const auto& n : protocol::error_bit_names(bits))
+    out += (out.empty() ? "" : ",") + n;
+  return out;
+}
+
+std::string format_pct(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1f%%", v);
+  return buf;
+}
+
+}  // namespace
+
+VirtualChassis::VirtualChassis(Bus& bus, const VirtualChassisConfig& config, Timestamp boot_time)
+    : bus_(bus),
+      config_(config),
+      motion_(config.geometry, config.limits),
+      drivetrain_(config.drivetrain, config.initial_soc),
+      now_(boot_time),
+      ultrasonic_enabled_(config.ultrasonic_enabled),
+      ultrasonic_(config.ultrasonic),
+      garbage_rng_(config.garbage_seed) {
+  schedules_[kFast] = {std::chrono::milliseconds(protocol::kFastPeriodMs), boot_time};
+  schedules_[kUltrasonic] = {std::chrono::milliseconds(protocol::kUltrasonicPeriodMs), boot_time};
+  schedules_[kSlow] = {std::chrono::milliseconds(protocol::kSlowPeriodMs), boot_time};
+  schedules_[kBms] = {std::chrono::milliseconds(protocol::kBmsPeriodMs), boot_time};
+  control_mode_ = config.boot_in_remote_mode ? ControlMode::kRemote : ControlMode::kStandby;
+  event(std::string("power on in ") + std::string(protocol::to_string(control_mode_)) +
+        " mode, motion mode " + std::string(protocol::to_string(motion_.mode())) + ", battery " +
+        format_pct(drivetrain_.soc()));
+  update_conditions(now_);
+  apply_motion_policy();
+}
+
+// ---- time -------------------------------------------------------------------------------------
+
+Timestamp VirtualChassis::next_deadline() const {
+  return garbage_pending_ > 0 ? now_ : next_timed_event();
+}
+
+Timestamp VirtualChassis::next_timed_event() const {
+  Timestamp next = Timestamp::max();
+  for (const auto& s : schedules_)
+    next = std::min(next, s.next_due);
+  if (watchdog_armed_ && !host_link_lost_ && control_mode_ == ControlMode::kCan) {
+    next = std::min(next, last_motion_command_ + config_.command_timeout);
+  }
+  if (silent_until_) next = std::min(next, *silent_until_);
+  return next;
+}
+
+void VirtualChassis::step(Timestamp now) {
+  advance_to(now);
+  while (garbage_pending_ > 0) {
+    --garbage_pending_;
+    CanFrame f;
+    const bool unknown_id = (garbage_rng_() & 1u) != 0;
+    if (unknown_id) {
+      do {
+        f.id = garbage_rng_() & 0x7FFu;
+      } while (protocol::is_known_id(f.id));
+      f.dlc = static_cast<std::uint8_t>(garbage_rng_() % 9);
+    } else {
+      const auto ids = protocol::all_ids();
+      f.id = ids[garbage_rng_() % ids.size()];
+      const int expected = protocol::expected_dlc(f.id);
+      do {
+        f.dlc = static_cast<std::uint8_t>(garbage_rng_() % 9);
+      } while (f.dlc == expected);
+    }
+    for (int i = 0; i < f.dlc; ++i)
+      f.data[i] = static_cast<std::uint8_t>(garbage_rng_());
+    send_raw(f, now_);
+  }
+}
+
+void VirtualChassis::poll(Timestamp now) {
+  for (;;) {
+    auto r = bus_.receive(std::chrono::nanoseconds(0));
+    if (!r) break;
+    on_frame(*r, now);
+  }
+  step(now);
+}
+
+void VirtualChassis::advance_to(Timestamp t) {
+  t = std::max(t, now_);
+  // After a long stall, do not replay a burst of stale feedback: resume the schedule from now.
+  for (auto& s : schedules_) {
+    if (s.next_due + 5 * s.period < t) s.next_due = t;
+  }
+  for (;;) {
+    const Timestamp next = next_timed_event();
+    if (next > t) break;
+    integrate(next);
+    if (silent_until_ && *silent_until_ <= next) {
+      silent_until_.reset();
+      silent_ = false;
+      event("silence over: sending again");
+    }
+    if (watchdog_armed_ && !host_link_lost_ && control_mode_ == ControlMode::kCan &&
+        last_motion_command_ + config_.command_timeout <= next) {
+      host_link_lost_ = true;
+      commanded_.speed = 0.0;
+      event("no 0x111 for " + std::to_string(config_.command_timeout.count() / 1000000) +
+            " ms: host communication lost, stopping");
+    }
+    update_conditions(next);
+    apply_motion_policy();
+    for (int i = 0; i < kScheduleCount; ++i) {
+      if (schedules_[i].next_due <= next) {
+        send_due(static_cast<ScheduleId>(i), next);
+        schedules_[i].next_due += schedules_[i].period;
+      }
+    }
+  }
+  integrate(t);
+  update_conditions(t);
+  apply_motion_policy();
+}
+
+void VirtualChassis::integrate(Timestamp t) {
+  if (t <= now_) return;
+  const double dt = seconds(t - now_);
+  const bool was_switching = motion_.switching();
+  const bool powered = !emergency_stop_ && (error_word() & kBatteryUnderVoltage) == 0;
+  motion_.advance(dt);
+  drivetrain_.advance(dt, motion_, powered);
+  now_ = t;
+  if (was_switching && !motion_.switching()) {
+    commanded_ = MotionTarget{};
+    event("motion mode switch complete: " + std::string(protocol::to_string(motion_.mode())));
+  }
+}
+
+// ---- conditions and policy --------------------------------------------------------------------
+
+bool VirtualChassis::ultrasonic_triggered() const {
+  if (!ultrasonic_enabled_) return false;
+  return std::any_of(ultrasonic_.begin(), ultrasonic_.end(), [&](std::int16_t d) {
+    return d >= 0 && d < config_.ultrasonic_stop_distance_mm;
+  });
+}
+
+std::uint32_t VirtualChassis::error_word() const {
+  return latched_errors_ | (host_link_lost_ ? kHostCommLost : 0u) |
+         (ultrasonic_triggered() ? kUltrasonicTriggered : 0u);
+}
+
+protocol::VehicleStatus VirtualChassis::vehicle_status() const {
+  if (emergency_stop_) {
+    return interpretation::kVehicleStatus1IsEmergencyStop ? protocol::VehicleStatus::kEmergencyStop
+                                                          : protocol::VehicleStatus::kAbnormal;
+  }
+  return error_word() != 0 ? protocol::VehicleStatus::kAbnormal : protocol::VehicleStatus::kNormal;
+}
+
+std::string VirtualChassis::refusal_reason() const {
+  if (control_mode_ != ControlMode::kCan) {
+    return std::string("control mode is ") + std::string(protocol::to_string(control_mode_));
+  }
+  if (emergency_stop_) return "emergency stop";
+  const std::uint32_t errors = error_word();
+  if (errors & kBatteryUnderVoltage) return "battery under-voltage: drive power cut";
+  if (errors & kUltrasonicTriggered) return "ultrasonic obstacle avoidance triggered";
+  if (host_link_lost_) return "host communication lost";
+  if (protocol::is_critical_error(errors)) return "critical error: " + names_of(errors);
+  if (motion_.switching()) return "switching motion mode";
+  return {};
+}
+
+void VirtualChassis::update_conditions(Timestamp) {
+  if (drivetrain_.soc() < kLowBatteryCutoffSoc && (latched_errors_ & kBatteryUnderVoltage) == 0) {
+    latched_errors_ |= kBatteryUnderVoltage;
+    event("battery at " + format_pct(drivetrain_.soc()) + " (< 10%): drive power cut");
+  }
+  const std::uint32_t errors = error_word();
+  if (errors != last_reported_errors_) {
+    const std::uint32_t raised = errors & ~last_reported_errors_;
+    const std::uint32_t cleared = last_reported_errors_ & ~errors;
+    std::string text = "error bits 0x" + [&] {
+      char buf[16];
+      std::snprintf(buf, sizeof buf, "%08X", errors);
+      return std::string(buf);
+    }();
+    if (raised) text += " raised: " + names_of(raised);
+    if (cleared) text += std::string(raised ? ";" : "") + " cleared: " + names_of(cleared);
+    event(text);
+    last_reported_errors_ = errors;
+  }
+}
+
+void VirtualChassis::apply_motion_policy() {
+  const std::string reason = refusal_reason();
+  if (reason != last_refusal_) {
+    event(reason.empty() ? std::string("motion allowed") : "motion refused: " + reason);
+    last_refusal_ = reason;
+  }
+  if (!reason.empty()) {
+    commanded_.speed = 0.0;
+    const bool power_cut = emergency_stop_ || (error_word() & kBatteryUnderVoltage) != 0;
+    motion_.stop(power_cut);
+  } else {
+    motion_.set_target(commanded_);
+  }
+}
+
+void VirtualChassis::event(std::string text) {
+  events_.push_back({now_, std::move(text)});
+  while (events_.size() > kMaxEvents)
+    events_.pop_front();
+}
+
+std::vector<SimEvent> VirtualChassis::take_events() {
+  std::vector<SimEvent> out(events_.begin(), events_.end());
+  events_.clear();
+  return out;
+}
+
+// ---- received frames --------------------------------------------------------------------------
+
+void VirtualChassis::on_frame(const CanFrame& frame, Timestamp now) {
+  advance_to(now);
+  ++counters_.frames_received;
+  if (frame.is_error) {
+    ++counters_.frames_rejected;
+    return;
+  }
+  auto decoded = decode(frame);
+  if (!decoded) {
+    ++counters_.frames_rejected;
+    return;
+  }
+  const Message& msg = *decoded;
+  const bool is_command = std::holds_alternative<MotionCommand>(msg) ||
+                          std::holds_alternative<MotionModeCommand>(msg) ||
+                          std::holds_alternative<ControlModeCommand>(msg) ||
+                          std::holds_alternative<ErrorClearCommand>(msg) ||
+                          std::holds_alternative<UltrasonicSettingCommand>(msg);
+  if (!is_command) {  // feedback from another node (or our own echo): not for us
+    ++counters_.frames_rejected;
+    return;
+  }
+  // Standby answers control-mode frames only; in remote mode the remote blocks CAN entirely.
+  const bool accepted =
+      control_mode_ == ControlMode::kCan ||
+      (control_mode_ == ControlMode::kStandby && std::holds_alternative<ControlModeCommand>(msg));
+  if (!accepted) {
+    ++counters_.frames_ignored;
+    return;
+  }
+  if (auto* m = std::get_if<MotionCommand>(&msg)) handle_motion_command(*m);
+  if (auto* m = std::get_if<MotionModeCommand>(&msg)) handle_motion_mode(*m);
+  if (auto* m = std::get_if<ControlModeCommand>(&msg)) handle_control_mode(*m);
+  if (auto* m = std::get_if<ErrorClearCommand>(&msg)) {
+    if (!clear_errors(m->code)) ++counters_.frames_ignored;
+  }
+  if (auto* m = std::get_if<UltrasonicSettingCommand>(&msg)) handle_ultrasonic_setting(*m);
+  update_conditions(now_);
+  apply_motion_policy();
+}
+
+void VirtualChassis::handle_motion_command(const MotionCommand& cmd) {
+  last_motion_command_ = now_;
+  watchdog_armed_ = true;
+  if (host_link_lost_) {
+    host_link_lost_ = false;
+    event("0x111 received again: host communication restored");
+  }
+  if (!refusal_reason().empty()) {
+    ++counters_.frames_ignored;
+    return;
+  }
+  const MotionMode mode = motion_.mode();
+  if (mode == MotionMode::kSpin) {
+    commanded_ = {cmd.spin_speed, 0.0};
+  } else {
+    const double steering = interpretation::rep103_from_manual_command_steering(cmd.steering_angle);
+    const VehicleGeometry& g = motion_.geometry();
+    // Oblique: all wheels parallel, curvature 0. Ackermann: the curvature the model will steer
+    // (its angle limit applied), which relates the wire's speed to the body centre's.
+    const double max_angle = motion_.limits().max_ackermann_angle;
+    const double curvature =
+        mode == MotionMode::kAckermann
+            ? interpretation::ackermann_curvature_from_mean_angle(
+                  std::clamp(steering, -max_angle, max_angle), g.wheelbase, g.track)
+            : 0.0;
+    commanded_ = {interpretation::body_speed_from_command_speed(cmd.linear_speed, curvature,
+                                                                g.wheelbase, g.track),
+                  steering};
+  }
+  ++counters_.motion_commands;
+}
+
+void VirtualChassis::handle_motion_mode(const MotionModeCommand& cmd) {
+  const auto raw = static_cast<std::uint8_t>(cmd.mode);
+  if (raw > static_cast<std::uint8_t>(MotionMode::kSpin)) {
+    ++counters_.frames_ignored;
+    event("0x141 with unknown motion mode " + std::to_string(raw) + " ignored");
+    return;
+  }
+  if (motion_.begin_mode_switch(cmd.mode, seconds(config_.mode_switch_duration))) {
+    commanded_ = MotionTarget{};
+    event("switching motion mode " + std::string(protocol::to_string(motion_.mode())) + " -> " +
+          std::string(protocol::to_string(cmd.mode)));
+  }
+}
+
+void VirtualChassis::handle_control_mode(const ControlModeCommand& cmd) {
+  if (cmd.mode == ControlMode::kStandby || cmd.mode == ControlMode::kCan) {
+    set_control_mode(cmd.mode, "0x421");
+  } else {
+    ++counters_.frames_ignored;  // the host cannot select remote mode
+  }
+}
+
+void VirtualChassis::set_control_mode(ControlMode mode, const std::string& why) {
+  if (mode == control_mode_) return;
+  event("control mode " + std::string(protocol::to_string(control_mode_)) + " -> " +
+        std::string(protocol::to_string(mode)) + " (" + why + ")");
+  control_mode_ = mode;
+  commanded_.speed = 0.0;
+  watchdog_armed_ = false;  // arms with the first 0x111 in CAN mode
+}
+
+void VirtualChassis::handle_ultrasonic_setting(const UltrasonicSettingCommand& cmd) {
+  if (cmd.enable != ultrasonic_enabled_) {
+    event(std::string("ultrasonic obstacle avoidance ") + (cmd.enable ? "enabled" : "disabled") +
+          " (0x451)");
+  }
+  ultrasonic_enabled_ = cmd.enable;
+  send(UltrasonicSettingFeedback{ultrasonic_enabled_}, now_);  // 0x451 is always answered
+}
+
+// ---- fault injection --------------------------------------------------------------------------
+
+void VirtualChassis::remote_takeover() {
+  set_control_mode(ControlMode::kRemote, "remote control took over");
+  update_conditions(now_);
+  apply_motion_policy();
+}
+
+void VirtualChassis::remote_hand_back(bool to_standby) {
+  if (control_mode_ != ControlMode::kRemote) return;
+  set_control_mode(to_standby ? ControlMode::kStandby : ControlMode::kCan,
+                   to_standby ? "remote control switched off" : "remote handed back to CAN");
+  update_conditions(now_);
+  apply_motion_policy();
+}
+
+void VirtualChassis::remote_signal_lost() {
+  latched_errors_ |= kRemoteLost;
+  if (control_mode_ == ControlMode::kRemote) {
+    set_control_mode(ControlMode::kStandby, "remote signal lost");
+  }
+  update_conditions(now_);
+  apply_motion_policy();
+}
+
+void VirtualChassis::set_emergency_stop(bool on) {
+  if (on == emergency_stop_) return;
+  emergency_stop_ = on;
+  event(on ? "emergency stop pressed" : "emergency stop released");
+  update_conditions(now_);
+  apply_motion_policy();
+}
+
+void VirtualChassis::set_error_bit(int index, bool on) {
+  if (index < 0 || index > 31) return;
+  const std::uint32_t b = 1u << index;
+  if (b == kHostCommLost) {
+    host_link_lost_ = on;
+  } else if (b == kUltrasonicTriggered) {
+    // A condition, not a latch: injected by placing an obstacle in front of sensor 1.
+    if (on) {
+      ultrasonic_enabled_ = true;
+      ultrasonic_[0] = static_cast<std::int16_t>(config_.ultrasonic_stop_distance_mm / 2);
+    } else {
+      for (auto& d : ultrasonic_) {
+        if (d >= 0 && d < config_.ultrasonic_stop_distance_mm)
+          d = config_.ultrasonic_stop_distance_mm;
+      }
+    }
+  } else {
+    latched_errors_ = on ? (latched_errors_ | b) : (latched_errors_ & ~b);
+  }
+  update_conditions(now_);
+  apply_motion_policy();
+}
+
+void VirtualChassis::set_error_bits(std::uint32_t bits) {
+  for (int i = 0; i < 32; ++i) {
+    const bool want = (bits >> i) & 1u;
+    if (want != (((error_word() >> i) & 1u) != 0)) set_error_bit(i, want);
+  }
+}
+
+void VirtualChassis::set_battery_soc(double soc_percent) {
+  drivetrain_.set_soc(soc_percent);
+  event("battery set to " + format_pct(drivetrain_.soc()));
+  update_conditions(now_);
+  apply_motion_policy();
+}
+
+void VirtualChassis::set_silent(bool silent) {
+  if (silent == silent_ && !silent_until_) return;
+  silent_ = silent;
+  silent_until_.reset();
+  event(silent ? "silent: no longer sending" : "silence over: sending again");
+}
+
+void VirtualChassis::silence_for(std::chrono::nanoseconds duration) {
+  silent_ = true;
+  silent_until_ = now_ + duration;
+  event("silent for " + std::to_string(seconds(duration)) + " s");
+}
+
+void VirtualChassis::inject_garbage(int count) {
+  if (count <= 0) return;
+  garbage_pending_ += count;
+  event("sending " + std::to_string(count) + " garbage frames");
+}
+
+void VirtualChassis::set_mode_switch_stuck(bool stuck) {
+  motion_.hold_mode_switch(stuck);
+  event(stuck ? "motion mode switches will not complete" : "motion mode switches complete again");
+}
+
+bool VirtualChassis::clear_errors(std::uint8_t code) {
+  std::uint32_t clear = 0;
+  if (code == 0x00) {
+    for (int i = 0; i < 32; ++i) {
+      const std::uint32_t b = 1u << i;
+      if (!protocol::is_critical_error(b)) clear |= b;
+    }
+    // The host link flag describes the link; 0x00 resets it and waits for the next 0x111.
+    if (host_link_lost_) {
+      host_link_lost_ = false;
+      watchdog_armed_ = false;
+    }
+  } else if (code <= 0x08) {
+    clear = motor_comm_bit(code);
+  } else if (code == 0x09) {
+    clear = kBatteryUnderVoltage;
+  } else if (code == 0x0A) {
+    clear = kRemoteLost;
+  } else if (code <= 0x0E) {
+    clear = steering_calib_bit(code - 0x0B + 5);
+  } else if (code == 0x0F) {
+    clear = kOverCurrent;
+  } else if (code == 0x10) {
+    clear = kOverTemperature;
+  } else {
+    return false;
+  }
+  latched_errors_ &= ~clear;
+  event("clear errors 0x" +
+        [&] {
+          char buf[8];
+          std::snprintf(buf, sizeof buf, "%02X", code);
+          return std::string(buf);
+        }() +
+        " (" + protocol::error_clear_description(code) + ")");
+  // Clearing under-voltage "tries to restore power": the fault comes straight back if the SOC is
+  // still below the cut-off (update_conditions re-latches it).
+  update_conditions(now_);
+  apply_motion_policy();
+  return true;
+}
+
+void VirtualChassis::set_ultrasonic(int sensor, std::int16_t raw) {
+  if (sensor < 1 || sensor > protocol::kUltrasonicCount) return;
+  ultrasonic_[sensor - 1] = raw;
+  update_conditions(now_);
+  apply_motion_policy();
+}
+
+void VirtualChassis::set_ultrasonic_enabled(bool enabled) {
+  if (enabled == ultrasonic_enabled_) return;
+  ultrasonic_enabled_ = enabled;
+  event(std::string("ultrasonic obstacle avoidance ") + (enabled ? "enabled" : "disabled"));
+  send(UltrasonicSettingFeedback{enabled}, now_);
+  update_conditions(now_);
+  apply_motion_policy();
+}
+
+// ---- feedback ---------------------------------------------------------------------------------
+
+void VirtualChassis::send_raw(CanFrame frame, Timestamp t) {
+  if (silent_) return;
+  frame.stamp = t;
+  if (bus_.send(frame)) {
+    ++counters_.frames_sent;
+  } else {
+    ++counters_.send_failures;
+  }
+}
+
+void VirtualChassis::send(const Message& message, Timestamp t) {
+  if (silent_) return;
+  auto frame = encode(message);
+  if (!frame) {
+    ++counters_.send_failures;
+    return;
+  }
+  send_raw(*frame, t);
+}
+
+Message VirtualChassis::motion_feedback() const {
+  const WheelStates w = motion_.wheels();
+  const VehicleGeometry& g = motion_.geometry();
+  MotionFeedback fb;
+  switch (motion_.mode()) {
+    case MotionMode::kAckermann: {
+      // 0x221 reports the front wheels' mean angle and (point 8) the mean wheel speed.
+      const double mean_front = (w[kRightFront].angle + w[kLeftFront].angle) / 2.0;
+      fb.steering_angle = interpretation::manual_from_rep103_steering(mean_front);
+      const double curvature = interpretation::ackermann_curvature_from_mean_angle(
+          motion_.steering(), g.wheelbase, g.track);
+      fb.speed = interpretation::ackermann_feedback_speed_from_body_speed(
+          motion_.twist().vx, curvature, g.wheelbase, g.track);
+      break;
+    }
+    case MotionMode::kOblique: {
+      double mean_angle = 0.0;
+      for (const auto& s : w) {
+        mean_angle += s.angle / kWheelCount;
+        fb.speed += s.speed / kWheelCount;
+      }
+      fb.steering_angle = interpretation::manual_from_rep103_steering(mean_angle);
+      break;
+    }
+    default: {
+      // Spin: the fixed angle (mean of |angles|) and (point 9) the signed tangential speed.
+      for (const auto& s : w)
+        fb.steering_angle += std::abs(s.angle) / kWheelCount;
+      fb.speed = interpretation::spin_feedback_speed_from_yaw_rate(motion_.twist().wz, g.wheelbase,
+                                                                   g.track);
+      break;
+    }
+  }
+  return fb;
+}
+
+void VirtualChassis::send_due(ScheduleId which, Timestamp t) {
+  const auto& motors = drivetrain_.motors();
+  const std::uint32_t errors = error_word();
+  switch (which) {
+    case kFast: {
+      SystemStatus st;
+      st.vehicle_status = vehicle_status();
+      st.vehicle_status_raw = static_cast<std::uint8_t>(st.vehicle_status);
+      st.control_mode = control_mode_;
+      st.control_mode_raw = static_cast<std::uint8_t>(control_mode_);
+      st.battery_voltage = drivetrain_.pack().voltage;
+      st.error_bits = errors;
+      send(st, t);
+      send(motion_feedback(), t);
+      for (int n = 1; n <= protocol::kMotorCount; ++n) {
+        const auto& m = motors[n - 1];
+        send(MotorHighSpeedFeedback{n, m.rpm, m.current, m.position}, t);
+      }
+      const WheelStates w = motion_.wheels();
+      SteeringAnglesFeedback angles;
+      WheelSpeedsFeedback speeds;
+      for (int i = 0; i < kWheelCount; ++i) {
+        angles.angles[i] = interpretation::manual_from_rep103_wheel_angle(w[i].angle);
+        speeds.speeds[i] = w[i].speed;
+      }
+      send(angles, t);
+      send(speeds, t);
+      MotionModeFeedback mm;
+      mm.mode = motion_.mode();  // while switching: the mode being left
+      mm.mode_raw = static_cast<std::uint8_t>(mm.mode);
+      mm.switching = motion_.switching();
+      send(mm, t);
+      break;
+    }
+    case kUltrasonic: {
+      UltrasonicFeedback a, b;
+      a.first_sensor = 1;
+      b.first_sensor = 5;
+      for (int i = 0; i < 4; ++i) {
+        a.raw[i] = ultrasonic_[i];
+        b.raw[i] = ultrasonic_[i + 4];
+      }
+      send(a, t);
+      send(b, t);
+      break;
+    }
+    case kSlow: {
+      const bool power_cut = emergency_stop_ || (errors & kBatteryUnderVoltage) != 0;
+      const double voltage = drivetrain_.pack().voltage;
+      for (int n = 1; n <= protocol::kMotorCount; ++n) {
+        const auto& m = motors[n - 1];
+        std::uint8_t status = 0;
+        if (drivetrain_.soc() < kLowBatteryCutoffSoc) status |= kDriverSupplyLow;
+        if (errors & kOverTemperature) status |= kDriverMotorOverTemp | kDriverOverTemp;
+        if (errors & kOverCurrent) status |= kDriverOverCurrent;
+        if ((errors & motor_comm_bit(n)) || (errors & kDriverStatusError)) status |= kDriverError;
+        if (power_cut) status |= kDriverDisabled;
+        send(MotorLowSpeedFeedback{n, voltage, m.driver_temperature, m.motor_temperature, status},
+             t);
+      }
+      break;
+    }
+    case kBms: {
+      auto send_battery = [&](int slot, const BatteryTelemetry& b) {
+        send(BmsData{slot, b.soc, b.soh, b.voltage, b.current, b.temperature}, t);
+        BmsAlarm alarm;
+        alarm.battery = slot;
+        if (b.soc < kLowBatteryCutoffSoc) alarm.alarm1 |= kBmsUnderVoltage;
+        if (b.soc < kLowBatteryWarningSoc) alarm.warning1 |= kBmsUnderVoltage;
+        send(alarm, t);
+      };
+      send_battery(0, drivetrain_.pack());
+      for (int slot = 1; slot <= drivetrain_.batteries(); ++slot) {
+        send_battery(slot, drivetrain_.battery(slot));
+      }
+      break;
+    }
+    default:
+      break;
+  }
+}
+
+// ---- observation ------------------------------------------------------------------------------
+
+ChassisSnapshot VirtualChassis::snapshot() const {
+  ChassisSnapshot s;
+  s.time = now_;
+  s.control_mode = control_mode_;
+  s.motion_mode = motion_.mode();
+  s.switching = motion_.switching();
+  s.switch_target = motion_.switch_target();
+  s.vehicle_status = vehicle_status();
+  s.error_bits = error_word();
+  s.emergency_stop = emergency_stop_;
+  s.host_link_lost = host_link_lost_;
+  s.motion_refused_reason = refusal_reason();
+  s.motion_allowed = s.motion_refused_reason.empty();
+  s.silent = silent_;
+  s.ultrasonic_enabled = ultrasonic_enabled_;
+  s.target = motion_.target();
+  s.speed = motion_.speed();
+  s.steering = motion_.steering();
+  s.twist = motion_.twist();
+  s.wheels = motion_.wheels();
+  s.pose = motion_.pose();
+  s.distance_travelled = motion_.distance_travelled();
+  s.yaw_travelled = motion_.yaw_travelled();
+  s.battery = drivetrain_.pack();
+  return s;
+}
+
+}  // namespace ranger::sim
