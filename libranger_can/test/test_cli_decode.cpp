@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "cli_commands.hpp"
+#include "cli_input.hpp"
 #include "cli_json.hpp"
 #include "support/cli_run.hpp"
 
@@ -248,14 +249,64 @@ TEST(CliDecode, MalformedLinesAreNumberedAndDecodingGoesOn) {
   EXPECT_EQ(err[2], "ranger_can decode: 2 malformed line(s) skipped");
 }
 
-TEST(CliDecode, EmptyInput) {
-  for (const Args& args : {Args{}, Args{"--json"}}) {
-    const Outcome r = run(args, "");
-    EXPECT_EQ(r.rc, 0);
-    EXPECT_EQ(r.out, "");
-    EXPECT_EQ(r.err, "");
+TEST(CliDecode, InputWithoutFramesFailsWithOneLineReason) {
+  struct Case {
+    std::string input;
+    std::string reason;
+  };
+  const Case cases[] = {
+      {"", "ranger_can decode: nothing to decode: the input is empty"},
+      {"\n\n  \n\r\n",
+       "ranger_can decode: nothing to decode: no RANGER frames in 4 line(s) (all blank)"},
+      {"(1.0) can0 1ABCDEF0#00\n",
+       "ranger_can decode: nothing to decode: no RANGER frames in 1 line(s) (1 with extended IDs "
+       "(other devices))"},
+  };
+  for (const auto& c : cases) {
+    for (const Args& args : {Args{}, Args{"--json"}}) {
+      const Outcome r = run(args, c.input);
+      EXPECT_EQ(r.rc, 1);
+      EXPECT_EQ(r.out, "");
+      ASSERT_FALSE(lines_of(r.err).empty());
+      EXPECT_EQ(lines_of(r.err).back(), c.reason);
+    }
   }
-  EXPECT_EQ(run({}, "\n\n  \n\r\n").err, "");  // blank lines are not errors
+  // Garbage only: the bad lines (at most 20), their count, and the reason.
+  const Outcome garbage = run({}, "garbage\nmore garbage\n");
+  EXPECT_EQ(garbage.rc, 1);
+  EXPECT_EQ(garbage.out, "");
+  EXPECT_EQ(lines_of(garbage.err).size(), 4u) << garbage.err;
+  EXPECT_EQ(lines_of(garbage.err).back(),
+            "ranger_can decode: nothing to decode: no RANGER frames in 2 line(s) (2 malformed)");
+}
+
+TEST(CliDecode, AtMostTwentyBadLinesAreReportedThenACount) {
+  std::string input;
+  for (int i = 0; i < 100000; ++i)
+    input += "not a candump line\n";
+  input += "(1.0) can0 45A#01\n";
+  const Outcome r = run({"--json"}, input);
+  EXPECT_EQ(r.rc, 0);  // one frame: the input held what decode needs
+  EXPECT_EQ(lines_of(r.out).size(), 1u);
+  const auto err = lines_of(r.err);
+  ASSERT_EQ(err.size(), kMaxReportedLines + 1) << r.err.substr(0, 2000);
+  EXPECT_EQ(kMaxReportedLines, 20u);
+  EXPECT_EQ(err[0].rfind("ranger_can decode: line 1: ", 0), 0u) << err[0];
+  EXPECT_EQ(err[19].rfind("ranger_can decode: line 20: ", 0), 0u) << err[19];
+  EXPECT_EQ(err[20], "ranger_can decode: 100000 malformed line(s) skipped (the first 20 shown)");
+}
+
+TEST(CliDecode, ExtendedIdsAreForeignFramesNotErrors) {
+  const Outcome r = run({"--json"},
+                        "(1.000000) can0 18FF1234#0102\n"  // another device (J1939-like)
+                        "(1.010000) can0 221#0096000000000000\n"
+                        "  can0  1ABCDEF0   [2]  01 02\n");
+  EXPECT_EQ(r.rc, 0);
+  EXPECT_EQ(lines_of(r.out).size(), 1u);
+  EXPECT_NE(r.out.find("\"motion_feedback\""), std::string::npos);
+  EXPECT_EQ(r.err,
+            "ranger_can decode: 2 frame(s) with extended (29-bit) IDs skipped: other devices' "
+            "frames, not RANGER's\n");
 }
 
 TEST(CliDecode, HugeLineIsSkippedWithoutBufferingIt) {

@@ -151,18 +151,29 @@ TEST(CliOdom, BadLinesAreReportedAndLogsWithoutTimestampsFail) {
   EXPECT_TRUE(parse_final(lines_of(bad.out).back(), p));
   EXPECT_NEAR(p.x, 0.2, 0.002);
 
-  const Outcome untimed = run({}, "can0  221   [8]  00 96 00 00 00 00 00 00\n");
-  EXPECT_EQ(untimed.rc, 1);
-  EXPECT_NE(untimed.err.find("timestamps"), std::string::npos);
-  ASSERT_EQ(lines_of(untimed.out).size(), 1u);
-  EXPECT_TRUE(parse_final(lines_of(untimed.out)[0], p));
-
-  const Outcome empty = run({});
-  EXPECT_EQ(empty.rc, 0);
-  ASSERT_EQ(lines_of(empty.out).size(), 1u);
-  ASSERT_TRUE(parse_final(lines_of(empty.out)[0], p));
-  EXPECT_EQ(p.t, 0.0);
-  EXPECT_EQ(p.x, 0.0);
+  // Without what odometry needs: exit 1, one line saying why, and no pose as if there were one.
+  struct Case {
+    std::string input;
+    std::string reason;
+  };
+  const Case cases[] = {
+      {"", "ranger_can odom: no pose: the input is empty"},
+      {"can0  221   [8]  00 96 00 00 00 00 00 00\ncan0  221   [8]  00 96 00 00 00 00 00 00\n",
+       "ranger_can odom: no pose: the log has no timestamps; record it with 'candump -L' (or -ta)"},
+      {"(1.0) can0 211#0001020000002001\n(1.02) can0 221#0096000000000000\n",
+       "ranger_can odom: no pose: none of the 2 frame(s) gave an odometry step (that needs two "
+       "timestamped motion feedback frames: 0x221, or 0x271 + 0x281, less than 0.5 s apart)"},
+      {"(1.0) can0 18FF1234#01\nnonsense\n",
+       "ranger_can odom: no pose: no RANGER frames in 2 line(s) (1 malformed, 1 with extended IDs "
+       "(other devices))"},
+  };
+  for (const auto& c : cases) {
+    const Outcome o = run({}, c.input);
+    EXPECT_EQ(o.rc, 1) << c.input;
+    EXPECT_EQ(o.out, "") << c.input;
+    ASSERT_FALSE(lines_of(o.err).empty());
+    EXPECT_EQ(lines_of(o.err).back(), c.reason);
+  }
 }
 
 }  // namespace

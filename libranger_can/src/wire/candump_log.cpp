@@ -129,8 +129,9 @@ Result<Timestamp> parse_timestamp(std::string_view t) {
 }
 
 // A CAN identifier as candump prints it: 3 hex digits for a standard frame, 8 for an extended
-// or error frame. Fills the frame's id / is_error.
-Status parse_id(std::string_view s, CanFrame* frame) {
+// or error frame. Fills the frame's id / is_error; `*extended` tells an extended (29-bit) ID,
+// which the caller rejects once the rest of the line proved well-formed.
+Status parse_id(std::string_view s, CanFrame* frame, bool* extended) {
   if (s.empty()) return parse_error("missing CAN ID");
   if (s.size() != 3 && s.size() != 8) {
     return parse_error("bad CAN ID " + quoted(s) + " (expected 3 or 8 hex digits)");
@@ -151,9 +152,16 @@ Status parse_id(std::string_view s, CanFrame* frame) {
     frame->is_error = true;
     return ok_status();
   }
+  frame->id = id & kCanEffMask;
+  *extended = true;
+  return ok_status();
+}
+
+// A well-formed frame of another device on the bus: kUnknownId, not a parse error.
+Error extended_id_error(std::uint32_t id) {
   char buf[48];
   std::snprintf(buf, sizeof buf, "extended ID 0x%08X is not a RANGER frame", id & kCanEffMask);
-  return parse_error(buf);
+  return Error{Errc::kUnknownId, buf};
 }
 
 // "0096000000000000" (optionally dot-separated, as cansend accepts) -> data/dlc.
@@ -259,9 +267,10 @@ Result<LogEntry> parse_candump_line(std::string_view line) {
   }
   if (frame_text.empty()) return parse_error("missing CAN frame after interface " + quoted(iface));
 
+  bool extended = false;
   const std::size_t hash = frame_text.find('#');
   if (hash != std::string_view::npos) {  // log format: ID#DATA
-    Status id = parse_id(frame_text.substr(0, hash), &entry.frame);
+    Status id = parse_id(frame_text.substr(0, hash), &entry.frame, &extended);
     if (!id) return id.error();
     Status data = parse_log_data(frame_text.substr(hash + 1), &entry.frame);
     if (!data) return data.error();
@@ -271,11 +280,12 @@ Result<LogEntry> parse_candump_line(std::string_view line) {
     }
     if (!sc.at_end()) return parse_error("unexpected text after the frame: " + quoted(sc.rest()));
   } else {  // default format: ID [n] bytes...
-    Status id = parse_id(frame_text, &entry.frame);
+    Status id = parse_id(frame_text, &entry.frame, &extended);
     if (!id) return id.error();
     Status data = parse_default_data(sc, &entry.frame);
     if (!data) return data.error();
   }
+  if (extended) return extended_id_error(entry.frame.id);
   return entry;
 }
 

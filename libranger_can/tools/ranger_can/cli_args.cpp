@@ -7,13 +7,13 @@
 
 namespace ranger::cli {
 
-namespace {
-std::string short_number(double v) {
+std::string number_text(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%g", v);
   return buf;
 }
 
+namespace {
 Error bad(std::string_view what, const std::string& text, const std::string& why) {
   return Error{Errc::kParseError, std::string(what) + ": '" + text + "' " + why};
 }
@@ -34,7 +34,7 @@ Result<double> parse_double_in(std::string_view what, const std::string& text, d
   auto v = parse_double(what, text);
   if (!v) return v;
   if (*v < min || *v > max) {
-    return bad(what, text, "is outside [" + short_number(min) + ", " + short_number(max) + "]");
+    return bad(what, text, "is outside [" + number_text(min) + ", " + number_text(max) + "]");
   }
   return v;
 }

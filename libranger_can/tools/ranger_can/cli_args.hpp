@@ -18,4 +18,7 @@ Result<double> parse_double_in(std::string_view what, const std::string& text, d
 Result<std::int64_t> parse_integer(std::string_view what, const std::string& text, std::int64_t min,
                                    std::int64_t max);
 
+// A number as help texts show defaults and ranges: "%g" ("0.89", "90", "1e-05").
+std::string number_text(double v);
+
 }  // namespace ranger::cli

@@ -55,24 +55,30 @@ CandumpReadSummary read_candump(std::istream& in, std::string_view command, std:
                                 const std::function<void(const LogEntry&)>& on_entry) {
   CandumpReadSummary summary;
   std::string line;
+  auto malformed = [&](const std::string& reason) {
+    if (++summary.malformed <= kMaxReportedLines) {
+      err << "ranger_can " << command << ": line " << summary.lines << ": " << reason << "\n";
+    }
+  };
   for (;;) {
     const LineRead r = read_line(in, line);
     if (r == LineRead::kEnd) break;
     ++summary.lines;
     if (r == LineRead::kTooLong) {
-      err << "ranger_can " << command << ": line " << summary.lines << ": longer than "
-          << kMaxCandumpLineLength << " characters, skipped\n";
-      ++summary.malformed;
+      malformed("longer than " + std::to_string(kMaxCandumpLineLength) + " characters, skipped");
       continue;
     }
     if (is_blank(line)) continue;
     const Result<LogEntry> entry = parse_candump_line(line);
     if (!entry) {
-      err << "ranger_can " << command << ": line " << summary.lines << ": " << entry.error().message
-          << "\n";
-      ++summary.malformed;
+      if (entry.error().code == Errc::kUnknownId) {
+        ++summary.foreign;  // another device's frame (extended ID): not an error
+      } else {
+        malformed(entry.error().message);
+      }
       continue;
     }
+    ++summary.frames;
     on_entry(*entry);
   }
   summary.read_error = in.bad();
@@ -81,14 +87,35 @@ CandumpReadSummary read_candump(std::istream& in, std::string_view command, std:
 
 bool report_candump_end(const CandumpReadSummary& summary, std::string_view command,
                         std::ostream& err) {
-  if (summary.malformed > 0) {
+  if (summary.malformed > kMaxReportedLines) {
+    err << "ranger_can " << command << ": " << summary.malformed
+        << " malformed line(s) skipped (the first " << kMaxReportedLines << " shown)\n";
+  } else if (summary.malformed > 0) {
     err << "ranger_can " << command << ": " << summary.malformed << " malformed line(s) skipped\n";
+  }
+  if (summary.foreign > 0) {
+    err << "ranger_can " << command << ": " << summary.foreign
+        << " frame(s) with extended (29-bit) IDs skipped: other devices' frames, not RANGER's\n";
   }
   if (summary.read_error) {
     err << "ranger_can " << command << ": read error after line " << summary.lines << "\n";
     return false;
   }
   return true;
+}
+
+std::string describe_no_frames(const CandumpReadSummary& summary) {
+  if (summary.read_error) return "the input could not be read";
+  if (summary.lines == 0) return "the input is empty";
+  std::string what = "no RANGER frames in " + std::to_string(summary.lines) + " line(s)";
+  std::string parts;
+  if (summary.malformed > 0) parts += std::to_string(summary.malformed) + " malformed";
+  if (summary.foreign > 0) {
+    parts += (parts.empty() ? "" : ", ") + std::to_string(summary.foreign) +
+             " with extended IDs (other devices)";
+  }
+  if (parts.empty()) parts = "all blank";
+  return what + " (" + parts + ")";
 }
 
 int with_input(const std::optional<std::string>& path, std::string_view command, Io io,

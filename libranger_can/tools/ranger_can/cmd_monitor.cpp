@@ -13,6 +13,7 @@
 #include "cli_bus.hpp"
 #include "cli_commands.hpp"
 #include "cli_monitor_view.hpp"
+#include "cli_options.hpp"
 #include "cli_signals.hpp"
 #include "ranger_can/clock.hpp"
 
@@ -21,26 +22,6 @@ namespace ranger::cli {
 namespace {
 
 using namespace std::chrono_literals;
-
-constexpr const char* kUsage =
-    "usage: ranger_can monitor IFACE [options]\n"
-    "\n"
-    "Shows what a RANGER chassis on IFACE (e.g. can0, vcan0) reports, refreshed live until\n"
-    "Ctrl-C: control and motion mode, speed and steering (with 'left'/'right' spelled out),\n"
-    "per-wheel angle/speed and motor rpm/current/temperature, battery and BMS alarms, 0x211\n"
-    "errors by name, ultrasonic distances, the commands the host sends (0x111 age and rate),\n"
-    "frame rates per ID against the manual's periods, and the bus state.\n"
-    "\n"
-    "options:\n"
-    "  --once         listen for --window seconds, print one view, exit (0 if the chassis was\n"
-    "                 heard, 1 if not)\n"
-    "  --count N      print N views, then exit\n"
-    "  --rate HZ      views per second (default 5)\n"
-    "  --window SEC   frame-rate window and --once listening time (default 1)\n"
-    "  --json         one JSON object per view instead of text\n"
-    "  --no-color     no ANSI colours (default: colours on a terminal unless NO_COLOR is set)\n"
-    "  --no-clear     do not clear the screen between views (default: clear on a terminal)\n"
-    "  -h, --help     this text\n";
 
 struct MonitorOptions {
   std::string iface;
@@ -53,45 +34,16 @@ struct MonitorOptions {
   bool no_clear = false;
 };
 
-Result<MonitorOptions> parse_options(const Args& args) {
+MonitorOptions options_from(const ParsedArgs& args) {
   MonitorOptions o;
-  std::optional<std::string> iface;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    auto value = [&]() -> Result<std::string> {
-      if (i + 1 >= args.size()) return Error{Errc::kInvalidArgument, a + " needs a value"};
-      return args[++i];
-    };
-    if (a == "--once") {
-      o.once = true;
-    } else if (a == "--json") {
-      o.json = true;
-    } else if (a == "--no-color") {
-      o.no_color = true;
-    } else if (a == "--no-clear") {
-      o.no_clear = true;
-    } else if (a == "--count") {
-      auto v = value();
-      if (!v) return v.error();
-      auto n = parse_integer(a, *v, 1, 1000000000);
-      if (!n) return n.error();
-      o.count = static_cast<long>(*n);
-    } else if (a == "--rate" || a == "--window") {
-      auto v = value();
-      if (!v) return v.error();
-      auto d = parse_double_in(a, *v, a == "--rate" ? 0.1 : 0.05, a == "--rate" ? 100.0 : 3600.0);
-      if (!d) return d.error();
-      (a == "--rate" ? o.rate : o.window) = *d;
-    } else if (a.size() > 1 && a[0] == '-') {
-      return Error{Errc::kInvalidArgument, "unknown option '" + a + "'"};
-    } else if (iface) {
-      return Error{Errc::kInvalidArgument, "unexpected argument '" + a + "'"};
-    } else {
-      iface = a;
-    }
-  }
-  if (!iface) return Error{Errc::kInvalidArgument, "missing IFACE (e.g. can0)"};
-  o.iface = *iface;
+  o.iface = *args.get("IFACE");
+  o.once = args.has("--once");
+  if (args.has("--count")) o.count = static_cast<long>(args.integer("--count", 1));
+  o.rate = args.number("--rate", o.rate);
+  o.window = args.number("--window", o.window);
+  o.json = args.has("--json");
+  o.no_color = args.has("--no-color");
+  o.no_clear = args.has("--no-clear");
   return o;
 }
 
@@ -99,23 +51,8 @@ std::chrono::nanoseconds seconds(double s) {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::duration<double>(s));
 }
 
-}  // namespace
-
-int run_monitor(const Args& args, Io io) {
-  for (const auto& a : args) {
-    if (a == "-h" || a == "--help") {
-      io.out << kUsage;
-      return 0;
-    }
-  }
-  auto parsed = parse_options(args);
-  if (!parsed) {
-    io.err << "ranger_can monitor: " << parsed.error().message << "\n"
-           << "usage: ranger_can monitor IFACE [--once] [--count N] [--rate HZ] [--json]   "
-              "('ranger_can monitor --help' for more)\n";
-    return 2;
-  }
-  const MonitorOptions& o = *parsed;
+int monitor_main(const ParsedArgs& args, Io io) {
+  const MonitorOptions o = options_from(args);
 
   auto bus = open_interface(o.iface);
   if (!bus) {
@@ -170,6 +107,42 @@ int run_monitor(const Args& args, Io io) {
     }
   }
   return 0;
+}
+
+}  // namespace
+
+const CommandSpec& monitor_command() {
+  static const CommandSpec spec{
+      "monitor",
+      "live view of a chassis on a CAN interface",
+      "Shows what a RANGER chassis on IFACE reports, refreshed live until Ctrl-C: control and\n"
+      "motion mode, speed and steering (with 'left'/'right' spelled out), per-wheel angle/speed\n"
+      "and motor rpm/current/temperature, battery and BMS alarms, 0x211 errors by name,\n"
+      "ultrasonic distances, the commands the host sends (0x111 age and rate), frame rates per\n"
+      "ID against the manual's periods, and the bus state.",
+      {required_arg("IFACE", "the CAN interface of the chassis", "can0")},
+      {
+          flag("--once",
+               "listen for --window seconds, print one view, exit (0 if the chassis was heard, 1 "
+               "if not)"),
+          option("--count", "N", "print N views, then exit", integer_in(1, 1000000000)),
+          option("--rate", "HZ", "views per second (default 5)", number_in(0.1, 100.0)),
+          option("--window", "SEC", "frame-rate window and --once listening time (default 1)",
+                 number_in(0.05, 3600.0)),
+          flag("--json", "one JSON object per view instead of text"),
+          flag("--no-color",
+               "no ANSI colours (default: colours on a terminal unless NO_COLOR is set)"),
+          flag("--no-clear",
+               "do not clear the screen between views (default: clear on a terminal)"),
+      },
+      "",
+      monitor_main,
+  };
+  return spec;
+}
+
+int run_monitor(const Args& args, Io io) {
+  return run_command(monitor_command(), args, io);
 }
 
 }  // namespace ranger::cli

@@ -10,42 +10,13 @@
 #include "cli_commands.hpp"
 #include "cli_input.hpp"
 #include "cli_json.hpp"
-#include "ranger_can/wire/candump_log.hpp"
+#include "cli_options.hpp"
 #include "ranger_can/control/odometry.hpp"
+#include "ranger_can/wire/candump_log.hpp"
 
 namespace ranger::cli {
 
 namespace {
-
-constexpr const char* kUsage =
-    "usage: ranger_can odom [FILE|-] [--source wheels|motion] [--wheelbase M] [--track M]\n"
-    "                       [--every N] [--quiet]\n"
-    "\n"
-    "Replays a candump log (FILE, or standard input when absent or '-') through the driver's\n"
-    "odometry and prints the pose in the odom frame (REP-103/105: m, rad, x forward, y left,\n"
-    "yaw counter-clockwise) as JSON lines, one per integrated step:\n"
-    "  "
-    "{\"t\":s,\"x\":m,\"y\":m,\"yaw\":rad,\"vx\":m/s,\"vy\":m/s,\"wz\":rad/"
-    "s,\"source\":\"wheels\"}\n"
-    "and, as the last line, the final pose: {\"t\":s,\"x\":m,\"y\":m,\"yaw\":rad}.\n"
-    "\n"
-    "The log needs timestamps (candump -L, or candump -ta): odometry integrates over the frames'\n"
-    "own times. Steps longer than 0.5 s or going backwards are not integrated. Malformed lines "
-    "are\n"
-    "reported on stderr as 'line N: reason' and skipped.\n"
-    "\n"
-    "options:\n"
-    "  --source S     wheels (default): least-squares fit to the per-wheel angles (0x271) and\n"
-    "                 speeds (0x281), falling back to 0x221 while those are missing;\n"
-    "                 motion: 0x221 speed and steering with the 0x291 motion mode only\n"
-    "  --wheelbase M  front to rear axle, m (default 0.890)\n"
-    "  --track M      left to right wheel centres, m (default 0.560)\n"
-    "  --every N      print every Nth step only (default 1)\n"
-    "  --quiet        print the final pose only\n"
-    "  -h, --help     this text\n"
-    "\n"
-    "Exit status: 0 success; 1 the input could not be read or had no timestamped frames; 2 "
-    "usage.\n";
 
 struct Options {
   OdometryConfig config;
@@ -86,61 +57,98 @@ int replay(std::istream& in, const Options& opt, Io io) {
       io.out << out;
     }
   });
-  out.clear();
-  append_pose(out, odom.state(), false);
-  io.out << out;
+  const bool read_ok = report_candump_end(summary, "odom", io.err);
+  if (read_ok && steps > 0) {  // the final pose only when there is one
+    out.clear();
+    append_pose(out, odom.state(), false);
+    io.out << out;
+  }
   io.out.flush();
-  if (!report_candump_end(summary, "odom", io.err)) return 1;
-  if (timestamped == 0 && summary.lines > 0) {
-    io.err << "ranger_can odom: the log has no timestamps; record it with 'candump -L' (or -ta)\n";
+  if (!read_ok) return 1;
+  if (steps == 0) {
+    io.err << "ranger_can odom: no pose: ";
+    if (summary.frames == 0) {
+      io.err << describe_no_frames(summary) << "\n";
+    } else if (timestamped == 0) {
+      io.err << "the log has no timestamps; record it with 'candump -L' (or -ta)\n";
+    } else {
+      io.err << "none of the " << summary.frames
+             << " frame(s) gave an odometry step (that needs two timestamped motion feedback "
+                "frames: 0x221, or 0x271 + 0x281, less than 0.5 s apart)\n";
+    }
     return 1;
   }
   return 0;
 }
 
+int odom_main(const ParsedArgs& args, Io io) {
+  Options opt;
+  opt.path = args.get("FILE");
+  if (const auto source = args.get("--source")) opt.config.source = *parse_odometry_source(*source);
+  opt.config.geometry.wheelbase = args.number("--wheelbase", opt.config.geometry.wheelbase);
+  opt.config.geometry.track = args.number("--track", opt.config.geometry.track);
+  opt.every = static_cast<long>(args.integer("--every", 1));
+  opt.quiet = args.has("--quiet");
+  if (Status st = opt.config.validate(); !st) {
+    return usage_error(odom_command(), io, st.error().message);
+  }
+  return with_input(opt.path, "odom", io, [&](std::istream& in) { return replay(in, opt, io); });
+}
+
+Status check_source(const std::string& text) {
+  const Result<OdometrySource> s = parse_odometry_source(text);
+  if (!s) return s.error();
+  return ok_status();
+}
+
 }  // namespace
 
-int run_odom(const Args& args, Io io) {
-  Options opt;
-  auto usage_error = [&](const std::string& message) {
-    io.err << "ranger_can odom: " << message << "\n\n" << kUsage;
-    return 2;
+const CommandSpec& odom_command() {
+  const OdometryConfig defaults;
+  static const CommandSpec spec{
+      "odom",
+      "replay a candump log through the odometry, print poses (JSON lines)",
+      "Replays a candump log through the driver's odometry (the very ranger::Odometry class the\n"
+      "ROS node runs) and prints the pose in the odom frame (REP-103/105: m, rad, x forward, y\n"
+      "left, yaw counter-clockwise) as JSON lines, one per integrated step:\n"
+      "  "
+      "{\"t\":s,\"x\":m,\"y\":m,\"yaw\":rad,\"vx\":m/s,\"vy\":m/s,\"wz\":rad/"
+      "s,\"source\":\"wheels\"}\n"
+      "and, as the last line, the final pose: {\"t\":s,\"x\":m,\"y\":m,\"yaw\":rad}.\n"
+      "\n"
+      "The log needs timestamps (candump -L, or candump -ta): odometry integrates over the "
+      "frames'\n"
+      "own times. Steps longer than 0.5 s or going backwards are not integrated. Malformed lines\n"
+      "are reported on stderr as 'line N: reason' (the first 20, then a count) and skipped;\n"
+      "frames with extended (29-bit) IDs (other devices) are counted and skipped.",
+      {optional_arg("FILE", "the candump log; standard input when absent or '-'", any_text())},
+      {
+          option("--source", "wheels|motion",
+                 "wheels (default): least-squares fit to the per-wheel angles (0x271) and speeds "
+                 "(0x281), falling back to 0x221 while those are missing; motion: 0x221 speed and "
+                 "steering with the 0x291 motion mode only",
+                 checked_by(check_source)),
+          option("--wheelbase", "M",
+                 "front to rear axle, m (default " + number_text(defaults.geometry.wheelbase) + ")",
+                 number_in(1e-3, 10.0)),
+          option("--track", "M",
+                 "left to right wheel centres, m (default " + number_text(defaults.geometry.track) +
+                     ")",
+                 number_in(1e-3, 10.0)),
+          option("--every", "N", "print every Nth step only (default 1)",
+                 integer_in(1, std::numeric_limits<std::int32_t>::max())),
+          flag("--quiet", "print the final pose only"),
+      },
+      "Exit status: 0 when the log gave at least one odometry step; 1 when it gave none (empty,\n"
+      "no timestamps, no motion feedback: the reason is on stderr, and no pose is printed) or\n"
+      "could not be read; 2 on a usage error.",
+      odom_main,
   };
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    if (a == "-h" || a == "--help") {
-      io.out << kUsage;
-      return 0;
-    }
-    const bool takes_value =
-        a == "--source" || a == "--wheelbase" || a == "--track" || a == "--every";
-    if (takes_value && i + 1 >= args.size()) return usage_error(a + " needs a value");
-    if (a == "--source") {
-      const Result<OdometrySource> s = parse_odometry_source(args[++i]);
-      if (!s) return usage_error("--source: " + s.error().message);
-      opt.config.source = *s;
-    } else if (a == "--wheelbase" || a == "--track") {
-      const Result<double> v = parse_double_in(a, args[++i], 1e-3, 10.0);
-      if (!v) return usage_error(v.error().message);
-      (a == "--wheelbase" ? opt.config.geometry.wheelbase : opt.config.geometry.track) = *v;
-    } else if (a == "--every") {
-      const Result<std::int64_t> n =
-          parse_integer(a, args[++i], 1, std::numeric_limits<std::int32_t>::max());
-      if (!n) return usage_error(n.error().message);
-      opt.every = static_cast<long>(*n);
-    } else if (a == "--quiet") {
-      opt.quiet = true;
-    } else if (a.size() > 1 && a[0] == '-') {
-      return usage_error("unknown option '" + a + "'");
-    } else if (opt.path) {
-      return usage_error("more than one input file ('" + *opt.path + "', '" + a + "')");
-    } else {
-      opt.path = a;
-    }
-  }
-  if (Status st = opt.config.validate(); !st) return usage_error(st.error().message);
+  return spec;
+}
 
-  return with_input(opt.path, "odom", io, [&](std::istream& in) { return replay(in, opt, io); });
+int run_odom(const Args& args, Io io) {
+  return run_command(odom_command(), args, io);
 }
 
 }  // namespace ranger::cli

@@ -1,18 +1,20 @@
-// `ranger_can send IFACE COMMAND ...`: one frame to a chassis, for bench tests. Every command
-// goes through the codec (byte-exact encoding, saturation) and every angle through
-// interpretation.hpp, exactly like the driver.
-#include <cctype>
+// `ranger_can send IFACE COMMAND [ARGS...]`: one frame to a chassis, for bench tests. Every
+// command goes through the codec (byte-exact encoding, saturation) and every angle through
+// interpretation.hpp, exactly like the driver. The commands are a table (kCommands): the help,
+// the summary and the parser all read it.
 #include <cmath>
 #include <optional>
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include "cli_args.hpp"
 #include "cli_bus.hpp"
 #include "cli_commands.hpp"
 #include "cli_frame_format.hpp"
-#include "ranger_can/wire/candump_log.hpp"
+#include "cli_options.hpp"
 #include "ranger_can/clock.hpp"
+#include "ranger_can/wire/candump_log.hpp"
 #include "ranger_can/wire/codec.hpp"
 #include "ranger_can/wire/interpretation.hpp"
 
@@ -20,121 +22,113 @@ namespace ranger::cli {
 
 namespace {
 
-constexpr const char* kUsage =
-    "usage: ranger_can send IFACE COMMAND [ARGS] [--dry-run]\n"
-    "\n"
-    "Sends one command frame to the chassis on IFACE and prints it in candump -L format.\n"
-    "\n"
-    "commands:\n"
-    "  mode ackermann|oblique|spin      0x141 motion mode\n"
-    "  control can|standby              0x421 control mode (CAN command mode / standby)\n"
-    "  clear-errors [CODE]              0x441 clear errors: CODE 0-16 or 0x00-0x10 (default 0 =\n"
-    "                                   all non-critical faults; 1-8 motor driver n "
-    "communication,\n"
-    "                                   9 battery under-voltage, 10 remote signal loss, 11-14\n"
-    "                                   steering calibration of motor 5-8, 15 over-current, 16\n"
-    "                                   over-temperature)\n"
-    "  ultrasonic on|off                0x451 ultrasonic obstacle avoidance\n"
-    "  motion V STEER_DEG SPIN          0x111 once: V linear speed m/s (forward +, |V| <= 2.6),\n"
-    "                                   STEER_DEG steering in degrees, REP-103 sign: positive =\n"
-    "                                   LEFT (|STEER_DEG| <= 90; sent with the manual's sign),\n"
-    "                                   SPIN wheel speed m/s, counter-clockwise + (|SPIN| <= 1).\n"
-    "                                   The chassis stops again 500 ms later unless repeated.\n"
-    "\n"
-    "options:\n"
-    "  -n, --dry-run   print the frame, do not open IFACE\n"
-    "  -h, --help      this text\n";
+using Words = std::vector<std::string>;  // the command's arguments (after its name)
 
 Error bad(const std::string& what) {
   return Error{Errc::kInvalidArgument, what};
 }
 
-Result<Message> parse_command(const std::vector<std::string>& w) {
-  if (w.empty()) return bad("missing COMMAND (mode, control, clear-errors, ultrasonic, motion)");
-  const std::string& c = w[0];
-  auto expect_args = [&](std::size_t min, std::size_t max, const char* form) -> Status {
-    if (w.size() - 1 < min || w.size() - 1 > max)
-      return bad("usage: send IFACE " + std::string(form));
-    return ok_status();
-  };
-  if (c == "mode") {
-    if (auto s = expect_args(1, 1, "mode ackermann|oblique|spin"); !s) return s.error();
-    if (w[1] == "ackermann") return Message{MotionModeCommand{protocol::MotionMode::kAckermann}};
-    if (w[1] == "oblique") return Message{MotionModeCommand{protocol::MotionMode::kOblique}};
-    if (w[1] == "spin") return Message{MotionModeCommand{protocol::MotionMode::kSpin}};
-    return bad("mode: unknown motion mode '" + w[1] + "' (ackermann, oblique or spin)");
-  }
-  if (c == "control") {
-    if (auto s = expect_args(1, 1, "control can|standby"); !s) return s.error();
-    if (w[1] == "can") return Message{ControlModeCommand{protocol::ControlMode::kCan}};
-    if (w[1] == "standby") return Message{ControlModeCommand{protocol::ControlMode::kStandby}};
-    return bad("control: unknown control mode '" + w[1] + "' (can or standby)");
-  }
-  if (c == "clear-errors") {
-    if (auto s = expect_args(0, 1, "clear-errors [CODE]"); !s) return s.error();
-    std::int64_t code = 0;
-    if (w.size() == 2) {
-      auto v = parse_integer("clear-errors CODE", w[1], 0, protocol::kMaxErrorClearCode);
-      if (!v) return v.error();
-      code = *v;
-    }
-    return Message{ErrorClearCommand{static_cast<std::uint8_t>(code)}};
-  }
-  if (c == "ultrasonic") {
-    if (auto s = expect_args(1, 1, "ultrasonic on|off"); !s) return s.error();
-    if (w[1] == "on") return Message{UltrasonicSettingCommand{true}};
-    if (w[1] == "off") return Message{UltrasonicSettingCommand{false}};
-    return bad("ultrasonic: expected 'on' or 'off', got '" + w[1] + "'");
-  }
-  if (c == "motion") {
-    if (auto s = expect_args(3, 3, "motion V STEER_DEG SPIN"); !s) return s.error();
-    auto v = parse_double_in("motion V", w[1], -interpretation::kMaxLinearSpeedMps,
-                             interpretation::kMaxLinearSpeedMps);
-    if (!v) return v.error();
-    constexpr double kRadPerDeg = M_PI / 180.0;  // the user's unit, not the wire's
-    auto steer = parse_double_in("motion STEER_DEG", w[2], -kMaxObliqueSteeringRad / kRadPerDeg,
-                                 kMaxObliqueSteeringRad / kRadPerDeg);
-    if (!steer) return steer.error();
-    auto spin = parse_double_in("motion SPIN", w[3], -kMaxSpinSpeedMps, kMaxSpinSpeedMps);
-    if (!spin) return spin.error();
-    MotionCommand m;
-    m.linear_speed = *v;
-    m.steering_angle = interpretation::manual_from_rep103_command_steering(*steer * kRadPerDeg);
-    m.spin_speed = *spin;
-    return Message{m};
-  }
-  return bad("unknown command '" + c + "' (mode, control, clear-errors, ultrasonic, motion)");
+Result<Message> parse_mode(const Words& w) {
+  if (w[0] == "ackermann") return Message{MotionModeCommand{protocol::MotionMode::kAckermann}};
+  if (w[0] == "oblique") return Message{MotionModeCommand{protocol::MotionMode::kOblique}};
+  if (w[0] == "spin") return Message{MotionModeCommand{protocol::MotionMode::kSpin}};
+  return bad("mode: unknown motion mode '" + w[0] + "' (ackermann, oblique or spin)");
 }
 
-}  // namespace
+Result<Message> parse_control(const Words& w) {
+  if (w[0] == "can") return Message{ControlModeCommand{protocol::ControlMode::kCan}};
+  if (w[0] == "standby") return Message{ControlModeCommand{protocol::ControlMode::kStandby}};
+  return bad("control: unknown control mode '" + w[0] + "' (can or standby)");
+}
 
-int run_send(const Args& args, Io io) {
-  bool dry_run = false;
-  std::vector<std::string> words;
-  for (const auto& a : args) {
-    if (a == "-h" || a == "--help") {
-      io.out << kUsage;
-      return 0;
-    }
-    if (a == "-n" || a == "--dry-run") {
-      dry_run = true;
-    } else if (a.size() > 1 && a[0] == '-' &&
-               !(std::isdigit(static_cast<unsigned char>(a[1])) || a[1] == '.')) {
-      io.err << "ranger_can send: unknown option '" << a << "'\n";
-      return 2;
-    } else {
-      words.push_back(a);
-    }
+Result<Message> parse_clear_errors(const Words& w) {
+  std::int64_t code = 0;
+  if (!w.empty()) {
+    auto v = parse_integer("clear-errors CODE", w[0], 0, protocol::kMaxErrorClearCode);
+    if (!v) return v.error();
+    code = *v;
   }
-  auto usage_fail = [&](const std::string& msg) {
-    io.err << "ranger_can send: " << msg << "\n"
-           << "usage: ranger_can send IFACE COMMAND [ARGS]   ('ranger_can send --help' for more)\n";
-    return 2;
+  return Message{ErrorClearCommand{static_cast<std::uint8_t>(code)}};
+}
+
+Result<Message> parse_ultrasonic(const Words& w) {
+  if (w[0] == "on") return Message{UltrasonicSettingCommand{true}};
+  if (w[0] == "off") return Message{UltrasonicSettingCommand{false}};
+  return bad("ultrasonic: expected 'on' or 'off', got '" + w[0] + "'");
+}
+
+constexpr double kRadPerDeg = M_PI / 180.0;  // the user's unit, not the wire's
+
+Result<Message> parse_motion(const Words& w) {
+  auto v = parse_double_in("motion V", w[0], -interpretation::kMaxLinearSpeedMps,
+                           interpretation::kMaxLinearSpeedMps);
+  if (!v) return v.error();
+  auto steer = parse_double_in("motion STEER_DEG", w[1], -kMaxObliqueSteeringRad / kRadPerDeg,
+                               kMaxObliqueSteeringRad / kRadPerDeg);
+  if (!steer) return steer.error();
+  auto spin = parse_double_in("motion SPIN", w[2], -kMaxSpinSpeedMps, kMaxSpinSpeedMps);
+  if (!spin) return spin.error();
+  MotionCommand m;
+  m.linear_speed = *v;
+  m.steering_angle = interpretation::manual_from_rep103_command_steering(*steer * kRadPerDeg);
+  m.spin_speed = *spin;
+  return Message{m};
+}
+
+struct SendCommand {
+  std::string name;
+  std::string args;  // as the help shows them
+  std::size_t min_args, max_args;
+  std::string help;
+  Result<Message> (*parse)(const Words&);
+};
+
+const std::vector<SendCommand>& send_commands() {
+  static const std::vector<SendCommand> commands = {
+      {"mode", "ackermann|oblique|spin", 1, 1, "0x141 motion mode", parse_mode},
+      {"control", "can|standby", 1, 1, "0x421 control mode (CAN command mode / standby)",
+       parse_control},
+      {"clear-errors", "[CODE]", 0, 1,
+       "0x441 clear errors: CODE 0-16 or 0x00-0x10 (default 0 = all non-critical faults; 1-8 "
+       "motor driver n communication, 9 battery under-voltage, 10 remote signal loss, 11-14 "
+       "steering calibration of motor 5-8, 15 over-current, 16 over-temperature)",
+       parse_clear_errors},
+      {"ultrasonic", "on|off", 1, 1, "0x451 ultrasonic obstacle avoidance", parse_ultrasonic},
+      {"motion", "V STEER_DEG SPIN", 3, 3,
+       "0x111 once: V linear speed m/s (forward +, |V| <= " +
+           number_text(interpretation::kMaxLinearSpeedMps) +
+           "), STEER_DEG steering in degrees, REP-103 sign: positive = LEFT (|STEER_DEG| <= " +
+           number_text(kMaxObliqueSteeringRad / kRadPerDeg) +
+           "; sent with the manual's sign), SPIN wheel speed m/s, counter-clockwise + (|SPIN| <= " +
+           number_text(kMaxSpinSpeedMps) +
+           "). The chassis stops again 500 ms later unless repeated.",
+       parse_motion},
   };
-  if (words.empty()) return usage_fail("missing IFACE (e.g. can0)");
-  const std::string iface = words[0];
-  auto message = parse_command(std::vector<std::string>(words.begin() + 1, words.end()));
-  if (!message) return usage_fail(message.error().message);
+  return commands;
+}
+
+std::string command_names() {
+  std::string names;
+  for (const auto& c : send_commands())
+    names += (names.empty() ? "" : ", ") + c.name;
+  return names;
+}
+
+Result<Message> parse_command(const std::string& name, const Words& args) {
+  for (const auto& c : send_commands()) {
+    if (c.name != name) continue;
+    if (args.size() < c.min_args || args.size() > c.max_args) {
+      return bad("usage: send IFACE " + c.name + " " + c.args);
+    }
+    return c.parse(args);
+  }
+  return bad("unknown command '" + name + "' (" + command_names() + ")");
+}
+
+int send_main(const ParsedArgs& args, Io io) {
+  const std::string iface = *args.get("IFACE");
+  auto message = parse_command(*args.get("COMMAND"), args.all("ARGS"));
+  if (!message) return usage_error(send_command(), io, message.error().message);
   auto frame = encode(*message);
   if (!frame) {
     io.err << "ranger_can send: " << frame.error().message << "\n";
@@ -143,7 +137,7 @@ int run_send(const Args& args, Io io) {
   frame->stamp = SystemClock().now();  // for the printed candump line
   std::string text;
   append_message_text(text, *message);
-  if (dry_run) {
+  if (args.has("--dry-run")) {
     io.out << format_candump_line(*frame, iface) << "   " << text << "  (dry run, not sent)\n";
     return 0;
   }
@@ -158,6 +152,34 @@ int run_send(const Args& args, Io io) {
   }
   io.out << format_candump_line(*frame, iface) << "   " << text << "\n";
   return 0;
+}
+
+std::string commands_help() {
+  std::vector<HelpRow> rows;
+  for (const auto& c : send_commands())
+    rows.push_back({"  " + c.name + " " + c.args, c.help});
+  return format_rows("commands", rows);
+}
+
+}  // namespace
+
+const CommandSpec& send_command() {
+  static const CommandSpec spec{
+      "send",
+      "send one command: " + command_names(),
+      "Sends one command frame to the chassis on IFACE and prints it in candump -L format.",
+      {required_arg("IFACE", "the CAN interface of the chassis", "can0"),
+       required_arg("COMMAND", "one of the commands below: " + command_names(), "control"),
+       rest_args("ARGS", "the command's arguments (negative numbers need no '--')")},
+      {flag("--dry-run", "print the frame, do not open IFACE").alias('n')},
+      commands_help(),
+      send_main,
+  };
+  return spec;
+}
+
+int run_send(const Args& args, Io io) {
+  return run_command(send_command(), args, io);
 }
 
 }  // namespace ranger::cli

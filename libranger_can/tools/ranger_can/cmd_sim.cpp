@@ -26,6 +26,7 @@
 #include "cli_bus.hpp"
 #include "cli_commands.hpp"
 #include "cli_json.hpp"
+#include "cli_options.hpp"
 #include "cli_signals.hpp"
 #include "cli_sim_control.hpp"
 #include "ranger_can/clock.hpp"
@@ -36,44 +37,6 @@ namespace ranger::cli {
 namespace {
 
 using namespace std::chrono_literals;
-
-constexpr const char* kUsageHead =
-    "usage: ranger_can sim IFACE [options]\n"
-    "\n"
-    "Runs a virtual RANGER chassis on IFACE (e.g. vcan0) until SIGINT/SIGTERM, 'quit' or\n"
-    "--duration: it speaks the chassis side of the whole protocol (boots in standby, obeys 0x421,\n"
-    "0x111 per motion mode, 0x141 with a timed switch, 0x441, 0x451; sends every feedback frame\n"
-    "at the manual's period) and stops by itself 500 ms after the last 0x111. State changes are\n"
-    "printed as '[seconds since boot] what happened'. Faults are injected with the options below\n"
-    "or with control commands read from standard input and/or a FIFO (--control).\n"
-    "\n"
-    "Try it:  ranger_can sim vcan0 &   ranger_can monitor vcan0   ranger_can send vcan0 control "
-    "can\n"
-    "\n"
-    "options:\n"
-    "  --mode-switch-time SEC   time a motion-mode switch takes once at rest (default 0.5)\n"
-    "  --soc PCT                initial battery state of charge, 0-100 (default 90)\n"
-    "  --batteries N            batteries fitted, 1-4 (default 2)\n"
-    "  --ultrasonic MM[,MM..]   sensor distances in mm: one value for all 8, or 8 values\n"
-    "                           (negative: -1 offline, -2 checksum, -3 abnormal, -4 exception)\n"
-    "  --avoidance              start with ultrasonic obstacle avoidance enabled\n"
-    "  --remote                 boot with the remote control in charge (remote mode)\n"
-    "  --estop                  boot with the emergency stop pressed\n"
-    "  --error BIT|NAME         boot with this 0x211 error bit raised (repeatable)\n"
-    "  --stuck-mode-switch      motion-mode switches never complete\n"
-    "  --accel M/S2             acceleration limit (default 1.0)\n"
-    "  --steering-rate DEG/S    steering slew rate (default 90)\n"
-    "  --seed N                 seed of the garbage-frame generator (default 1)\n"
-    "  --pose-out FILE          write the ground-truth pose as JSON lines:\n"
-    "                           {\"t\":unix s,\"sim_t\":s since boot,\"x\":m,\"y\":m,\"yaw\":rad,\n"
-    "                            \"vx\":m/s,\"vy\":m/s,\"wz\":rad/s,\"distance\":m}\n"
-    "  --pose-rate HZ           pose lines per second (default 50)\n"
-    "  --control FIFO           also read control commands from FIFO (created if missing)\n"
-    "  --no-stdin               do not read control commands from standard input\n"
-    "  --duration SEC           stop after SEC seconds\n"
-    "  --quiet                  do not print state changes\n"
-    "  -h, --help               this text\n"
-    "\n";
 
 struct SimOptions {
   std::string iface;
@@ -89,137 +52,61 @@ struct SimOptions {
   bool quiet = false;
 };
 
-Error usage_error(const std::string& what) {
-  return Error{Errc::kInvalidArgument, what};
+Result<std::vector<std::int16_t>> parse_ultrasonic(const std::string& text) {
+  std::vector<std::int16_t> mm;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    auto d = parse_integer("distance", item, -4, 32767);
+    if (!d) return d.error();
+    mm.push_back(static_cast<std::int16_t>(*d));
+  }
+  if (mm.size() != 1 && mm.size() != protocol::kUltrasonicCount) {
+    return Error{Errc::kInvalidArgument,
+                 "give 1 or 8 comma-separated distances, got " + std::to_string(mm.size())};
+  }
+  return mm;
 }
 
-Result<SimOptions> parse_options(const Args& args) {
-  SimOptions o;
-  std::vector<std::string> positional;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    std::string arg = args[i];
-    std::optional<std::string> inline_value;
-    if (arg.rfind("--", 0) == 0) {
-      const auto eq = arg.find('=');
-      if (eq != std::string::npos) {
-        inline_value = arg.substr(eq + 1);
-        arg = arg.substr(0, eq);
-      }
-    }
-    auto value = [&]() -> Result<std::string> {
-      if (inline_value) return *inline_value;
-      if (i + 1 >= args.size()) return usage_error(arg + " needs a value");
-      return args[++i];
-    };
-    auto number = [&](double min, double max) -> Result<double> {
-      auto v = value();
-      if (!v) return v.error();
-      return parse_double_in(arg, *v, min, max);
-    };
-    auto flag = [&]() -> Status {
-      if (inline_value) return usage_error(arg + " takes no value");
-      return ok_status();
-    };
+std::chrono::nanoseconds duration_of(double seconds) {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+      std::chrono::duration<double>(seconds));
+}
 
-    if (arg == "--mode-switch-time") {
-      auto v = number(0.0, 60.0);
-      if (!v) return v.error();
-      o.config.mode_switch_duration =
-          std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::duration<double>(*v));
-    } else if (arg == "--soc") {
-      auto v = number(0.0, 100.0);
-      if (!v) return v.error();
-      o.config.initial_soc = *v;
-    } else if (arg == "--batteries") {
-      auto v = value();
-      if (!v) return v.error();
-      auto n = parse_integer(arg, *v, 1, protocol::kBatteryCount);
-      if (!n) return n.error();
-      o.config.drivetrain.batteries = static_cast<int>(*n);
-    } else if (arg == "--ultrasonic") {
-      auto v = value();
-      if (!v) return v.error();
-      std::vector<std::int16_t> mm;
-      std::stringstream ss(*v);
-      std::string item;
-      while (std::getline(ss, item, ',')) {
-        auto d = parse_integer(arg, item, -4, 32767);
-        if (!d) return d.error();
-        mm.push_back(static_cast<std::int16_t>(*d));
-      }
-      if (mm.size() == 1) {
-        o.config.ultrasonic.fill(mm[0]);
-      } else if (mm.size() == protocol::kUltrasonicCount) {
-        std::copy(mm.begin(), mm.end(), o.config.ultrasonic.begin());
-      } else {
-        return usage_error(arg + ": give 1 or 8 comma-separated distances, got " +
-                           std::to_string(mm.size()));
-      }
-    } else if (arg == "--avoidance") {
-      if (auto s = flag(); !s) return s.error();
-      o.config.ultrasonic_enabled = true;
-    } else if (arg == "--remote") {
-      if (auto s = flag(); !s) return s.error();
-      o.config.boot_in_remote_mode = true;
-    } else if (arg == "--estop") {
-      if (auto s = flag(); !s) return s.error();
-      o.estop = true;
-    } else if (arg == "--error") {
-      auto v = value();
-      if (!v) return v.error();
-      auto b = parse_error_bit(*v);
-      if (!b) return Error{Errc::kInvalidArgument, "--error: " + b.error().message};
-      o.errors.push_back(*b);
-    } else if (arg == "--stuck-mode-switch") {
-      if (auto s = flag(); !s) return s.error();
-      o.stuck = true;
-    } else if (arg == "--accel") {
-      auto v = number(0.01, 20.0);
-      if (!v) return v.error();
-      o.config.limits.acceleration = *v;
-    } else if (arg == "--steering-rate") {
-      auto v = number(1.0, 3600.0);
-      if (!v) return v.error();
-      o.config.limits.steering_rate = *v * M_PI / 180.0;
-    } else if (arg == "--seed") {
-      auto v = value();
-      if (!v) return v.error();
-      auto n = parse_integer(arg, *v, 0, 0xFFFFFFFFLL);
-      if (!n) return n.error();
-      o.config.garbage_seed = static_cast<std::uint32_t>(*n);
-    } else if (arg == "--pose-out") {
-      auto v = value();
-      if (!v) return v.error();
-      if (v->empty()) return usage_error("--pose-out needs a file name");
-      o.pose_out = *v;
-    } else if (arg == "--pose-rate") {
-      auto v = number(0.1, 1000.0);
-      if (!v) return v.error();
-      o.pose_rate = *v;
-    } else if (arg == "--control") {
-      auto v = value();
-      if (!v) return v.error();
-      if (v->empty()) return usage_error("--control needs a FIFO path");
-      o.control_fifo = *v;
-    } else if (arg == "--no-stdin") {
-      if (auto s = flag(); !s) return s.error();
-      o.read_stdin = false;
-    } else if (arg == "--duration") {
-      auto v = number(0.0, 1e7);
-      if (!v) return v.error();
-      o.duration = *v;
-    } else if (arg == "--quiet") {
-      if (auto s = flag(); !s) return s.error();
-      o.quiet = true;
-    } else if (arg.size() > 1 && arg[0] == '-') {
-      return usage_error("unknown option '" + arg + "'");
+SimOptions options_from(const ParsedArgs& args) {
+  SimOptions o;
+  o.iface = *args.get("IFACE");
+  if (args.has("--mode-switch-time")) {
+    o.config.mode_switch_duration = duration_of(args.number("--mode-switch-time", 0.0));
+  }
+  o.config.initial_soc = args.number("--soc", o.config.initial_soc);
+  o.config.drivetrain.batteries =
+      static_cast<int>(args.integer("--batteries", o.config.drivetrain.batteries));
+  if (const auto text = args.get("--ultrasonic")) {
+    const auto mm = *parse_ultrasonic(*text);  // the table's rule accepted it
+    if (mm.size() == 1) {
+      o.config.ultrasonic.fill(mm[0]);
     } else {
-      positional.push_back(arg);
+      std::copy(mm.begin(), mm.end(), o.config.ultrasonic.begin());
     }
   }
-  if (positional.empty()) return usage_error("missing IFACE (e.g. vcan0)");
-  if (positional.size() > 1) return usage_error("unexpected argument '" + positional[1] + "'");
-  o.iface = positional[0];
+  o.config.ultrasonic_enabled = args.has("--avoidance");
+  o.config.boot_in_remote_mode = args.has("--remote");
+  o.estop = args.has("--estop");
+  for (const auto& e : args.all("--error"))
+    o.errors.push_back(*parse_error_bit(e));
+  o.stuck = args.has("--stuck-mode-switch");
+  o.config.limits.acceleration = args.number("--accel", o.config.limits.acceleration);
+  if (args.has("--steering-rate")) {
+    o.config.limits.steering_rate = args.number("--steering-rate", 0.0) * M_PI / 180.0;
+  }
+  o.config.garbage_seed = static_cast<std::uint32_t>(args.integer("--seed", o.config.garbage_seed));
+  o.pose_out = args.get_or("--pose-out", "");
+  o.pose_rate = args.number("--pose-rate", o.pose_rate);
+  o.control_fifo = args.get_or("--control", "");
+  o.read_stdin = !args.has("--no-stdin");
+  if (args.has("--duration")) o.duration = args.number("--duration", 0.0);
+  o.quiet = args.has("--quiet");
   return o;
 }
 
@@ -307,22 +194,8 @@ std::string stamp_prefix(Timestamp since_boot) {
   return buf;
 }
 
-}  // namespace
-
-int run_sim(const Args& args, Io io) {
-  for (const auto& a : args) {
-    if (a == "-h" || a == "--help") {
-      io.out << kUsageHead << kSimControlHelp;
-      return 0;
-    }
-  }
-  auto parsed = parse_options(args);
-  if (!parsed) {
-    io.err << "ranger_can sim: " << parsed.error().message << "\n"
-           << "usage: ranger_can sim IFACE [options]   ('ranger_can sim --help' for more)\n";
-    return 2;
-  }
-  const SimOptions& o = *parsed;
+int sim_main(const ParsedArgs& args, Io io) {
+  const SimOptions o = options_from(args);
 
   std::ofstream pose_file;
   if (!o.pose_out.empty()) {
@@ -504,6 +377,92 @@ int run_sim(const Args& args, Io io) {
     io.out.flush();
   }
   return exit_code;
+}
+
+template <typename T>
+Status check_with(Result<T> (*parse)(const std::string&), const std::string& text) {
+  auto r = parse(text);
+  if (!r) return r.error();
+  return ok_status();
+}
+
+}  // namespace
+
+const CommandSpec& sim_command() {
+  const sim::VirtualChassisConfig defaults;
+  const SimOptions option_defaults;
+  const auto seconds_of = [](std::chrono::nanoseconds d) {
+    return number_text(std::chrono::duration<double>(d).count());
+  };
+  static const CommandSpec spec{
+      "sim",
+      "run the virtual RANGER chassis on a CAN interface, with fault injection",
+      "Runs a virtual RANGER chassis on IFACE until SIGINT/SIGTERM, 'quit' or --duration: it\n"
+      "speaks the chassis side of the whole protocol (boots in standby, obeys 0x421, 0x111 per\n"
+      "motion mode, 0x141 with a timed switch, 0x441, 0x451; sends every feedback frame at the\n"
+      "manual's period) and stops by itself 500 ms after the last 0x111. State changes are\n"
+      "printed as '[seconds since boot] what happened'. Faults are injected with the options\n"
+      "below or with control commands read from standard input and/or a FIFO (--control).\n"
+      "\n"
+      "Try it:  ranger_can sim vcan0 &   ranger_can monitor vcan0   ranger_can send vcan0 control "
+      "can",
+      {required_arg("IFACE", "the CAN interface to run the chassis on", "vcan0")},
+      {
+          option("--mode-switch-time", "SEC",
+                 "time a motion-mode switch takes once at rest (default " +
+                     seconds_of(defaults.mode_switch_duration) + ")",
+                 number_in(0.0, 60.0)),
+          option("--soc", "PCT",
+                 "initial battery state of charge, 0-100 (default " +
+                     number_text(defaults.initial_soc) + ")",
+                 number_in(0.0, 100.0)),
+          option("--batteries", "N",
+                 "batteries fitted, 1-" + std::to_string(protocol::kBatteryCount) + " (default " +
+                     std::to_string(defaults.drivetrain.batteries) + ")",
+                 integer_in(1, protocol::kBatteryCount)),
+          option("--ultrasonic", "MM[,MM..]",
+                 "sensor distances in mm: one value for all 8, or 8 values (negative: -1 offline, "
+                 "-2 checksum, -3 abnormal, -4 exception)",
+                 checked_by([](const std::string& t) { return check_with(parse_ultrasonic, t); })),
+          flag("--avoidance", "start with ultrasonic obstacle avoidance enabled"),
+          flag("--remote", "boot with the remote control in charge (remote mode)"),
+          flag("--estop", "boot with the emergency stop pressed"),
+          option("--error", "BIT|NAME", "boot with this 0x211 error bit raised",
+                 checked_by([](const std::string& t) { return check_with(parse_error_bit, t); }))
+              .repeated(),
+          flag("--stuck-mode-switch", "motion-mode switches never complete"),
+          option("--accel", "M/S2",
+                 "acceleration limit (default " + number_text(defaults.limits.acceleration) + ")",
+                 number_in(0.01, 20.0)),
+          option("--steering-rate", "DEG/S",
+                 "steering slew rate (default " +
+                     number_text(defaults.limits.steering_rate * 180.0 / M_PI) + ")",
+                 number_in(1.0, 3600.0)),
+          option("--seed", "N",
+                 "seed of the garbage-frame generator (default " +
+                     std::to_string(defaults.garbage_seed) + ")",
+                 integer_in(0, 0xFFFFFFFFLL)),
+          option("--pose-out", "FILE",
+                 "write the ground-truth pose as JSON lines:\n"
+                 "{\"t\":s,\"sim_t\":s,\"x\":m,\"y\":m,\"yaw\":rad,\n"
+                 "\"vx\":m/s,\"vy\":m/s,\"wz\":rad/s,\"distance\":m}\n"
+                 "(t: Unix time; sim_t: since the chassis booted)"),
+          option("--pose-rate", "HZ",
+                 "pose lines per second (default " + number_text(option_defaults.pose_rate) + ")",
+                 number_in(0.1, 1000.0)),
+          option("--control", "FIFO", "also read control commands from FIFO (created if missing)"),
+          flag("--no-stdin", "do not read control commands from standard input"),
+          option("--duration", "SEC", "stop after SEC seconds", number_in(0.0, 1e7)),
+          flag("--quiet", "do not print state changes"),
+      },
+      kSimControlHelp,
+      sim_main,
+  };
+  return spec;
+}
+
+int run_sim(const Args& args, Io io) {
+  return run_command(sim_command(), args, io);
 }
 
 }  // namespace ranger::cli

@@ -21,8 +21,10 @@ struct LogEntry {
 };
 
 // Parses one line in either format. Errors (kParseError) say what is wrong ("bad hex digit in
-// data", "more than 8 data bytes", "extended ID 0x1ABCDEF0 is not a RANGER frame" ...). Remote
-// (RTR) and CAN FD frames are reported as errors too: RANGER uses neither.
+// data", "more than 8 data bytes" ...). Remote (RTR) and CAN FD frames are reported as errors
+// too: RANGER uses neither. A well-formed frame with an extended (29-bit) ID is another device's
+// on a shared bus: kUnknownId ("extended ID 0x1ABCDEF0 is not a RANGER frame"), so that a reader
+// can count it as foreign rather than malformed.
 Result<LogEntry> parse_candump_line(std::string_view line);
 
 // Formats a frame as one candump -L line (without a newline).
