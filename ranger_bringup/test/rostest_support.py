@@ -5,6 +5,7 @@ timeouts below only bound how long a failing test waits)."""
 import os
 import pty
 import shutil
+import signal
 import socket
 import subprocess
 import tempfile
@@ -80,18 +81,16 @@ class RosMaster:
         shutil.rmtree(self.home, ignore_errors=True)
 
 
-class TeleopProcess:
-    """scripts/ranger_teleop_keyboard on the slave side of a pseudo-terminal, in namespace `ns`,
-    with private parameters from `params`."""
+class PtyProcess:
+    """A command on the slave side of a pseudo-terminal (as if typed into a terminal), in a
+    session of its own; its output is collected in the background."""
 
-    def __init__(self, master, ns, **params):
+    def __init__(self, args, env):
         self.fd, slave = pty.openpty()
         self.slave = slave
         self.original = termios.tcgetattr(slave)
-        args = ["/usr/bin/python3", TELEOP, f"__ns:={ns}"] + [
-            f"_{k}:={v}" for k, v in params.items()]
-        self.process = subprocess.Popen(args, stdin=slave, stdout=slave, stderr=slave,
-                                        env=master.env, start_new_session=True)
+        self.process = subprocess.Popen(args, stdin=slave, stdout=slave, stderr=slave, env=env,
+                                        start_new_session=True)
         self.output = b""
         self.reader = threading.Thread(target=self._read, daemon=True)
         self.reader.start()
@@ -127,7 +126,20 @@ class TeleopProcess:
 
     def close(self):
         if self.process.poll() is None:
-            self.process.kill()
+            try:
+                os.killpg(self.process.pid, signal.SIGKILL)
+            except OSError:
+                pass
             self.process.wait()
         os.close(self.slave)
         os.close(self.fd)
+
+
+class TeleopProcess(PtyProcess):
+    """scripts/ranger_teleop_keyboard on the slave side of a pseudo-terminal, in namespace `ns`,
+    with private parameters from `params`."""
+
+    def __init__(self, master, ns, **params):
+        args = ["/usr/bin/python3", TELEOP, f"__ns:={ns}"] + [
+            f"_{k}:={v}" for k, v in params.items()]
+        super().__init__(args, master.env)

@@ -48,14 +48,42 @@ def all_launch_files():
 
 
 def test_every_launch_file_is_covered():
-    assert all_launch_files() == ["display.launch", "ranger_minimal.launch", "ranger_sim.launch",
-                                  "ranger_teleop_keyboard.launch"]
+    assert all_launch_files() == ["display.launch", "ranger_diagnostics.launch",
+                                  "ranger_minimal.launch", "ranger_sim.launch",
+                                  "ranger_sim_two.launch", "ranger_teleop_keyboard.launch"]
+
+
+ROBOT_LAUNCH_FILES = ["display.launch", "ranger_minimal.launch", "ranger_sim.launch",
+                      "ranger_teleop_keyboard.launch"]
 
 
 @pytest.mark.parametrize("launch", all_launch_files())
 @pytest.mark.parametrize("ns", [[], ["namespace:=r1"]])
 def test_every_launch_file_resolves(launch, ns):
     assert nodes(launch, *ns)
+
+
+@pytest.mark.parametrize("launch", ROBOT_LAUNCH_FILES)
+def test_ns_and_namespace_are_one_argument(launch):
+    """README and users say ns:=robot1; a silently ignored ns:= would start a second robot in the
+    root namespace, whose node replaces (kills) the first robot's driver."""
+    expected = nodes(launch, "namespace:=robot1")
+    assert all(n.startswith("/robot1/") or n == "/diagnostic_aggregator" for n in expected)
+    assert any(n.startswith("/robot1/") for n in expected)
+    assert nodes(launch, "ns:=robot1") == expected
+    assert nodes(launch, "ns:=/robot1/") == expected  # slashes are the namespace's, not a name
+    assert nodes(launch, "ns:=robot1", "namespace:=robot1") == expected
+    assert params(launch, "ns:=robot1") == params(launch, "namespace:=robot1")
+
+
+@pytest.mark.parametrize("launch", ROBOT_LAUNCH_FILES)
+def test_ns_and_namespace_that_disagree_are_refused(launch):
+    result = subprocess.run(["roslaunch", "--nodes", os.path.join(LAUNCH_DIR, launch),
+                             "ns:=robot1", "namespace:=robot2"],
+                            capture_output=True, text=True, env=ENV, timeout=120)
+    assert result.returncode != 0
+    assert ("ns:=robot1 and namespace:=robot2 name two different namespaces"
+            in result.stdout + result.stderr)
 
 
 def test_minimal_on_can0_by_default():
@@ -67,6 +95,8 @@ def test_minimal_on_can0_by_default():
     assert p["/ranger_base_node/base_frame"] == "base_footprint"  # the URDF's root
     assert p["/ranger_base_node/publish_odom_tf"] is True
     assert p["/diagnostic_aggregator/analyzers/ranger/path"] == "RANGER"
+    assert p["/diagnostic_aggregator/analyzers/ranger/expected"] == [
+        f"ranger_base_node: {s}" for s in STATUSES]
 
 
 def test_minimal_arguments_reach_the_node():
@@ -103,7 +133,8 @@ def test_a_custom_geometry_file_changes_node_and_urdf_together(tmp_path):
 
 
 def test_namespace_moves_nodes_params_and_frames():
-    assert nodes("ranger_minimal.launch", "namespace:=r1", "diagnostics_aggregator:=false") == [
+    # A robot in a namespace starts no aggregator of its own (the fleet shares one).
+    assert nodes("ranger_minimal.launch", "namespace:=r1") == [
         "/r1/ranger_base_node", "/r1/robot_state_publisher"]
     p = params("ranger_minimal.launch", "namespace:=r1")
     assert p["/r1/ranger_base_node/odom_frame"] == "r1/odom"
@@ -137,3 +168,58 @@ def test_teleop_parameters_and_namespace():
     p = params("ranger_teleop_keyboard.launch", "speed:=0.5")
     assert p["/ranger_teleop_keyboard/speed"] == 0.5
     assert p["/ranger_teleop_keyboard/key_timeout"] < 0.5  # the driver's cmd_vel_timeout
+
+
+# ---- diagnostics: one aggregator per ROS master -------------------------------------------------
+
+STATUSES = ["CAN link", "Control mode", "Chassis errors", "Battery", "Frame rates"]
+
+
+def analyzer_of(p, robot):
+    key = f"/diagnostic_aggregator/analyzers/ranger/analyzers/{robot}"
+    return {k[len(key) + 1:]: v for k, v in p.items() if k.startswith(key + "/")}
+
+
+def test_one_aggregator_groups_several_robots():
+    assert nodes("ranger_diagnostics.launch", "robots:=robot1 robot2") == [
+        "/diagnostic_aggregator"]
+    p = params("ranger_diagnostics.launch", "robots:=robot1 /robot2/")
+    assert p["/diagnostic_aggregator/analyzers/ranger/type"] == (
+        "diagnostic_aggregator/AnalyzerGroup")
+    assert p["/diagnostic_aggregator/analyzers/ranger/path"] == "RANGER"
+    for robot in ("robot1", "robot2"):
+        a = analyzer_of(p, robot)
+        assert a["path"] == robot
+        assert a["find_and_remove_prefix"] == [f"{robot}/ranger_base_node: "]
+        assert a["expected"] == [f"{robot}/ranger_base_node: {s}" for s in STATUSES]
+
+
+def test_the_aggregator_stays_at_the_root_when_asked_for_a_namespaced_robot():
+    assert nodes("ranger_minimal.launch", "ns:=r1", "diagnostics_aggregator:=true") == [
+        "/diagnostic_aggregator", "/r1/ranger_base_node", "/r1/robot_state_publisher"]
+    p = params("ranger_minimal.launch", "ns:=r1", "diagnostics_aggregator:=true")
+    assert analyzer_of(p, "r1")["path"] == "r1"
+
+
+def test_two_simulated_robots_share_one_aggregator():
+    assert nodes("ranger_sim_two.launch") == [
+        "/diagnostic_aggregator", "/robot1/ranger_base_node", "/robot1/robot_state_publisher",
+        "/robot2/ranger_base_node", "/robot2/robot_state_publisher"]
+    p = params("ranger_sim_two.launch")
+    for robot in ("robot1", "robot2"):
+        assert p[f"/{robot}/ranger_base_node/port_name"] == "sim"
+        assert p[f"/{robot}/ranger_base_node/odom_frame"] == f"{robot}/odom"
+        assert p[f"/{robot}/ranger_base_node/base_frame"] == f"{robot}/base_footprint"
+        assert p[f"/{robot}/robot_state_publisher/tf_prefix"] == robot
+        assert analyzer_of(p, robot)["path"] == robot
+    assert "/robot_description" not in p
+
+
+def test_teleop_is_not_required():
+    """Quitting the teleop is how it ends: not a reason for a REQUIRED-process-died banner
+    (test_teleop_pty.py runs the launch file in a terminal and quits)."""
+    import roslaunch.config
+
+    config = roslaunch.config.load_config_default(
+        [os.path.join(LAUNCH_DIR, "ranger_teleop_keyboard.launch")], None, verbose=False)
+    assert [(n.name, n.required) for n in config.nodes] == [("ranger_teleop_keyboard", False)]

@@ -12,7 +12,8 @@ import threading
 import pytest
 
 sys.path.insert(0, os.path.dirname(__file__))
-from rostest_support import TELEOP, RosMaster, TeleopProcess, wait_for  # noqa: E402
+from rostest_support import (PACKAGE_DIR, TELEOP, PtyProcess, RosMaster,  # noqa: E402
+                             TeleopProcess, wait_for)
 
 SPEED, SPIN, RADIUS = 0.4, 0.6, 2.0
 
@@ -150,3 +151,23 @@ def test_without_a_terminal_it_refuses_to_start(master):
                             capture_output=True, text=True, env=master.env, timeout=60)
     assert result.returncode == 1
     assert "stdin is not a terminal" in result.stderr
+
+
+@pytest.mark.parametrize("quit_key", ["\x03", "\x04"])  # Ctrl-C, Ctrl-D
+def test_quitting_the_launched_teleop_ends_roslaunch_without_a_required_banner(master, quit_key):
+    """ranger_teleop_keyboard.launch in a terminal: quitting the teleop is how a user ends it,
+    so roslaunch ends by itself, cleanly, and prints no REQUIRED-process-died banner."""
+    env = dict(master.env, ROS_PACKAGE_PATH=os.pathsep.join(
+        [PACKAGE_DIR] + [p for p in master.env.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p]))
+    launch = PtyProcess(["roslaunch", os.path.join(PACKAGE_DIR, "launch",
+                                                   "ranger_teleop_keyboard.launch"),
+                         "ns:=launched_teleop"], env)
+    try:
+        assert wait_for(lambda: "RANGER keyboard teleop" in launch.text(), timeout=60), \
+            launch.text()
+        launch.type(quit_key)
+        assert launch.wait_exit(timeout=60) == 0, launch.text()
+        assert "REQUIRED" not in launch.text()
+        assert "all processes on machine have died" in launch.text()
+    finally:
+        launch.close()
