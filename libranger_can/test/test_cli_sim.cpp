@@ -278,6 +278,25 @@ TEST(CliMonitorView, SaysSoWhenNothingArrives) {
   EXPECT_FALSE(monitor.heard_chassis());
 }
 
+TEST(CliSim, BadControlLinesFromAPipeAreBoundedThenCounted) {
+  LoopbackOptions options;
+  options.interface = "vsim_cli1";
+  auto network = std::make_shared<LoopbackNetwork>(options);
+  register_loopback_interface(network);
+  std::string input;
+  for (int i = 0; i < 1000; ++i)
+    input += "frobnicate " + std::to_string(i) + "\n";
+  input += "quit\n";
+  const CliRun r = run(run_sim, {"vsim_cli1", "--quiet"}, input);
+  unregister_loopback_interface("vsim_cli1");
+  EXPECT_EQ(r.rc, 0) << r.err;
+  const auto err = test::lines_of(r.err);
+  ASSERT_EQ(err.size(), 22u) << r.err;
+  EXPECT_TRUE(contains(err[0], "frobnicate")) << err[0];
+  EXPECT_EQ(err[20], "ranger_can sim: more bad control lines: counted, not shown");
+  EXPECT_EQ(err[21], "ranger_can sim: 1000 bad control line(s) (the first 20 shown)");
+}
+
 // ---- sim + send + monitor together, in-process ------------------------------------------------
 
 TEST(CliSession, SimSendAndMonitorWorkTogetherOnALoopbackInterface) {

@@ -3,7 +3,19 @@ diagnostics aggregator): each is driven by its own cmd_vel (one moves, the other
 has its own frames, and one aggregated diagnostics view shows both.
 
 The tests marked xfail(strict=True) are what the node itself must still provide (issue 16, phase
-2): they fail the suite as soon as the node provides it, so that the mark is removed then."""
+2); they fail the suite as soon as the node provides it, so that the mark is removed then:
+* hardware_id: each robot's diagnostics name their robot, e.g. "ranger:robot1/sim" (today
+  "ranger:" + port_name, the same for every simulated robot); derived from the node's namespace,
+  or a `~hardware_id` parameter the launch file passes.
+* ultrasonic frames: Range.header.frame_id carries the same prefix as odom_frame/base_frame
+  ("robot1/ultrasonic_1_link"; today "ultrasonic_1_link"). ranger_minimal.launch computes the
+  prefix (arg frame_prefix); the node needs a parameter for it (e.g. `~frame_prefix`), which the
+  launch file passes once the node accepts it (today an unknown private parameter is warned
+  about, so the launch file does not pass it yet).
+Beyond this file, the node's part of issue 16 (phase 2): INFO (not WARN) while waiting for a
+chassis never heard; the CAN open error naming the interface and bringup_can2usb.bash; exit
+within 0.3 s of Ctrl-C / rosnode kill after the stop was sent and logged; clear_errors answering
+with the chassis's error word after it answered; set_ultrasonic refusing an empty request."""
 
 import math
 import os

@@ -25,6 +25,7 @@
 #include "cli_args.hpp"
 #include "cli_bus.hpp"
 #include "cli_commands.hpp"
+#include "cli_input.hpp"
 #include "cli_json.hpp"
 #include "cli_options.hpp"
 #include "cli_signals.hpp"
@@ -271,6 +272,19 @@ int sim_main(const ParsedArgs& args, Io io) {
     }
   };
 
+  // Bad control lines are reported one by one to a person typing; from a pipe or a FIFO only
+  // the first kMaxReportedLines are, then counted, so no input makes sim print without bound.
+  const bool typing = &io.in == &std::cin && o.read_stdin && ::isatty(STDIN_FILENO) != 0;
+  std::size_t bad_lines = 0;
+  auto control_error = [&](const std::string& message) {
+    ++bad_lines;
+    if (typing || bad_lines <= kMaxReportedLines) {
+      io.err << "ranger_can sim: " << message << "\n";
+    } else if (bad_lines == kMaxReportedLines + 1) {
+      io.err << "ranger_can sim: more bad control lines: counted, not shown\n";
+    }
+  };
+
   auto execute = [&](const std::string& line) {
     std::istringstream words(line);
     std::string first;
@@ -289,7 +303,7 @@ int sim_main(const ParsedArgs& args, Io io) {
       words >> sec >> extra;
       auto v = parse_double_in("wait SEC", sec, 0.0, 1e6);
       if (!v || !extra.empty()) {
-        io.err << "ranger_can sim: " << (v ? "usage: wait SEC" : v.error().message) << "\n";
+        control_error(v ? "usage: wait SEC" : v.error().message);
         return;
       }
       hold_until = clock.now() + std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -299,7 +313,7 @@ int sim_main(const ParsedArgs& args, Io io) {
     auto r =
         runner.with_chassis([&](sim::VirtualChassis& c) { return apply_sim_command(line, c); });
     if (!r) {
-      io.err << "ranger_can sim: " << r.error().message << "\n";
+      control_error(r.error().message);
     } else if (!r->empty()) {
       io.out << *r << "\n";
       io.out.flush();
@@ -367,6 +381,10 @@ int sim_main(const ParsedArgs& args, Io io) {
   }
   runner.stop();
   print_events();
+  if (bad_lines > kMaxReportedLines && !typing) {
+    io.err << "ranger_can sim: " << bad_lines << " bad control line(s) (the first "
+           << kMaxReportedLines << " shown)\n";
+  }
   if (!o.quiet) {
     const auto c = runner.with_chassis([](sim::VirtualChassis& ch) { return ch.counters(); });
     io.out << "ranger_can sim: stopped; " << c.frames_sent << " frames sent, " << c.frames_received
