@@ -12,6 +12,7 @@
 #include "ranger_can/wire/codec.hpp"
 #include "ranger_can/control/controller.hpp"
 #include "ranger_can/control/kinematics.hpp"
+#include "ranger_can/control/mode_selector.hpp"
 #include "ranger_can/control/odometry.hpp"
 
 namespace {

@@ -20,6 +20,7 @@
 #include "ranger_can/wire/codec.hpp"
 #include "ranger_can/wire/interpretation.hpp"
 #include "ranger_can/control/kinematics.hpp"
+#include "ranger_can/control/mode_selector.hpp"
 #include "ranger_can/wire/protocol.hpp"
 #include "ranger_can/control/speed_limiter.hpp"
 

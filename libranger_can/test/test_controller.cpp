@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "ranger_can/wire/codec.hpp"
 #include "ranger_can/control/controller.hpp"
+#include "ranger_can/wire/codec.hpp"
 #include "ranger_can/wire/interpretation.hpp"
 #include "ranger_can/wire/protocol.hpp"
 #include "support/fake_bus.hpp"
@@ -60,6 +60,7 @@ struct Rig {
   bool switching = false;
   double wheel_speed = 0.0;
   std::optional<double> soc;
+  std::optional<std::array<double, 4>> wheel_angles;  // 0x271, manual signs
   bool obey_control_requests = false;  // switch to CAN mode when asked (a cooperative chassis)
 
   Timestamp next_feedback{0};
@@ -92,6 +93,11 @@ struct Rig {
       mm.mode_raw = static_cast<std::uint8_t>(mode);
       mm.switching = switching;
       inject(mm);
+    }
+    if (wheel_angles) {
+      SteeringAnglesFeedback a;
+      a.angles = *wheel_angles;
+      inject(a);
     }
     if (soc) {
       BmsData b;
@@ -197,7 +203,7 @@ TEST(ControllerHandshake, AutoCommandModeOffNeverRequestsByItself) {
   EXPECT_FALSE(rig.ctl->request_control_mode(ControlMode::kRemote, rig.now).ok());
 }
 
-TEST(ControllerHandshake, RemoteTakeoverIsNeverFoughtAndControlResumesAfterHandBack) {
+TEST(ControllerHandshake, RemoteTakeoverIsNeverFoughtAndIsFinal) {
   Rig rig;
   rig.connect_in_can_mode();
   auto drive = [&](std::chrono::nanoseconds d) {
@@ -216,8 +222,19 @@ TEST(ControllerHandshake, RemoteTakeoverIsNeverFoughtAndControlResumesAfterHandB
   EXPECT_TRUE(rig.bus.sent.empty()) << "the host must stay silent under remote control";
   EXPECT_EQ(rig.state().refusal, MotionRefusal::kRemote);
   EXPECT_FALSE(rig.state().awaiting_command_mode);
+  EXPECT_TRUE(rig.state().reclaim_blocked);
 
-  rig.control = 0x00;  // remote hands back: standby -> request CAN mode again
+  // The remote is switched off (or loses its signal): standby. Remote control is final: no
+  // 0x421 of the driver's own, whatever the commander keeps publishing.
+  rig.control = 0x00;
+  drive(2s);
+  EXPECT_EQ(rig.bus.count(protocol::kControlModeCommandId), 0u);
+  EXPECT_EQ(rig.bus.count(protocol::kMotionCommandId), 0u);
+  EXPECT_EQ(rig.state().refusal, MotionRefusal::kRearmRequired);
+  EXPECT_TRUE(has(rig.state().latched_causes, StopCause::kRemote));
+
+  // resume() gives control back: CAN mode is requested, and the latch is cleared with it.
+  ASSERT_TRUE(rig.ctl->resume(rig.now).ok());
   drive(100ms);
   EXPECT_GE(rig.bus.count(protocol::kControlModeCommandId), 1u);
   EXPECT_EQ(rig.bus.count(protocol::kMotionCommandId), 0u);
@@ -227,18 +244,49 @@ TEST(ControllerHandshake, RemoteTakeoverIsNeverFoughtAndControlResumesAfterHandB
   EXPECT_TRUE(is_moving(rig.motion_frames().back()));
 }
 
-TEST(ControllerHandshake, RemoteSwitchingStraightBackToCanModeResumes) {
+TEST(ControllerHandshake, OptionalAutomaticReclaimAfterRemote) {
+  ControllerConfig cfg;
+  cfg.auto_reclaim_after_remote = true;
+  Rig rig(cfg);
+  rig.connect_in_can_mode();
+  rig.control = 0x03;
+  rig.run(100ms);
+  rig.control = 0x00;  // remote switched off
+  rig.bus.clear_sent();
+  rig.run(100ms);
+  EXPECT_GE(rig.bus.count(protocol::kControlModeCommandId), 1u);
+  EXPECT_FALSE(rig.state().reclaim_blocked);
+  // Reclaiming the control mode is not a re-arm: motion still needs one.
+  rig.control = 0x01;
+  ASSERT_TRUE(rig.ctl->set_command(BodyTwist{0.3, 0, 0}, rig.now).ok());
+  rig.run(40ms);
+  EXPECT_EQ(rig.state().refusal, MotionRefusal::kRearmRequired);
+}
+
+TEST(ControllerHandshake, RemoteHandingBackWithSwbStillNeedsTheRearm) {
   Rig rig;
   rig.connect_in_can_mode();
   rig.control = 0x03;
   rig.run(40ms);
   rig.bus.clear_sent();
-  rig.control = 0x01;
+  rig.control = 0x01;  // SWB up: the chassis itself reports CAN command mode
+  for (int i = 0; i < 10; ++i) {
+    ASSERT_TRUE(rig.ctl->set_command(BodyTwist{0.3, 0, 0}, rig.now).ok());
+    rig.run(20ms);
+  }
+  EXPECT_EQ(rig.bus.count(protocol::kControlModeCommandId), 0u);
+  EXPECT_FALSE(rig.state().reclaim_blocked);
+  EXPECT_EQ(rig.state().refusal, MotionRefusal::kRearmRequired);
+  for (const CanFrame& f : rig.motion_frames())
+    EXPECT_TRUE(is_zero(motion_of(f))) << "moved before the re-arm";
+  // The commander sends a zero twist: re-armed; the next twist drives.
+  ASSERT_TRUE(rig.ctl->set_command(BodyTwist{}, rig.now).ok());
+  rig.run(20ms);
+  EXPECT_EQ(rig.state().refusal, MotionRefusal::kNone);
   ASSERT_TRUE(rig.ctl->set_command(BodyTwist{0.3, 0, 0}, rig.now).ok());
   rig.run(40ms);
-  EXPECT_EQ(rig.bus.count(protocol::kControlModeCommandId), 0u);
-  ASSERT_FALSE(rig.motion_frames().empty());
   EXPECT_TRUE(is_moving(rig.motion_frames().back()));
+  EXPECT_EQ(rig.state().counters.rearms, 1u);
 }
 
 TEST(ControllerLink, StaleAfterTimeoutAndReconnectsByItself) {
@@ -264,10 +312,18 @@ TEST(ControllerLink, StaleAfterTimeoutAndReconnectsByItself) {
   for (const CanFrame& f : rig.motion_frames())
     EXPECT_TRUE(is_zero(motion_of(f)));
 
+  // The chassis is heard again: the link reconnects by itself, but motion does not resume on
+  // the stale twist: link loss was an involuntary stop.
   rig.alive = true;
   ASSERT_TRUE(rig.ctl->set_command(BodyTwist{0.5, 0, 0}, rig.now).ok());
   rig.run(40ms);
   EXPECT_EQ(rig.state().link, LinkState::kConnected);
+  EXPECT_EQ(rig.state().refusal, MotionRefusal::kRearmRequired);
+  EXPECT_TRUE(is_zero(motion_of(rig.motion_frames().back())));
+  ASSERT_TRUE(rig.ctl->set_command(BodyTwist{}, rig.now).ok());  // the re-arm
+  rig.run(20ms);
+  ASSERT_TRUE(rig.ctl->set_command(BodyTwist{0.5, 0, 0}, rig.now).ok());
+  rig.run(40ms);
   EXPECT_TRUE(is_moving(rig.motion_frames().back()));
 }
 
@@ -458,7 +514,7 @@ TEST(ControllerModeSwitch, StopsWaitsForStandstillSwitchesAndResumes) {
   // Ask for a pure rotation: spin mode is needed.
   command({0, 0, 0.8}, 400ms);  // still moving according to the feedback
   EXPECT_EQ(rig.bus.count(protocol::kMotionModeCommandId), 0u) << "0x141 while moving";
-  EXPECT_EQ(rig.state().mode_switch_phase, ModeSwitchPhase::kStopping);
+  EXPECT_EQ(rig.state().mode_switch.phase, ModeSwitchPhase::kStopping);
   EXPECT_EQ(rig.state().refusal, MotionRefusal::kSwitching);
   EXPECT_TRUE(is_zero(motion_of(rig.motion_frames().back())));
 
@@ -467,7 +523,7 @@ TEST(ControllerModeSwitch, StopsWaitsForStandstillSwitchesAndResumes) {
   const auto mode_cmds = rig.bus.sent_with_id(protocol::kMotionModeCommandId);
   ASSERT_EQ(mode_cmds.size(), 1u);
   EXPECT_EQ(mode_cmds[0].data[0], 0x02);  // spin
-  EXPECT_EQ(rig.state().mode_switch_phase, ModeSwitchPhase::kAwaitingConfirmation);
+  EXPECT_EQ(rig.state().mode_switch.phase, ModeSwitchPhase::kAwaitingConfirmation);
 
   // The chassis switches for 500 ms: first reporting the old mode, then the new one, with
   // switching = 1 throughout; only switching = 0 completes it.
@@ -475,10 +531,10 @@ TEST(ControllerModeSwitch, StopsWaitsForStandstillSwitchesAndResumes) {
   command({0, 0, 0.8}, 300ms);
   rig.mode = MotionMode::kSpin;
   command({0, 0, 0.8}, 200ms);
-  EXPECT_EQ(rig.state().mode_switch_phase, ModeSwitchPhase::kAwaitingConfirmation);
+  EXPECT_EQ(rig.state().mode_switch.phase, ModeSwitchPhase::kAwaitingConfirmation);
   rig.switching = false;
   command({0, 0, 0.8}, 100ms);
-  EXPECT_EQ(rig.state().mode_switch_phase, ModeSwitchPhase::kIdle);
+  EXPECT_EQ(rig.state().mode_switch.phase, ModeSwitchPhase::kIdle);
   EXPECT_EQ(rig.state().motion_mode, MotionMode::kSpin);
   EXPECT_EQ(rig.state().refusal, MotionRefusal::kNone);
 
@@ -527,21 +583,29 @@ TEST(ControllerModeSwitch, ForcedModeAndRetryThenReportWhenNeverConfirmed) {
     EXPECT_LE(mode_cmds[i].stamp - start, 1500ms * static_cast<long>(i) + 1ms);
     if (i > 0) EXPECT_EQ(mode_cmds[i].stamp - mode_cmds[i - 1].stamp, 1500ms);
   }
-  EXPECT_TRUE(rig.state().mode_switch_failed);
+  EXPECT_TRUE(rig.state().mode_switch.failed);
   EXPECT_NE(
       std::find(rig.state().faults.begin(), rig.state().faults.end(), "motion_mode_switch_failed"),
       rig.state().faults.end());
   for (const CanFrame& f : rig.motion_frames())
     EXPECT_TRUE(is_zero(motion_of(f)));
 
-  // The chassis finally gets there: the failure clears and the crab drives.
+  EXPECT_EQ(rig.state().refusal, MotionRefusal::kModeSwitchFailed);
+
+  // The chassis finally gets there: the failure clears, but a failed switch was an involuntary
+  // stop: the crab drives only after the re-arm.
   rig.mode = MotionMode::kOblique;
   MotionRequest req;
   req.twist = {0.4, 0, 0};
   req.mode = MotionMode::kOblique;
   ASSERT_TRUE(rig.ctl->set_command(req, rig.now).ok());
   rig.run(40ms);
-  EXPECT_FALSE(rig.state().mode_switch_failed);
+  EXPECT_FALSE(rig.state().mode_switch.failed);
+  EXPECT_EQ(rig.state().refusal, MotionRefusal::kRearmRequired);
+  EXPECT_TRUE(is_zero(motion_of(rig.motion_frames().back())));
+  ASSERT_TRUE(rig.ctl->resume(rig.now).ok());
+  ASSERT_TRUE(rig.ctl->set_command(req, rig.now).ok());
+  rig.run(40ms);
   EXPECT_TRUE(is_moving(rig.motion_frames().back()));
 }
 
@@ -626,9 +690,14 @@ TEST(ControllerFaults, EstopAbnormalAndCriticalBitsAreNamedAndStop) {
 
   rig.vehicle = 0x00;
   rig.errors = 0;
+  drive();  // the causes cleared by themselves: no restart on the commander's stale twist
+  EXPECT_EQ(rig.state().refusal, MotionRefusal::kRearmRequired);
+  EXPECT_TRUE(rig.state().faults.empty());
+  EXPECT_TRUE(is_zero(motion_of(rig.motion_frames().back())));
+  EXPECT_EQ(describe(rig.state().latched_causes), "emergency_stop,critical_error");
+  ASSERT_TRUE(rig.ctl->set_command(BodyTwist{}, rig.now).ok());
   drive();
   EXPECT_EQ(rig.state().refusal, MotionRefusal::kNone);
-  EXPECT_TRUE(rig.state().faults.empty());
   EXPECT_TRUE(is_moving(rig.motion_frames().back()));
 }
 
@@ -639,14 +708,18 @@ TEST(ControllerFaults, LowBatteryIsTheReasonMotionIsRefused) {
   ASSERT_TRUE(rig.ctl->set_command(BodyTwist{0.4, 0, 0}, rig.now).ok());
   rig.run(40ms);
   EXPECT_EQ(rig.state().refusal, MotionRefusal::kLowBattery);
-  EXPECT_TRUE(rig.state().low_battery);
+  EXPECT_TRUE(rig.state().low_battery());
   EXPECT_TRUE(has_fault(rig.state(), "low_battery"));
   EXPECT_TRUE(is_zero(motion_of(rig.motion_frames().back())));
   rig.soc = 55.0;
   ASSERT_TRUE(rig.ctl->set_command(BodyTwist{0.4, 0, 0}, rig.now).ok());
   rig.run(40ms);
-  EXPECT_EQ(rig.state().refusal, MotionRefusal::kNone);
+  EXPECT_EQ(rig.state().refusal, MotionRefusal::kRearmRequired);
   EXPECT_DOUBLE_EQ(*rig.state().battery_soc, 55.0);
+  ASSERT_TRUE(rig.ctl->resume(rig.now).ok());
+  ASSERT_TRUE(rig.ctl->set_command(BodyTwist{0.4, 0, 0}, rig.now).ok());
+  rig.run(40ms);
+  EXPECT_EQ(rig.state().refusal, MotionRefusal::kNone);
 }
 
 TEST(ControllerFaults, ClearErrorsSendsEachCodeAndRejectsUnknownOnes) {
@@ -731,7 +804,7 @@ TEST(ControllerFeedback, SnapshotKeepsEveryKindOfFeedback) {
   SteeringAnglesFeedback angles;
   angles.angles = {0.1, 0.2, 0.3, 0.4};
   rig.inject(angles);
-  const ChassisFeedback& fb = rig.state().feedback;
+  const ChassisFeedback& fb = rig.ctl->feedback();
   ASSERT_TRUE(fb.motor_high_speed[2].has_value());
   EXPECT_DOUBLE_EQ(fb.motor_high_speed[2]->value.rpm, 120.0);
   ASSERT_TRUE(fb.motor_low_speed[6].has_value());
@@ -751,6 +824,144 @@ TEST(ControllerFeedback, SnapshotKeepsEveryKindOfFeedback) {
   rig.ctl->on_frame(garbage, rig.now);
   EXPECT_EQ(rig.state().counters.decode_errors, 1u);
   EXPECT_FALSE(rig.state().last_error.empty());
+}
+
+// ---- re-arm, steer first, small twists, prompt sends (issue 13) ----------------------------
+
+TEST(ControllerRearm, ResumeIsRefusedWhileTheCauseIsActiveAndSendsNothing) {
+  Rig rig;
+  rig.connect_in_can_mode();
+  rig.vehicle = 0x01;  // e-stop pressed
+  rig.run(40ms);
+  rig.bus.clear_sent();
+  const Status st = rig.ctl->resume(rig.now);
+  ASSERT_FALSE(st.ok());
+  EXPECT_NE(st.error().message.find("emergency_stop"), std::string::npos) << st.error().message;
+  EXPECT_TRUE(rig.bus.sent.empty());
+  // A zero twist while the e-stop is still pressed does not re-arm either.
+  ASSERT_TRUE(rig.ctl->set_command(BodyTwist{}, rig.now).ok());
+  rig.vehicle = 0x00;  // released
+  ASSERT_TRUE(rig.ctl->set_command(BodyTwist{0.4, 0, 0}, rig.now).ok());
+  rig.run(100ms);
+  EXPECT_EQ(rig.state().refusal, MotionRefusal::kRearmRequired);
+  for (const CanFrame& f : rig.motion_frames())
+    EXPECT_TRUE(is_zero(motion_of(f)));
+  EXPECT_TRUE(rig.ctl->resume(rig.now).ok());
+  ASSERT_TRUE(rig.ctl->set_command(BodyTwist{0.4, 0, 0}, rig.now).ok());
+  rig.run(40ms);
+  EXPECT_TRUE(is_moving(rig.motion_frames().back()));
+}
+
+TEST(ControllerRearm, TheCommandTimeoutIsTheCommandersOwnStopAndNeedsNoRearm) {
+  Rig rig;
+  rig.connect_in_can_mode();
+  ASSERT_TRUE(rig.ctl->set_command(BodyTwist{0.4, 0, 0}, rig.now).ok());
+  rig.run(700ms);
+  EXPECT_EQ(rig.state().refusal, MotionRefusal::kCmdTimeout);
+  EXPECT_FALSE(rig.state().rearm_required());
+  ASSERT_TRUE(rig.ctl->set_command(BodyTwist{0.4, 0, 0}, rig.now).ok());
+  rig.run(20ms);
+  EXPECT_EQ(rig.state().refusal, MotionRefusal::kNone);
+  EXPECT_TRUE(is_moving(rig.motion_frames().back()));
+}
+
+TEST(ControllerRearm, StartUpInStandbyIsNotAnInvoluntaryStop) {
+  Rig rig;
+  rig.obey_control_requests = true;
+  ASSERT_TRUE(rig.ctl->set_command(BodyTwist{0.4, 0, 0}, rig.now).ok());
+  for (int i = 0; i < 20; ++i) {
+    ASSERT_TRUE(rig.ctl->set_command(BodyTwist{0.4, 0, 0}, rig.now).ok());
+    rig.run(20ms);
+  }
+  EXPECT_EQ(rig.state().refusal, MotionRefusal::kNone);
+  EXPECT_TRUE(is_moving(rig.motion_frames().back()));
+}
+
+TEST(ControllerSteerFirst, SidewaysFromStraightWaitsForTheWheels) {
+  Rig rig;
+  rig.wheel_angles = std::array<double, 4>{0, 0, 0, 0};
+  rig.connect_in_can_mode(MotionMode::kOblique);
+  MotionRequest req;
+  req.twist = {0, 0.4, 0};
+  for (int i = 0; i < 5; ++i) {
+    ASSERT_TRUE(rig.ctl->set_command(req, rig.now).ok());
+    rig.run(20ms);
+  }
+  // Wheels still straight: the 90 deg steering goes out, the speed is held at zero.
+  MotionCommand c = motion_of(rig.motion_frames().back());
+  EXPECT_EQ(c.linear_speed, 0.0);
+  EXPECT_NEAR(interpretation::rep103_from_manual_command_steering(c.steering_angle), M_PI / 2,
+              1e-3);
+  EXPECT_EQ(rig.state().steer_first_factor, 0.0);
+  EXPECT_EQ(rig.state().refusal, MotionRefusal::kNone);
+  // Halfway through the threshold band: part of the speed.
+  const double at = M_PI / 2 - 15.0 * M_PI / 180.0;              // 15 deg off
+  rig.wheel_angles = std::array<double, 4>{-at, -at, -at, -at};  // manual signs: left negative
+  ASSERT_TRUE(rig.ctl->set_command(req, rig.now).ok());
+  rig.run(40ms);
+  c = motion_of(rig.motion_frames().back());
+  EXPECT_NEAR(c.linear_speed, 0.2, 0.01);
+  // Wheels there: full speed.
+  rig.wheel_angles = std::array<double, 4>{-M_PI / 2, -M_PI / 2, -M_PI / 2, -M_PI / 2};
+  ASSERT_TRUE(rig.ctl->set_command(req, rig.now).ok());
+  rig.run(40ms);
+  c = motion_of(rig.motion_frames().back());
+  EXPECT_NEAR(c.linear_speed, 0.4, 1e-3);
+  EXPECT_EQ(rig.state().steer_first_factor, 1.0);
+}
+
+TEST(ControllerSmallTwists, BelowTheResolutionIsRefusedByName) {
+  Rig rig;
+  rig.connect_in_can_mode();
+  ASSERT_TRUE(rig.ctl->set_command(BodyTwist{0.0003, 0, 0}, rig.now).ok());
+  rig.run(40ms);
+  EXPECT_EQ(rig.state().refusal, MotionRefusal::kBelowMinimum);
+  EXPECT_EQ(to_string(MotionRefusal::kBelowMinimum), "below_minimum");
+  ASSERT_TRUE(rig.ctl->set_command(BodyTwist{0.05, 0, 0}, rig.now).ok());
+  rig.run(20ms);
+  EXPECT_EQ(rig.state().refusal, MotionRefusal::kNone);
+  EXPECT_TRUE(is_moving(rig.motion_frames().back()));
+}
+
+TEST(ControllerLatency, AChangedCommandIsNotHeldBackByAKeepAlive) {
+  Rig rig;
+  rig.connect_in_can_mode();
+  rig.run(100ms);
+  // Right after a keep-alive (sent by the tick 1 ms ago), change the command: it goes out at once.
+  while (rig.motion_frames().empty() || rig.motion_frames().back().stamp != rig.now - 1ms) {
+    rig.run(1ms);
+  }
+  rig.bus.clear_sent();
+  ASSERT_TRUE(rig.ctl->set_command(BodyTwist{0.3, 0, 0}, rig.now).ok());
+  EXPECT_EQ(rig.ctl->next_tick_due(), rig.now) << "a pending command is due now";
+  const Timestamp posted = rig.now;
+  rig.ctl->tick(rig.now);
+  ASSERT_EQ(rig.bus.count(protocol::kMotionCommandId), 1u);
+  EXPECT_EQ(rig.motion_frames()[0].stamp, posted);
+  EXPECT_TRUE(is_moving(rig.motion_frames()[0]));
+  // A second change within min_command_interval waits for it, and next_tick_due says when.
+  ASSERT_TRUE(rig.ctl->set_command(BodyTwist{0.35, 0, 0}, rig.now).ok());
+  EXPECT_EQ(rig.ctl->next_tick_due(), posted + rig.ctl->config().min_command_interval);
+}
+
+TEST(ControllerEvents, EveryFrameSentIsReportedTheShutdownStopIncluded) {
+  Rig rig;
+  std::vector<SentFrame> seen;
+  rig.connect_in_can_mode();
+  rig.ctl->set_send_observer([&](const SentFrame& f) { seen.push_back(f); });
+  ASSERT_TRUE(rig.ctl->set_command(BodyTwist{0.3, 0, 0}, rig.now).ok());
+  rig.run(40ms);
+  rig.ctl->shutdown(rig.now);
+  ASSERT_EQ(seen.size(), rig.bus.sent.size() + 0u);
+  for (std::size_t i = 0; i < seen.size(); ++i)
+    EXPECT_EQ(seen[i].frame, rig.bus.sent[i]);
+  EXPECT_TRUE(seen.back().shutdown);
+  EXPECT_EQ(seen.back().frame.id, protocol::kMotionCommandId);
+  EXPECT_EQ(seen.back().achieved.vx, 0.0);
+  const auto moving =
+      std::find_if(seen.begin(), seen.end(), [](const SentFrame& f) { return is_moving(f.frame); });
+  ASSERT_NE(moving, seen.end());
+  EXPECT_NEAR(moving->achieved.vx, 0.3, 1e-9);
 }
 
 TEST(ControllerConfig, Validation) {

@@ -6,9 +6,10 @@
 #include <cmath>
 #include <limits>
 
+#include "ranger_can/control/kinematics.hpp"
+#include "ranger_can/control/mode_selector.hpp"
 #include "ranger_can/wire/codec.hpp"
 #include "ranger_can/wire/interpretation.hpp"
-#include "ranger_can/control/kinematics.hpp"
 
 namespace ranger {
 namespace {
@@ -316,14 +317,32 @@ TEST(ModeSelector, ClassificationTable) {
       {{1, 0.03, 0.5}, MotionMode::kOblique, MotionMode::kOblique},      // above lateral_exit
       {{0.03, 0, 0.5}, MotionMode::kAckermann, MotionMode::kAckermann},  // above linear_enter
       {{0.03, 0, 0.5}, MotionMode::kSpin, MotionMode::kSpin},            // below linear_exit
-      {{0, 0, 0.03}, MotionMode::kAckermann, MotionMode::kAckermann},    // below rotation_enter
       {{0, 0, 0.03}, MotionMode::kSpin, MotionMode::kSpin},              // above rotation_exit
+      // no dead band (issue 13): a small twist drives in the mode a user expects
+      {{0, 0, 0.03}, MotionMode::kAckermann, MotionMode::kSpin},        // small pure rotation
+      {{0, 0.03, 0}, MotionMode::kAckermann, MotionMode::kOblique},     // small pure lateral
+      {{0.02, 0.03, 0}, MotionMode::kAckermann, MotionMode::kOblique},  // lateral dominates
+      {{0.01, 0, 0}, MotionMode::kSpin, MotionMode::kAckermann},        // small pure translation
+      {{0, 0.05, 0}, MotionMode::kAckermann, MotionMode::kOblique},     // teleop's minimum
+      {{0, 0, 0.05}, MotionMode::kAckermann, MotionMode::kSpin},
+      // below the chassis's resolution: nothing to drive, no switch
+      {{0.0004, 0, 0}, MotionMode::kSpin, MotionMode::kSpin},
+      {{0, 0, 0.001}, MotionMode::kAckermann, MotionMode::kAckermann},
   };
   for (const Case& c : cases) {
     EXPECT_EQ(sel.classify(c.t, c.current), c.expected)
         << "twist (" << c.t.vx << ", " << c.t.vy << ", " << c.t.wz << ") in "
         << protocol::to_string(c.current);
   }
+}
+
+TEST(ModeSelector, BelowMinimumIsNamedNotDropped) {
+  const ModeSelector sel;
+  EXPECT_FALSE(sel.below_minimum({0, 0, 0}));  // zero is a stop, not a too-small motion
+  EXPECT_TRUE(sel.below_minimum({0.0004, 0, 0}));
+  EXPECT_TRUE(sel.below_minimum({0, -0.0002, 0.001}));
+  EXPECT_FALSE(sel.below_minimum({0.001, 0, 0}));
+  EXPECT_FALSE(sel.below_minimum({0, 0, 0.002}));
 }
 
 TEST(ModeSelector, NoisyInputDoesNotFlapAndSteadyInputSwitchesAfterConfirmTime) {

@@ -18,8 +18,8 @@
 
 #include "ranger_can/clock.hpp"
 #include "ranger_can/control/controller.hpp"
-#include "ranger_can/transport/loopback_bus.hpp"
 #include "ranger_can/sim/virtual_chassis.hpp"
+#include "ranger_can/transport/loopback_bus.hpp"
 #include "wire_audit.hpp"
 
 namespace ranger::faults {
@@ -66,6 +66,8 @@ class LoopbackFaultRig {
       if (request_ && t >= next_request_) {
         last_request_status_ = controller_->set_command(*request_, t);
         next_request_ = t + kCallerPeriod;
+        const BodyTwist& w = request_->twist;
+        if (w.vx == 0.0 && w.vy == 0.0 && w.wz == 0.0) audit_.on_rearm_attempt(t);
       }
       controller_->tick(t);
     }
@@ -103,6 +105,11 @@ class LoopbackFaultRig {
     next_request_ = now();
   }
   void stop_commanding() { request_.reset(); }
+  // The explicit re-arm (the node's `resume` service).
+  Status resume() {
+    audit_.on_rearm_attempt(now());
+    return controller_->resume(now());
+  }
   const Status& last_request_status() const { return last_request_status_; }
   // The driver process dies: nothing is read, decided or sent any more (no shutdown, no stop).
   void kill_driver() { driver_alive_ = false; }
@@ -142,6 +149,33 @@ class LoopbackFaultRig {
     return ::testing::AssertionFailure()
            << "no CAN command mode after 3 s; refusal " << to_string(state().refusal);
   }
+  // After an involuntary stop whose cause has cleared: the chassis stays at rest although the
+  // caller still asks for `twist` (kRearmRequired, for a whole second); a zero twist re-arms and
+  // `twist` then drives it up to `speed` again.
+  ::testing::AssertionResult latched_then_rearmed_by_zero_twist(const BodyTwist& twist,
+                                                                double speed) {
+    command(twist);
+    if (!run_until([&] { return state().refusal == MotionRefusal::kRearmRequired; }, 3s)) {
+      return ::testing::AssertionFailure()
+             << "no kRearmRequired; refusal " << to_string(state().refusal);
+    }
+    const Timestamp until = now() + std::chrono::seconds(1);
+    while (now() < until) {
+      step();
+      if (snapshot().speed != 0.0) return ::testing::AssertionFailure() << "moved unasked";
+    }
+    command(BodyTwist{});
+    if (!run_until([&] { return state().refusal != MotionRefusal::kRearmRequired; }, 1s)) {
+      return ::testing::AssertionFailure() << "the zero twist did not re-arm";
+    }
+    command(twist);
+    if (run_until([&] { return std::abs(snapshot().speed - speed) < 1e-9; }, 10s)) {
+      return ::testing::AssertionSuccess();
+    }
+    return ::testing::AssertionFailure() << "chassis at " << snapshot().speed << " m/s after the "
+                                         << "re-arm; refusal " << to_string(state().refusal);
+  }
+
   // connect(), then drives `twist` until the chassis moves at `speed` (exactly, the model settles).
   ::testing::AssertionResult drive(const BodyTwist& twist, double speed) {
     if (auto r = connect(); !r) return r;

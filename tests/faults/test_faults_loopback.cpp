@@ -88,16 +88,18 @@ TEST_F(Faults, BusOffStopsTheChassisAndRestartResumesWithEveryFrameAccountedFor)
   EXPECT_EQ(during.tx_frames - before.tx_frames, c.frames_sent - sent_before.frames_sent);
   EXPECT_EQ(c.error_frames - sent_before.error_frames, 1u);
 
-  // The controller restarts: the queued frames go out, the link comes back, motion resumes.
+  // The controller restarts: the queued frames go out and the link comes back; motion resumes
+  // only after the caller's re-arm (the link loss was an involuntary stop).
   rig_.network().inject_error_frame(can_error::make(can_error::kRestarted));
   rig_.network().stall_transmission(false);
   const Timestamp t_restart = rig_.now();
-  ASSERT_TRUE(rig_.run_until([&] { return rig_.snapshot().speed > kCruise - 0.05; }, 5s));
+  ASSERT_TRUE(rig_.run_until([&] { return rig_.state().link == LinkState::kConnected; }, 2s));
+  EXPECT_LE(rig_.now() - t_restart, 2s);
+  ASSERT_TRUE(rig_.latched_then_rearmed_by_zero_twist({kCruise, 0, 0}, kCruise));
   EXPECT_EQ(rig_.driver_bus().status().state, BusState::kActive);
   EXPECT_EQ(rig_.driver_bus().status().stats.restarts - before.restarts, 1u);
   EXPECT_EQ(rig_.state().refusal, MotionRefusal::kNone);
   EXPECT_FALSE(rig_.snapshot().host_link_lost);
-  EXPECT_LE(rig_.now() - t_restart, 2s);
   // Every frame the driver's bus accepted since the fault reached the wire.
   EXPECT_EQ(host_frames_on_wire(t_off),
             rig_.driver_bus().status().stats.tx_frames - before.tx_frames);
@@ -124,7 +126,7 @@ TEST_F(Faults, InterfaceDownAndUpStopsTheChassisThenReopensAndResumes) {
   EXPECT_LE(rig_.now() - t_up, 1s + 50ms);
   EXPECT_GE(rig_.driver_bus().status().stats.reopens - before.reopens, 1u);
   EXPECT_EQ(rig_.driver_bus().status().state, BusState::kActive);
-  ASSERT_TRUE(rig_.run_until([&] { return rig_.snapshot().speed > kCruise - 0.05; }, 5s));
+  ASSERT_TRUE(rig_.latched_then_rearmed_by_zero_twist({kCruise, 0, 0}, kCruise));
   EXPECT_FALSE(rig_.snapshot().host_link_lost);
 }
 
@@ -214,17 +216,11 @@ TEST_F(Faults, ChassisSilentForOneSecondIsDetectedAfterLinkTimeoutAndResumesWith
   EXPECT_EQ(rig_.snapshot().speed, 0.0);
   EXPECT_FALSE(rig_.snapshot().host_link_lost);
 
-  // Back: the new command, never the old one.
-  double max_speed = 0.0;
-  ASSERT_TRUE(rig_.run_until(
-      [&] {
-        max_speed = std::max(max_speed, rig_.snapshot().speed);
-        return rig_.state().link == LinkState::kConnected &&
-               std::abs(rig_.snapshot().speed - 0.3) < 1e-9;
-      },
-      3s));
+  // Back: held at rest until the re-arm, then the new command, never the old one.
+  ASSERT_TRUE(rig_.run_until([&] { return rig_.state().link == LinkState::kConnected; }, 3s));
+  ASSERT_TRUE(rig_.latched_then_rearmed_by_zero_twist({0.3, 0, 0}, 0.3));
   rig_.run_for(1s);
-  EXPECT_LE(std::max(max_speed, rig_.snapshot().speed), 0.3 + 1e-9);
+  EXPECT_LE(rig_.snapshot().speed, 0.3 + 1e-9);
   EXPECT_EQ(rig_.state().counters.link_losses, 1u);
 }
 
@@ -237,6 +233,7 @@ struct RefusingFault {
   const char* fault;                    // in state().faults, or nullptr
   std::chrono::nanoseconds detection;   // the feedback period that carries it, plus a step
   bool host_silent;                     // no host frames at all while it lasts (remote control)
+  bool clear_needs_resume = false;      // ends in standby after remote control: resume() only
 };
 
 std::ostream& operator<<(std::ostream& os, const RefusingFault& f) {
@@ -245,7 +242,7 @@ std::ostream& operator<<(std::ostream& os, const RefusingFault& f) {
 
 class RefusingFaults : public Faults, public ::testing::WithParamInterface<RefusingFault> {};
 
-TEST_P(RefusingFaults, StopsMotionOnTheWireAtOnceAndResumesWhenCleared) {
+TEST_P(RefusingFaults, StopsMotionOnTheWireAtOnceAndResumesOnlyAfterTheRearm) {
   const RefusingFault& fault = GetParam();
   ASSERT_TRUE(rig_.drive({kCruise, 0, 0}, kCruise));
   fault.inject(rig_);
@@ -279,8 +276,18 @@ TEST_P(RefusingFaults, StopsMotionOnTheWireAtOnceAndResumesWhenCleared) {
   EXPECT_EQ(rig_.snapshot().speed, 0.0);
 
   fault.clear(rig_);
-  ASSERT_TRUE(rig_.run_until([&] { return rig_.snapshot().speed > kCruise - 0.05; }, 5s))
-      << "refusal " << to_string(rig_.state().refusal);
+  if (fault.clear_needs_resume) {
+    // Remote switched off: standby, and remote control is final: no CAN-mode request of the
+    // driver's own until resume().
+    rig_.run_for(2s);
+    EXPECT_TRUE(rig_.wire(protocol::kControlModeCommandId, t_detect).empty());
+    EXPECT_EQ(rig_.snapshot().speed, 0.0);
+    ASSERT_TRUE(rig_.resume().ok());
+    ASSERT_TRUE(rig_.run_until([&] { return rig_.snapshot().speed > kCruise - 0.05; }, 5s))
+        << "refusal " << to_string(rig_.state().refusal);
+  } else {
+    ASSERT_TRUE(rig_.latched_then_rearmed_by_zero_twist({kCruise, 0, 0}, kCruise));
+  }
   EXPECT_EQ(rig_.state().refusal, MotionRefusal::kNone);
   if (fault.fault) {
     EXPECT_FALSE(has_fault(rig_.state(), fault.fault));
@@ -306,6 +313,7 @@ INSTANTIATE_TEST_SUITE_P(
                       {MotionRefusal::kRemote},
                       nullptr,
                       40ms,
+                      true,
                       true},
         RefusingFault{"emergency_stop",
                       [](LoopbackFaultRig& r) { r.chassis().set_emergency_stop(true); },
@@ -338,7 +346,7 @@ TEST_F(Faults, LowBatteryIsReportedFromBothTheBmsAndTheStatusBits) {
   ASSERT_TRUE(rig_.drive({kCruise, 0, 0}, kCruise));
   rig_.chassis().set_battery_soc(8.0);
   // The BMS frame comes every 500 ms; the status bit every 20 ms.
-  ASSERT_TRUE(rig_.run_until([&] { return rig_.state().low_battery; }, 600ms));
+  ASSERT_TRUE(rig_.run_until([&] { return rig_.state().low_battery(); }, 600ms));
   EXPECT_TRUE(has_fault(rig_.state(), "low_battery"));
   EXPECT_TRUE(rig_.state().error_bits & (1u << kUnderVoltage));
   ASSERT_TRUE(rig_.state().battery_soc.has_value());
@@ -378,7 +386,7 @@ TEST_F(Faults, ErrorBitsSetAndClearedByTheChassisAreReportedAndOnlyCriticalOnesS
   EXPECT_EQ(rig_.state().refusal, MotionRefusal::kCriticalError);
   EXPECT_EQ(rig_.snapshot().speed, 0.0);
   rig_.chassis().set_error_bit(over_current, false);
-  ASSERT_TRUE(rig_.run_until([&] { return rig_.snapshot().speed > kCruise - 0.05; }, 5s));
+  ASSERT_TRUE(rig_.latched_then_rearmed_by_zero_twist({kCruise, 0, 0}, kCruise));
   EXPECT_TRUE(rig_.state().faults.empty());
 }
 
@@ -388,7 +396,7 @@ TEST_F(Faults, ModeSwitchThatNeverCompletesIsRetriedAtABoundedRateAndNeverDrives
   const Timestamp t0 = rig_.now();
   const std::uint64_t moving_before = rig_.audit().moving_commands();
   rig_.command({0, 0, 0.5}, MotionMode::kSpin);
-  ASSERT_TRUE(rig_.run_until([&] { return rig_.state().mode_switch_failed; }, 10s));
+  ASSERT_TRUE(rig_.run_until([&] { return rig_.state().mode_switch.failed; }, 10s));
   EXPECT_TRUE(has_fault(rig_.state(), "motion_mode_switch_failed"));
   rig_.run_for(5s);
 
@@ -403,7 +411,7 @@ TEST_F(Faults, ModeSwitchThatNeverCompletesIsRetriedAtABoundedRateAndNeverDrives
   EXPECT_EQ(rig_.audit().moving_commands(), moving_before) << "no motion while switching";
   EXPECT_EQ(rig_.snapshot().speed, 0.0);
   EXPECT_TRUE(rig_.snapshot().switching);
-  EXPECT_EQ(rig_.state().refusal, MotionRefusal::kSwitching);
+  EXPECT_EQ(rig_.state().refusal, MotionRefusal::kModeSwitchFailed);
 }
 
 // ---- hostile commands -------------------------------------------------------------------------

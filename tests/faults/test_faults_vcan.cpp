@@ -33,9 +33,9 @@
 
 #include "ranger_can/clock.hpp"
 #include "ranger_can/control/controller.hpp"
+#include "ranger_can/sim/virtual_chassis_runner.hpp"
 #include "ranger_can/transport/error_frame.hpp"
 #include "ranger_can/transport/socketcan_bus.hpp"
-#include "ranger_can/sim/virtual_chassis_runner.hpp"
 #include "wire_audit.hpp"
 
 extern char** environ;
@@ -169,6 +169,23 @@ class VcanFaultRig {
   }
   const WireAudit& audit() const { return audit_; }
 
+  // After an involuntary stop whose cause has cleared: held at rest (kRearmRequired) while the
+  // caller asks for `twist`; a zero twist re-arms; then `twist` drives above `min_speed`.
+  ::testing::AssertionResult rearm_by_zero_twist_then_drive(const BodyTwist& twist,
+                                                            double min_speed) {
+    command(twist);
+    if (!run_until([&] { return state().refusal == MotionRefusal::kRearmRequired; }, 2s)) {
+      return ::testing::AssertionFailure() << "refusal " << to_string(state().refusal);
+    }
+    run_for(500ms);
+    if (snapshot().speed != 0.0) return ::testing::AssertionFailure() << "moved before the re-arm";
+    command(BodyTwist{});
+    if (!run_until([&] { return state().refusal != MotionRefusal::kRearmRequired; }, 2s)) {
+      return ::testing::AssertionFailure() << "the zero twist did not re-arm";
+    }
+    return drive(twist, min_speed);
+  }
+
   ::testing::AssertionResult drive(const BodyTwist& twist, double min_speed) {
     if (!ready()) return ::testing::AssertionFailure() << "no vcan";
     command(twist);
@@ -185,6 +202,9 @@ class VcanFaultRig {
     if (request_ && now >= next_request_) {
       EXPECT_TRUE(controller_->set_command(*request_, now).ok());
       next_request_ = now + 20ms;
+      if (request_->vx == 0.0 && request_->vy == 0.0 && request_->wz == 0.0) {
+        audit_.on_rearm_attempt(now);
+      }
     }
     controller_->tick(now);
     const auto wait =
@@ -239,7 +259,7 @@ TEST_F(VcanFaults, BusOffFromAnErrorFrameStopsTheChassisAndRestartResumes) {
 
   // Restart: the queue drains, traffic flows again, the controller reports error-active again
   // (the restart report is written once frames flow: right after the qdisc is removed the kernel
-  // may still drop a frame), motion resumes.
+  // may still drop a frame); motion resumes after the caller's re-arm (link loss latches).
   ASSERT_TRUE(
       rig_.run("tc qdisc change dev " + interface_name() + " root plug release_indefinite"));
   ASSERT_TRUE(rig_.run("tc qdisc del dev " + interface_name() + " root"));
@@ -249,8 +269,7 @@ TEST_F(VcanFaults, BusOffFromAnErrorFrameStopsTheChassisAndRestartResumes) {
       rig_.run_until([&] { return rig_.driver_bus().status().state == BusState::kActive; }, 2s))
       << "bus " << to_string(rig_.driver_bus().status().state) << " ("
       << rig_.driver_bus().status().detail << ")";
-  ASSERT_TRUE(rig_.run_until([&] { return rig_.snapshot().speed >= 0.45; }, 5s))
-      << "refusal " << to_string(rig_.state().refusal);
+  ASSERT_TRUE(rig_.rearm_by_zero_twist_then_drive({0.5, 0, 0}, 0.45));
   const BusStatistics after = rig_.driver_bus().status().stats;
   EXPECT_EQ(after.restarts - before.restarts, 1u);
   EXPECT_GE(after.error_frames - before.error_frames, 2u);
@@ -274,10 +293,9 @@ TEST_F(VcanFaults, InterfaceDownAndUpStopsTheChassisThenReopensAndResumes) {
   EXPECT_EQ(rig_.driver_bus().status().state, BusState::kDown);
 
   ASSERT_TRUE(rig_.run("ip link set dev " + interface_name() + " up"));
-  ASSERT_TRUE(rig_.run_until(
-      [&] { return rig_.state().link == LinkState::kConnected && rig_.snapshot().speed >= 0.45; },
-      5s))
+  ASSERT_TRUE(rig_.run_until([&] { return rig_.state().link == LinkState::kConnected; }, 5s))
       << "refusal " << to_string(rig_.state().refusal);
+  ASSERT_TRUE(rig_.rearm_by_zero_twist_then_drive({0.5, 0, 0}, 0.45));
   EXPECT_EQ(rig_.driver_bus().status().state, BusState::kActive);
   EXPECT_GE(rig_.driver_bus().status().stats.reopens - before.reopens, 1u);
   EXPECT_FALSE(rig_.snapshot().host_link_lost);

@@ -11,6 +11,11 @@
 //     any) reported a SOC at or above the cut-off.
 //  2. No 0x421 asks for CAN mode while the last 0x211 said remote control (never fight the remote).
 //  3. Every host frame (0x111, 0x141, 0x421, 0x441, 0x451) decodes: no wrong DLC, no NaN field.
+//  4. No moving 0x111 after an involuntary stop until a re-arm: once the wire showed an e-stop,
+//     remote control, a critical error bit, a low battery or a silent chassis (no 0x211 for
+//     longer than link_timeout), motion is a violation until the caller re-armed (a zero twist or
+//     resume, reported by the rig through on_rearm_attempt) at a time the wire showed none of
+//     those any more.
 #pragma once
 
 #include <chrono>
@@ -21,8 +26,8 @@
 #include <string>
 #include <vector>
 
-#include "ranger_can/wire/codec.hpp"
 #include "ranger_can/control/controller.hpp"
+#include "ranger_can/wire/codec.hpp"
 #include "ranger_can/wire/frame.hpp"
 #include "ranger_can/wire/protocol.hpp"
 
@@ -47,13 +52,18 @@ class WireAudit {
       if (is_host_id(f.id)) violation(f, "host frame does not decode: " + message.error().message);
       return;
     }
+    if (status_ && f.stamp - status_stamp_ > config_.link_timeout + slack_ && !blind_) {
+      latched_ = true;  // the chassis fell silent: an involuntary stop
+    }
     if (const auto* s = std::get_if<SystemStatus>(&*message)) {
       status_ = *s;
       status_stamp_ = f.stamp;
+      if (cause_active()) latched_ = true;
     } else if (const auto* m = std::get_if<MotionModeFeedback>(&*message)) {
       mode_ = *m;
     } else if (const auto* b = std::get_if<BmsData>(&*message)) {
       if (b->battery == 0) soc_ = b->soc;
+      if (cause_active()) latched_ = true;
     } else if (const auto* c = std::get_if<MotionCommand>(&*message)) {
       check_motion(f, *c);
     } else if (const auto* r = std::get_if<ControlModeCommand>(&*message)) {
@@ -63,6 +73,15 @@ class WireAudit {
       }
     }
   }
+
+  // The caller asked for a re-arm at `t` (a zero twist, or resume): it counts if the wire shows
+  // no involuntary-stop cause at that time.
+  void on_rearm_attempt(Timestamp t) {
+    if (!cause_active() && !(status_ && t - status_stamp_ > config_.link_timeout + slack_)) {
+      latched_ = false;
+    }
+  }
+  bool latched() const { return latched_; }
 
   // The observer itself lost the bus (its interface went down): what it knew may be stale and
   // it may miss frames the driver sees. Motion is not judged again until the observer has seen a
@@ -86,6 +105,15 @@ class WireAudit {
     return id == protocol::kMotionCommandId || id == protocol::kMotionModeCommandId ||
            id == protocol::kControlModeCommandId || id == protocol::kErrorClearCommandId ||
            id == protocol::kUltrasonicSettingId;
+  }
+
+  bool cause_active() const {
+    if (soc_ && *soc_ < config_.low_battery_soc) return true;
+    if (!status_) return false;
+    return status_->control_mode_raw == static_cast<std::uint8_t>(protocol::ControlMode::kRemote) ||
+           status_->vehicle_status_raw ==
+               static_cast<std::uint8_t>(protocol::VehicleStatus::kEmergencyStop) ||
+           protocol::is_critical_error(status_->error_bits);
   }
 
   void check_motion(const CanFrame& f, const MotionCommand& c) {
@@ -114,6 +142,7 @@ class WireAudit {
     }
     if (mode_->switching) return violation(f, "motion while the chassis is switching modes");
     if (soc_ && *soc_ < config_.low_battery_soc) return violation(f, "motion on a low battery");
+    if (latched_) return violation(f, "motion after an involuntary stop without a re-arm");
   }
 
   void violation(const CanFrame& f, const std::string& what) {
@@ -130,6 +159,7 @@ class WireAudit {
   std::optional<MotionModeFeedback> mode_;
   std::optional<double> soc_;
   bool blind_ = false;
+  bool latched_ = false;  // an involuntary stop seen on the wire, not yet re-armed
   std::map<std::uint32_t, std::uint64_t> counts_;
   std::uint64_t error_frames_ = 0;
   std::uint64_t moving_commands_ = 0;

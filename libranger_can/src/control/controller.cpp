@@ -7,6 +7,9 @@
 #include <utility>
 #include <variant>
 
+#include "ranger_can/transport/error_frame.hpp"
+#include "ranger_can/wire/interpretation.hpp"
+
 namespace ranger {
 namespace {
 
@@ -19,8 +22,12 @@ bool known_control_mode(std::uint8_t raw) {
          raw == static_cast<std::uint8_t>(ControlMode::kRemote);
 }
 
-bool known_motion_mode(std::uint8_t raw) {
-  return raw <= static_cast<std::uint8_t>(MotionMode::kSpin);
+bool drivable_mode(MotionMode m) {
+  return m == MotionMode::kAckermann || m == MotionMode::kOblique || m == MotionMode::kSpin;
+}
+
+bool is_zero(const BodyTwist& t) {
+  return t.vx == 0.0 && t.vy == 0.0 && t.wz == 0.0;
 }
 
 Status check_duration(const char* name, std::chrono::nanoseconds d) {
@@ -40,20 +47,28 @@ std::string_view to_string(MotionRefusal r) {
       return "link_lost";
     case MotionRefusal::kRemote:
       return "remote";
-    case MotionRefusal::kStandby:
-      return "standby";
     case MotionRefusal::kEstop:
       return "estop";
     case MotionRefusal::kCriticalError:
       return "critical_error";
     case MotionRefusal::kLowBattery:
       return "low_battery";
+    case MotionRefusal::kModeSwitchFailed:
+      return "mode_switch_failed";
+    case MotionRefusal::kImplausible:
+      return "implausible_feedback";
+    case MotionRefusal::kRearmRequired:
+      return "rearm_required";
+    case MotionRefusal::kStandby:
+      return "standby";
     case MotionRefusal::kModeUnknown:
       return "mode_unknown";
     case MotionRefusal::kSwitching:
       return "switching";
     case MotionRefusal::kCmdTimeout:
       return "cmd_timeout";
+    case MotionRefusal::kBelowMinimum:
+      return "below_minimum";
   }
   return "unknown";
 }
@@ -66,18 +81,6 @@ std::string_view to_string(LinkState s) {
       return "connected";
     case LinkState::kStale:
       return "stale";
-  }
-  return "unknown";
-}
-
-std::string_view to_string(ModeSwitchPhase p) {
-  switch (p) {
-    case ModeSwitchPhase::kIdle:
-      return "idle";
-    case ModeSwitchPhase::kStopping:
-      return "stopping";
-    case ModeSwitchPhase::kAwaitingConfirmation:
-      return "awaiting_confirmation";
   }
   return "unknown";
 }
@@ -113,6 +116,11 @@ Status ControllerConfig::validate() const {
   if (!std::isfinite(standstill_speed) || standstill_speed < 0.0) {
     return Error{Errc::kOutOfRange, "controller: standstill_speed must be finite and >= 0"};
   }
+  if (!std::isfinite(steer_first_threshold) || steer_first_threshold < 0.0 ||
+      steer_first_threshold > M_PI / 2) {
+    return Error{Errc::kOutOfRange,
+                 "controller: steer_first_threshold must be in [0, pi/2] rad (0 disables)"};
+  }
   if (!std::isfinite(low_battery_soc) || low_battery_soc < 0.0 || low_battery_soc > 100.0) {
     return Error{Errc::kOutOfRange, "controller: low_battery_soc must be in [0, 100] %"};
   }
@@ -123,6 +131,7 @@ ChassisController::ChassisController(Bus& bus, ControllerConfig config)
     : bus_(bus),
       config_(std::move(config)),
       selector_(config_.mode_selection),
+      mode_switch_(ModeSwitchConfig{config_.mode_switch_timeout, config_.mode_switch_max_attempts}),
       limiter_vx_(config_.limit_vx),
       limiter_vy_(config_.limit_vy),
       limiter_wz_(config_.limit_wz) {
@@ -142,6 +151,15 @@ void ChassisController::on_frame(const CanFrame& frame, Timestamp now) {
   state_.now = now;
   if (frame.is_error) {
     ++state_.counters.error_frames;
+    // Bus-off: nothing we send arrives any more, and what is queued goes out only after the
+    // controller restarts. Treat it as link loss at once, so that only zero commands queue up
+    // behind the moving ones already in flight (waiting link_timeout would queue moving ones).
+    if (interpret_error_frame(frame).new_state == BusState::kBusOff &&
+        state_.link == LinkState::kConnected) {
+      lose_link();
+      update_causes();
+      update_faults();
+    }
     return;
   }
   ++state_.counters.frames_received;
@@ -156,94 +174,62 @@ void ChassisController::on_frame(const CanFrame& frame, Timestamp now) {
 
 void ChassisController::on_message(const Message& message, Timestamp stamp, Timestamp now) {
   state_.now = now;
-  ChassisFeedback& fb = state_.feedback;
-  std::visit(
-      [&](const auto& m) {
-        using T = std::decay_t<decltype(m)>;
-        const Stamped<T> stamped{m, now, stamp};
-        if constexpr (std::is_same_v<T, SystemStatus>) {
-          fb.system_status = stamped;
-          last_status_time_ = now;
-          if (state_.link != LinkState::kConnected) state_.link = LinkState::kConnected;
-          const bool was_can = state_.control_mode == ControlMode::kCan;
-          state_.control_mode_raw = m.control_mode_raw;
-          state_.control_mode = known_control_mode(m.control_mode_raw)
-                                    ? std::optional<ControlMode>(m.control_mode)
-                                    : std::nullopt;
-          const bool is_can = state_.control_mode == ControlMode::kCan;
-          // Awaiting ends with CAN mode, and under remote control there is nothing to await.
-          if (state_.control_mode != ControlMode::kStandby) state_.awaiting_command_mode = false;
-          if (is_can && !was_can) {
-            next_keep_alive_ = now;  // (re)gained control: keep-alive starts at the next tick
-            command_changed_ = true;
-          }
-          state_.vehicle_status = m.vehicle_status_raw <= 2
-                                      ? std::optional<protocol::VehicleStatus>(m.vehicle_status)
-                                      : std::nullopt;
-          state_.estop = state_.vehicle_status == protocol::VehicleStatus::kEmergencyStop;
-          state_.error_bits = m.error_bits;
-          state_.critical_error = protocol::is_critical_error(m.error_bits);
-        } else if constexpr (std::is_same_v<T, MotionFeedback>) {
-          fb.motion = stamped;
-        } else if constexpr (std::is_same_v<T, MotionModeFeedback>) {
-          fb.motion_mode = stamped;
-          if (known_motion_mode(m.mode_raw)) {
-            state_.motion_mode = m.mode;
-            state_.chassis_switching = m.switching;
-            if (state_.mode_switch_phase == ModeSwitchPhase::kAwaitingConfirmation &&
-                state_.mode_switch_target == m.mode && !m.switching) {
-              state_.mode_switch_phase = ModeSwitchPhase::kIdle;
-              state_.mode_switch_target.reset();
-              state_.mode_switch_attempts = 0;
-              state_.mode_switch_failed = false;
-              command_changed_ = true;
-            }
-          } else {
-            // A mode this driver does not know: what a 0x111 would do is unknown, so motion is
-            // refused (kModeUnknown) until a known mode is reported; its switching bit still
-            // counts.
-            state_.motion_mode.reset();
-            state_.chassis_switching = m.switching;
-          }
-        } else if constexpr (std::is_same_v<T, SteeringAnglesFeedback>) {
-          fb.steering_angles = stamped;
-        } else if constexpr (std::is_same_v<T, WheelSpeedsFeedback>) {
-          fb.wheel_speeds = stamped;
-        } else if constexpr (std::is_same_v<T, MotorHighSpeedFeedback>) {
-          if (m.motor >= 1 && m.motor <= protocol::kMotorCount) {
-            fb.motor_high_speed[static_cast<std::size_t>(m.motor - 1)] = stamped;
-          }
-        } else if constexpr (std::is_same_v<T, MotorLowSpeedFeedback>) {
-          if (m.motor >= 1 && m.motor <= protocol::kMotorCount) {
-            fb.motor_low_speed[static_cast<std::size_t>(m.motor - 1)] = stamped;
-          }
-        } else if constexpr (std::is_same_v<T, BmsData>) {
-          if (m.battery >= 0 && m.battery <= protocol::kBatteryCount) {
-            fb.bms[static_cast<std::size_t>(m.battery)] = stamped;
-          }
-          if (m.battery == 0) {
-            state_.battery_soc = m.soc;
-            state_.low_battery = m.soc < config_.low_battery_soc;
-          }
-        } else if constexpr (std::is_same_v<T, BmsAlarm>) {
-          if (m.battery >= 0 && m.battery <= protocol::kBatteryCount) {
-            fb.bms_alarm[static_cast<std::size_t>(m.battery)] = stamped;
-          }
-        } else if constexpr (std::is_same_v<T, UltrasonicFeedback>) {
-          fb.ultrasonic[m.first_sensor >= 5 ? 1 : 0] = stamped;
-        } else if constexpr (std::is_same_v<T, UltrasonicSettingFeedback>) {
-          fb.ultrasonic_setting = stamped;
-          state_.ultrasonic_enabled = m.enabled;
-          if (state_.ultrasonic_requested == m.enabled) {
-            state_.ultrasonic_requested.reset();
-            state_.ultrasonic_failed = false;
-            ultrasonic_attempts_ = 0;
-          }
-        }
-        // Host -> chassis messages seen on the bus (another host, our own echo) carry no state.
-      },
-      message);
+  if (!feedback_.record(message, stamp, now)) return;  // host -> chassis: no chassis state
+  if (const auto* status = std::get_if<SystemStatus>(&message)) {
+    on_system_status(*status, now);
+  } else if (const auto* mode = std::get_if<MotionModeFeedback>(&message)) {
+    on_motion_mode(*mode);
+  } else if (const auto* bms = std::get_if<BmsData>(&message)) {
+    if (bms->battery == 0) state_.battery_soc = bms->soc;
+  } else if (const auto* us = std::get_if<UltrasonicSettingFeedback>(&message)) {
+    state_.ultrasonic_enabled = us->enabled;
+    if (state_.ultrasonic_requested && *state_.ultrasonic_requested == us->enabled) {
+      state_.ultrasonic_requested.reset();
+      state_.ultrasonic_failed = false;
+      ultrasonic_attempts_ = 0;
+    }
+  }
+  update_causes();
   update_faults();
+}
+
+void ChassisController::on_system_status(const SystemStatus& m, Timestamp now) {
+  last_status_time_ = now;
+  state_.link = LinkState::kConnected;
+  const bool was_can = state_.control_mode == ControlMode::kCan;
+  state_.control_mode_raw = m.control_mode_raw;
+  state_.control_mode = known_control_mode(m.control_mode_raw)
+                            ? std::optional<ControlMode>(m.control_mode)
+                            : std::nullopt;
+  const bool is_can = state_.control_mode == ControlMode::kCan;
+  // Awaiting ends with CAN mode, and under remote control there is nothing to await.
+  if (state_.control_mode != ControlMode::kStandby) state_.awaiting_command_mode = false;
+  if (state_.control_mode == ControlMode::kRemote && !config_.auto_reclaim_after_remote) {
+    state_.reclaim_blocked = true;  // remote control is final: only resume() asks again
+  }
+  if (is_can) state_.reclaim_blocked = false;  // the operator handed back with SWB
+  if (is_can && !was_can) {
+    next_keep_alive_ = now;  // (re)gained control: keep-alive starts at the next tick
+    command_changed_ = true;
+  }
+  state_.vehicle_status = m.vehicle_status_raw <= 2
+                              ? std::optional<protocol::VehicleStatus>(m.vehicle_status)
+                              : std::nullopt;
+  state_.error_bits = m.error_bits;
+}
+
+void ChassisController::on_motion_mode(const MotionModeFeedback& m) {
+  const bool known = m.mode_raw <= static_cast<std::uint8_t>(MotionMode::kSpin);
+  if (!known || !drivable_mode(m.mode)) {
+    // A mode this driver cannot command in (unknown value, park, side slip): the meaning of
+    // 0x111 is unknown, so nothing moves (kModeUnknown). The switching bit still counts.
+    state_.motion_mode.reset();
+    state_.chassis_switching = m.switching;
+    return;
+  }
+  state_.motion_mode = m.mode;
+  state_.chassis_switching = m.switching;
+  if (mode_switch_.on_feedback(m.mode, m.switching)) command_changed_ = true;
 }
 
 // ---- commands ----------------------------------------------------------------------------------
@@ -269,9 +255,18 @@ Status ChassisController::set_command(const MotionRequest& request, Timestamp no
                                          (std::isnan(c.value) ? "NaN" : "infinite") + "; stopping"};
     }
   }
-  if (request.mode && !known_motion_mode(static_cast<std::uint8_t>(*request.mode))) {
-    return Error{Errc::kInvalidArgument, "controller: unknown motion mode " +
-                                             std::to_string(static_cast<int>(*request.mode))};
+  if (request.mode && !drivable_mode(*request.mode)) {
+    return Error{Errc::kInvalidArgument, "controller: motion mode " +
+                                             std::to_string(static_cast<int>(*request.mode)) +
+                                             " cannot be driven (ackermann, oblique or spin)"};
+  }
+  if (is_zero(request.twist)) {
+    // A zero twist abandons a switch that never completed, and re-arms once every cause of an
+    // involuntary stop has cleared: the commander has seen the stop and asks for rest.
+    if (mode_switch_.status().failed) mode_switch_.cancel();
+    update_causes();
+    if (latch_.on_zero_command(state_.active_causes)) ++state_.counters.rearms;
+    state_.latched_causes = latch_.causes();
   }
   state_.requested = request;
   state_.has_command = true;
@@ -283,7 +278,7 @@ Status ChassisController::set_command(const MotionRequest& request, Timestamp no
 
 void ChassisController::request_motion_mode(std::optional<MotionMode> mode, Timestamp now) {
   state_.now = now;
-  if (mode && !known_motion_mode(static_cast<std::uint8_t>(*mode))) return;
+  if (mode && !drivable_mode(*mode)) return;
   state_.mode_override = mode;
   command_changed_ = true;
 }
@@ -324,13 +319,40 @@ Status ChassisController::set_ultrasonic(bool enable, Timestamp now) {
   return ok_status();
 }
 
+Status ChassisController::resume(Timestamp now) {
+  state_.now = now;
+  if (state_.shut_down) return Error{Errc::kInvalidArgument, "controller: resume after shutdown"};
+  update_link(now);
+  update_causes();
+  if (state_.link != LinkState::kConnected) {
+    return Error{Errc::kInvalidArgument, "resume refused: the chassis is not connected (" +
+                                             std::string(to_string(state_.link)) + ")"};
+  }
+  if (Status st = latch_.resume(state_.active_causes); !st) return st;
+  ++state_.counters.rearms;
+  state_.latched_causes = latch_.causes();
+  state_.reclaim_blocked = false;
+  next_control_request_ = now;  // in standby: ask for CAN mode at the next tick
+  command_changed_ = true;
+  update_faults();
+  return ok_status();
+}
+
+void ChassisController::set_implausible(std::string reason) {
+  implausible_reason_ = std::move(reason);
+  command_changed_ = true;
+  update_causes();
+  update_faults();
+}
+
 void ChassisController::shutdown(Timestamp now) {
   if (state_.shut_down) return;
   state_.now = now;
-  send_motion(MotionCommand{}, now);  // stop, whatever the state: a zero 0x111 never hurts
+  // Stop, whatever the state: a zero 0x111 never hurts.
+  send_motion(MotionCommand{}, nullptr, now, /*shutdown=*/true);
   state_.shut_down = true;
-  state_.mode_switch_phase = ModeSwitchPhase::kIdle;
-  state_.mode_switch_target.reset();
+  mode_switch_.cancel();
+  state_.mode_switch = mode_switch_.status();
   state_.limited = BodyTwist{};
 }
 
@@ -340,6 +362,7 @@ void ChassisController::tick(Timestamp now) {
   if (state_.shut_down) return;
   state_.now = now;
   update_link(now);
+  update_causes();
   run_control_mode(now);
   run_ultrasonic(now);
   run_motion(now);
@@ -349,32 +372,66 @@ void ChassisController::tick(Timestamp now) {
 Timestamp ChassisController::next_tick_due() const {
   Timestamp due = state_.now + config_.keep_alive_period;
   auto earlier = [&due](Timestamp t) { due = std::min(due, t); };
-  if (state_.control_mode == ControlMode::kCan) earlier(next_keep_alive_);
-  if (state_.awaiting_command_mode) earlier(next_control_request_);
+  if (state_.control_mode == ControlMode::kCan) {
+    earlier(next_keep_alive_);
+    // A changed command goes out as soon as the rate bound allows.
+    if (command_changed_) {
+      earlier(prompt_sent_ ? last_prompt_send_ + config_.min_command_interval : state_.now);
+    }
+  }
+  if (state_.awaiting_command_mode ||
+      (state_.control_mode == ControlMode::kStandby && !state_.reclaim_blocked)) {
+    earlier(next_control_request_);
+  }
   if (state_.link == LinkState::kConnected) earlier(last_status_time_ + config_.link_timeout);
   if (state_.has_command && !state_.cmd_timed_out) {
     earlier(state_.last_command_time + config_.cmd_timeout);
   }
   if (state_.ultrasonic_requested) earlier(ultrasonic_sent_ + config_.ultrasonic_confirm_timeout);
-  if (state_.mode_switch_phase == ModeSwitchPhase::kAwaitingConfirmation) {
-    earlier(mode_switch_sent_ + config_.mode_switch_timeout);
-  }
+  earlier(mode_switch_.next_due());
   return std::max(due, state_.now);
 }
 
 void ChassisController::update_link(Timestamp now) {
   if (state_.link == LinkState::kConnected && now - last_status_time_ > config_.link_timeout) {
-    state_.link = LinkState::kStale;
-    ++state_.counters.link_losses;
-    state_.awaiting_command_mode = false;
-    selector_.reset();
-    cancel_mode_switch();
-    command_changed_ = true;
+    lose_link();
   }
 }
 
+void ChassisController::lose_link() {
+  state_.link = LinkState::kStale;
+  ++state_.counters.link_losses;
+  state_.awaiting_command_mode = false;
+  selector_.reset();
+  mode_switch_.cancel();
+  command_changed_ = true;
+}
+
+void ChassisController::update_causes() {
+  StopCauses active = 0;
+  if (state_.link == LinkState::kStale) active = active | StopCause::kLinkLost;
+  if (state_.link == LinkState::kConnected) {
+    if (state_.control_mode == ControlMode::kRemote) active = active | StopCause::kRemote;
+    if (state_.vehicle_status == protocol::VehicleStatus::kEmergencyStop) {
+      active = active | StopCause::kEstop;
+    }
+    if (protocol::is_critical_error(state_.error_bits)) {
+      active = active | StopCause::kCriticalError;
+    }
+  }
+  if (state_.battery_soc && *state_.battery_soc < config_.low_battery_soc) {
+    active = active | StopCause::kLowBattery;
+  }
+  if (mode_switch_.status().failed) active = active | StopCause::kModeSwitchFailed;
+  if (!implausible_reason_.empty()) active = active | StopCause::kImplausible;
+  state_.active_causes = active;
+  latch_.update(active);
+  state_.latched_causes = latch_.causes();
+}
+
 void ChassisController::run_control_mode(Timestamp now) {
-  if (!config_.auto_command_mode || state_.link != LinkState::kConnected) return;
+  if (config_.listen_only || !config_.auto_command_mode) return;
+  if (state_.link != LinkState::kConnected || state_.reclaim_blocked) return;
   // Only standby is answered with a request: remote control is never fought, and an unknown
   // mode is not guessed at.
   if (state_.control_mode != ControlMode::kStandby) return;
@@ -399,36 +456,49 @@ void ChassisController::run_ultrasonic(Timestamp now) {
   send(UltrasonicSettingCommand{*state_.ultrasonic_requested}, now);
 }
 
-MotionRefusal ChassisController::evaluate_refusal(Timestamp) const {
+MotionRefusal ChassisController::evaluate_refusal() const {
+  const StopCauses active = state_.active_causes;
   if (state_.link != LinkState::kConnected) return MotionRefusal::kLinkLost;
-  if (state_.control_mode == ControlMode::kRemote) return MotionRefusal::kRemote;
+  if (has(active, StopCause::kRemote)) return MotionRefusal::kRemote;
+  if (has(active, StopCause::kEstop)) return MotionRefusal::kEstop;
+  if (has(active, StopCause::kCriticalError)) return MotionRefusal::kCriticalError;
+  if (has(active, StopCause::kLowBattery)) return MotionRefusal::kLowBattery;
+  if (has(active, StopCause::kModeSwitchFailed)) return MotionRefusal::kModeSwitchFailed;
+  if (has(active, StopCause::kImplausible)) return MotionRefusal::kImplausible;
+  if (state_.latched_causes != 0) return MotionRefusal::kRearmRequired;
   if (state_.control_mode != ControlMode::kCan) return MotionRefusal::kStandby;
-  if (state_.estop) return MotionRefusal::kEstop;
-  if (state_.critical_error) return MotionRefusal::kCriticalError;
-  if (state_.low_battery) return MotionRefusal::kLowBattery;
   if (!state_.motion_mode) return MotionRefusal::kModeUnknown;
   if (state_.cmd_timed_out) return MotionRefusal::kCmdTimeout;
+  if (selector_.below_minimum(state_.requested.twist)) return MotionRefusal::kBelowMinimum;
   return MotionRefusal::kNone;
 }
 
 bool ChassisController::at_standstill(Timestamp now) const {
-  const ChassisFeedback& fb = state_.feedback;
-  auto fresh = [&](Timestamp received) { return now - received <= config_.link_timeout; };
-  if (fb.wheel_speeds && fresh(fb.wheel_speeds->received)) {
+  const ChassisFeedback& fb = feedback_;
+  if (is_fresh(fb.wheel_speeds, now, config_.link_timeout)) {
     const auto& speeds = fb.wheel_speeds->value.speeds;
     return std::all_of(speeds.begin(), speeds.end(),
                        [&](double s) { return std::fabs(s) <= config_.standstill_speed; });
   }
-  if (fb.motion && fresh(fb.motion->received)) {
+  if (is_fresh(fb.motion, now, config_.link_timeout)) {
     return std::fabs(fb.motion->value.speed) <= config_.standstill_speed;
   }
   return false;  // no fresh feedback: standstill cannot be confirmed
 }
 
-void ChassisController::cancel_mode_switch() {
-  state_.mode_switch_phase = ModeSwitchPhase::kIdle;
-  state_.mode_switch_target.reset();
-  state_.mode_switch_attempts = 0;
+double ChassisController::steer_first_factor(const KinematicsSolution& solution,
+                                             Timestamp now) const {
+  const double threshold = config_.steer_first_threshold;
+  if (threshold <= 0.0 || solution.mode == MotionMode::kSpin) return 1.0;
+  if (!is_fresh(feedback_.steering_angles, now, config_.link_timeout)) return 1.0;
+  const auto wanted = wheel_angles_for_command(solution.command, solution.mode, config_.geometry);
+  double worst = 0.0;
+  for (std::size_t i = 0; i < wanted.size(); ++i) {
+    const double measured =
+        interpretation::rep103_from_manual_wheel_angle(feedback_.steering_angles->value.angles[i]);
+    worst = std::max(worst, std::fabs(wanted[i] - measured));
+  }
+  return std::clamp((2.0 * threshold - worst) / threshold, 0.0, 1.0);
 }
 
 void ChassisController::run_motion(Timestamp now) {
@@ -441,13 +511,16 @@ void ChassisController::run_motion(Timestamp now) {
   }
 
   // 2. Everything that forbids motion except a mode switch.
-  MotionRefusal refusal = evaluate_refusal(now);
-  const bool may_drive = refusal == MotionRefusal::kNone && state_.has_command;
+  MotionRefusal refusal = evaluate_refusal();
+  // A switch that failed goes on retrying at its bounded rate (it stops nothing else).
+  const bool may_drive =
+      (refusal == MotionRefusal::kNone || refusal == MotionRefusal::kModeSwitchFailed) &&
+      state_.has_command;
 
   // 3. Motion-mode switching: decide the wanted mode, then stop -> 0x141 -> confirmation.
-  bool send_mode_command = false;
+  std::optional<MotionMode> mode_to_send;
   if (!may_drive) {
-    cancel_mode_switch();  // nothing to drive (or not allowed to): no reason to switch
+    mode_switch_.cancel();  // nothing to drive (or not allowed to): no reason to switch
   } else {
     const MotionMode current = *state_.motion_mode;
     MotionMode wanted = current;
@@ -458,47 +531,30 @@ void ChassisController::run_motion(Timestamp now) {
     } else {
       wanted = selector_.select(state_.requested.twist, current, now);
     }
-    switch (state_.mode_switch_phase) {
-      case ModeSwitchPhase::kIdle:
-        if (wanted != current) {
-          state_.mode_switch_phase = ModeSwitchPhase::kStopping;
-          state_.mode_switch_target = wanted;
-          state_.mode_switch_attempts = 0;
-          command_changed_ = true;
-        }
-        break;
-      case ModeSwitchPhase::kStopping:
-        if (wanted == current) {
-          cancel_mode_switch();
-          command_changed_ = true;
-        } else {
-          state_.mode_switch_target = wanted;
-        }
-        break;
-      case ModeSwitchPhase::kAwaitingConfirmation:
-        if (now - mode_switch_sent_ >= config_.mode_switch_timeout) {
-          ++state_.counters.mode_switch_timeouts;
-          if (state_.mode_switch_attempts >= config_.mode_switch_max_attempts) {
-            state_.mode_switch_failed = true;
-          }
-          send_mode_command = true;  // retry at the timeout's (bounded) rate
-        }
-        break;
-    }
-    if (state_.mode_switch_phase == ModeSwitchPhase::kStopping && at_standstill(now)) {
-      state_.mode_switch_phase = ModeSwitchPhase::kAwaitingConfirmation;
-      send_mode_command = true;
+    const bool was_active = mode_switch_.active();
+    const int attempts = mode_switch_.status().attempts;
+    mode_to_send = mode_switch_.update(wanted, current, at_standstill(now), now);
+    if (mode_switch_.active() != was_active) command_changed_ = true;
+    if (mode_to_send && attempts > 0 && mode_switch_.status().attempts > attempts) {
+      ++state_.counters.mode_switch_timeouts;
     }
   }
-  if (refusal == MotionRefusal::kNone &&
-      (state_.chassis_switching || state_.mode_switch_phase != ModeSwitchPhase::kIdle)) {
-    refusal = MotionRefusal::kSwitching;
+  state_.mode_switch = mode_switch_.status();
+  if (state_.mode_switch.failed != has(state_.active_causes, StopCause::kModeSwitchFailed)) {
+    update_causes();  // the switch failed (or its failure ended) in this very step
+    refusal = evaluate_refusal();
+  }
+  if (refusal == MotionRefusal::kNone && (state_.chassis_switching || mode_switch_.active())) {
+    refusal =
+        mode_switch_.status().failed ? MotionRefusal::kModeSwitchFailed : MotionRefusal::kSwitching;
   }
   if (refusal != state_.refusal) command_changed_ = true;
   state_.refusal = refusal;
 
   // 4. The 0x111 to send: the limited request in the chassis's mode, or zero.
   MotionCommand command{};
+  const KinematicsSolution* solution = nullptr;
+  state_.steer_first_factor = 1.0;
   if (refusal == MotionRefusal::kNone && state_.has_command) {
     const double dt = limiter_started_ ? seconds(now - last_limit_time_) : 0.0;
     const BodyTwist& target = state_.requested.twist;
@@ -506,13 +562,25 @@ void ChassisController::run_motion(Timestamp now) {
     state_.limited = BodyTwist{limiter_vx_.limit(target.vx, previous.vx, dt),
                                limiter_vy_.limit(target.vy, previous.vy, dt),
                                limiter_wz_.limit(target.wz, previous.wz, dt)};
-    Result<KinematicsSolution> solution =
+    Result<KinematicsSolution> solved =
         selector_.solve(state_.limited, *state_.motion_mode, config_.geometry, config_.limits);
-    if (solution) {
-      command = solution->command;
-      state_.last_solution = *solution;
+    if (solved) {
+      // Steer first: hold the speed back while the wheels are far from the commanded angle.
+      const double factor = steer_first_factor(*solved, now);
+      if (factor < 1.0) {
+        solved->command.linear_speed *= factor;
+        solved->achieved = BodyTwist{solved->achieved.vx * factor, solved->achieved.vy * factor,
+                                     solved->achieved.wz * factor};
+        state_.limited = BodyTwist{state_.limited.vx * factor, state_.limited.vy * factor,
+                                   state_.limited.wz * factor};
+        if (state_.steer_first_factor == 1.0) command_changed_ = true;
+      }
+      state_.steer_first_factor = factor;
+      command = solved->command;
+      state_.last_solution = *solved;
+      solution = &*state_.last_solution;
     } else {
-      state_.last_error = solution.error().message;
+      state_.last_error = solved.error().message;
       state_.limited = BodyTwist{};
     }
   } else {
@@ -525,10 +593,14 @@ void ChassisController::run_motion(Timestamp now) {
   // in standby it ignores 0x111, and under remote control the host stays silent.
   if (state_.control_mode == ControlMode::kCan) {
     const bool scheduled = now >= next_keep_alive_;
-    const bool prompt =
-        command_changed_ && now - state_.last_motion_command_time >= config_.min_command_interval;
+    const bool prompt = command_changed_ &&
+                        (!prompt_sent_ || now - last_prompt_send_ >= config_.min_command_interval);
     if (scheduled || prompt || !state_.last_motion_command) {
-      send_motion(command, now);
+      send_motion(command, solution, now);
+      if (prompt && !scheduled) {
+        last_prompt_send_ = now;
+        prompt_sent_ = true;
+      }
       command_changed_ = false;
       next_keep_alive_ = scheduled && next_keep_alive_ + config_.keep_alive_period > now
                              ? next_keep_alive_ + config_.keep_alive_period
@@ -537,17 +609,17 @@ void ChassisController::run_motion(Timestamp now) {
   }
 
   // 6. The mode command goes after the zero 0x111 of this tick.
-  if (send_mode_command && state_.mode_switch_target) {
-    ++state_.mode_switch_attempts;
+  if (mode_to_send) {
     ++state_.counters.mode_switch_requests;
-    mode_switch_sent_ = now;
-    send(MotionModeCommand{*state_.mode_switch_target}, now);
+    send(MotionModeCommand{*mode_to_send}, now);
   }
 }
 
 // ---- output and bookkeeping --------------------------------------------------------------------
 
-bool ChassisController::send(const Message& message, Timestamp now) {
+bool ChassisController::send(const Message& message, Timestamp now,
+                             const KinematicsSolution* solution, bool shutdown) {
+  if (config_.listen_only) return false;
   Result<CanFrame> frame = encode(message);
   if (!frame) {
     ++state_.counters.send_failures;
@@ -562,46 +634,56 @@ bool ChassisController::send(const Message& message, Timestamp now) {
     return false;
   }
   ++state_.counters.frames_sent;
+  if (observer_) {
+    SentFrame sent{*frame, message, BodyTwist{}, std::nullopt, shutdown};
+    if (solution) {
+      sent.solution = *solution;
+      sent.achieved = solution->achieved;
+    }
+    observer_(sent);
+  }
   return true;
 }
 
-void ChassisController::send_motion(const MotionCommand& command, Timestamp now) {
+void ChassisController::send_motion(const MotionCommand& command,
+                                    const KinematicsSolution* solution, Timestamp now,
+                                    bool shutdown) {
+  if (config_.listen_only) return;
   state_.last_motion_command = command;
   state_.last_motion_command_time = now;
-  if (send(command, now)) ++state_.counters.motion_commands_sent;
+  if (send(command, now, solution, shutdown)) ++state_.counters.motion_commands_sent;
 }
 
 void ChassisController::update_faults() {
   // Rebuilt only when an input changes: 0x211 arrives 50 times a second.
   const std::uint64_t signature =
       static_cast<std::uint64_t>(state_.error_bits) |
-      (static_cast<std::uint64_t>(state_.link == LinkState::kStale) << 32) |
-      (static_cast<std::uint64_t>(state_.estop) << 33) |
+      (static_cast<std::uint64_t>(state_.active_causes) << 32) |
       (static_cast<std::uint64_t>(state_.vehicle_status == protocol::VehicleStatus::kAbnormal)
-       << 34) |
-      (static_cast<std::uint64_t>(state_.low_battery) << 35) |
-      (static_cast<std::uint64_t>(state_.mode_switch_failed) << 36) |
-      (static_cast<std::uint64_t>(state_.ultrasonic_failed) << 37) |
-      (static_cast<std::uint64_t>(state_.feedback.system_status.has_value() &&
+       << 48) |
+      (static_cast<std::uint64_t>(state_.ultrasonic_failed) << 49) |
+      (static_cast<std::uint64_t>(feedback_.system_status.has_value() &&
                                   !state_.vehicle_status.has_value())
-       << 38);
+       << 50);
   if (faults_valid_ && signature == faults_signature_) return;
   faults_valid_ = true;
   faults_signature_ = signature;
   std::vector<std::string> faults;
-  if (state_.link == LinkState::kStale) faults.emplace_back("link_lost");
-  if (state_.estop) faults.emplace_back("emergency_stop");
+  const StopCauses active = state_.active_causes;
+  if (has(active, StopCause::kLinkLost)) faults.emplace_back("link_lost");
+  if (has(active, StopCause::kEstop)) faults.emplace_back("emergency_stop");
   if (state_.vehicle_status == protocol::VehicleStatus::kAbnormal) {
     faults.emplace_back("vehicle_abnormal");
   }
-  if (state_.feedback.system_status && !state_.vehicle_status) {
+  if (feedback_.system_status && !state_.vehicle_status) {
     faults.emplace_back("vehicle_status_unknown");
   }
   for (std::string& name : protocol::error_bit_names(state_.error_bits)) {
     faults.push_back(std::move(name));
   }
-  if (state_.low_battery) faults.emplace_back("low_battery");
-  if (state_.mode_switch_failed) faults.emplace_back("motion_mode_switch_failed");
+  if (has(active, StopCause::kLowBattery)) faults.emplace_back("low_battery");
+  if (has(active, StopCause::kModeSwitchFailed)) faults.emplace_back("motion_mode_switch_failed");
+  if (has(active, StopCause::kImplausible)) faults.emplace_back("implausible_feedback");
   if (state_.ultrasonic_failed) faults.emplace_back("ultrasonic_setting_unconfirmed");
   state_.faults = std::move(faults);
 }

@@ -132,8 +132,7 @@ Pose2D integrate_pose(const Pose2D& pose, const BodyTwist& twist, double dt) {
   const double bx = (twist.vx * s_over - twist.vy * c_over) * dt;
   const double by = (twist.vy * s_over + twist.vx * c_over) * dt;
   const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);
-  return Pose2D{pose.x + c * bx - s * by, pose.y + s * bx + c * by,
-                wrap_angle(pose.yaw + dyaw)};
+  return Pose2D{pose.x + c * bx - s * by, pose.y + s * bx + c * by, wrap_angle(pose.yaw + dyaw)};
 }
 
 Odometry::Odometry(OdometryConfig config) : config_(std::move(config)) {

@@ -1,5 +1,7 @@
 #include "ranger_can/sim/virtual_chassis_runner.hpp"
 
+#include <pthread.h>
+
 #include <algorithm>
 #include <chrono>
 #include <exception>
@@ -36,6 +38,8 @@ std::string VirtualChassisRunner::failure() const {
 }
 
 void VirtualChassisRunner::loop() {
+  // Named so that top -H and the performance script tell the simulator from the driver.
+  ::pthread_setname_np(::pthread_self(), "ranger_sim");
   try {
     while (!stop_requested_.load()) {
       Timestamp deadline;

@@ -2,50 +2,61 @@
 // and a RANGER chassis on a Bus.
 //
 // Single-threaded and clock-free: the owner feeds received frames (on_frame), wanted motion
-// (set_command) and the time (every call takes `now`, from the owner's monotonic clock, e.g.
-// SteadyClock or a ManualClock in tests), and calls tick(now) from its loop; tick sends whatever
-// is due. Nothing inside sleeps, spawns threads or reads a clock. The owner serialises calls (one
-// thread, or a mutex around the controller). The Bus must outlive the controller.
+// (set_command) and the time (every call takes `now`, from the owner's monotonic clock), and
+// calls tick(now) at next_tick_due() (or more often); tick sends whatever is due. Nothing inside
+// sleeps, spawns threads or reads a clock. The owner serialises calls (control/driver.hpp does).
+// The Bus must outlive the controller. Every frame it sends is reported to the send observer,
+// the stop on shutdown included.
 //
-// Behaviour (issue 4):
-//  * Link: connected while 0x211 arrives; stale after `link_timeout` without it; reconnects by
-//    itself when 0x211 returns.
-//  * Control mode: while 0x211 reports standby (including right after connecting), requests CAN
-//    command mode (0x421 = 0x01) at most every `control_mode_retry_period` until 0x211 confirms
-//    (unless auto_command_mode = false). Remote control (0x03) is never fought: nothing but the
-//    request after it hands back, and no 0x111 while the chassis is not in CAN mode.
+// Behaviour:
+//  * Link: connected while 0x211 arrives; stale after `link_timeout` without it, or at once when
+//    the bus reports bus-off; reconnects by itself when 0x211 returns.
+//  * Control mode: while 0x211 reports standby, requests CAN command mode (0x421 = 0x01) at most
+//    every `control_mode_retry_period` until 0x211 confirms (unless auto_command_mode = false).
+//    Remote control is never fought and is final: once the chassis has reported remote mode
+//    (0x03), the controller never requests CAN mode by itself again (unless
+//    auto_reclaim_after_remote); control comes back by resume(), or when the operator hands back
+//    with SWB (the chassis reports CAN mode itself) — and motion then still needs the re-arm.
+//  * Re-arm (rearm.hpp): after any stop the commander did not ask for (e-stop, remote takeover,
+//    a critical error, the low-battery cut-off, link loss, a failed mode switch) motion stays
+//    refused (kRearmRequired) until a zero twist or resume() after the cause has cleared.
 //  * Keep-alive: while the chassis is in CAN command mode, 0x111 goes out every
-//    `keep_alive_period` (zero whenever motion is refused), on a fixed-rate schedule; call tick()
-//    at least twice per period or at next_tick_due(). A changed command goes out at the next
-//    tick at least `min_command_interval` after the previous 0x111 (low latency, bounded rate).
+//    `keep_alive_period` (zero whenever motion is refused), on a fixed-rate schedule. A changed
+//    command goes out at once, at most one per `min_command_interval` (keep-alives do not count).
 //  * Command timeout: no set_command for `cmd_timeout` -> zero command, reported
-//    (MotionRefusal::kCmdTimeout); the next set_command resumes.
-//  * Motion-mode switch (0x141) only at standstill: command zero, wait until the wheel speeds
-//    (0x281, else 0x221) are below `standstill_speed`, send 0x141, send only zero 0x111 until
-//    0x291 reports the target with switching = 0; resend every `mode_switch_timeout`, and report
-//    failure after `mode_switch_max_attempts`.
-//  * Faults: e-stop, abnormal status, every 0x211 error bit, low battery (BMS SOC below
-//    `low_battery_soc`), a failed mode switch or ultrasonic setting: named in state().faults;
-//    those that stop the chassis are the MotionRefusal reason.
+//    (kCmdTimeout); the next set_command resumes (the commander's own stop: no re-arm needed).
+//  * Motion-mode switch (0x141) only at standstill (mode_switch.hpp).
+//  * Steer first: in Ackermann and oblique mode, while the measured wheel angles (0x271) are
+//    further than `steer_first_threshold` from the commanded ones, the speed is scaled down (to
+//    zero at twice the threshold) and the new steering is commanded: a sideways request never
+//    rolls the chassis forwards while its wheels turn.
+//  * A twist below the chassis's resolution is refused by name (kBelowMinimum), never dropped
+//    silently.
+//  * Faults: named in state().faults; those that stop the chassis are the refusal reason.
 //  * Shutdown (or destruction): a zero 0x111 before the bus is released.
 #pragma once
 
-#include <array>
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "ranger_can/control/feedback.hpp"
+#include "ranger_can/control/geometry.hpp"
+#include "ranger_can/control/kinematics.hpp"
+#include "ranger_can/control/mode_selector.hpp"
+#include "ranger_can/control/mode_switch.hpp"
+#include "ranger_can/control/rearm.hpp"
+#include "ranger_can/control/speed_limiter.hpp"
+#include "ranger_can/result.hpp"
 #include "ranger_can/transport/bus.hpp"
 #include "ranger_can/wire/codec.hpp"
 #include "ranger_can/wire/frame.hpp"
-#include "ranger_can/control/geometry.hpp"
-#include "ranger_can/control/kinematics.hpp"
+#include "ranger_can/wire/profile.hpp"
 #include "ranger_can/wire/protocol.hpp"
-#include "ranger_can/result.hpp"
-#include "ranger_can/control/speed_limiter.hpp"
 
 namespace ranger {
 
@@ -57,38 +68,38 @@ struct MotionRequest {
 
 // Why the chassis is not being commanded the requested motion, most fundamental first.
 enum class MotionRefusal {
-  kNone,           // commanding the request (or idle: nothing was ever requested)
-  kLinkLost,       // no 0x211 within link_timeout (or never)
-  kRemote,         // the remote control has the chassis (0x211 control mode 0x03)
-  kStandby,        // chassis in standby (CAN mode requested, or auto_command_mode = false)
-  kEstop,          // 0x211 vehicle status emergency stop
-  kCriticalError,  // a 0x211 error bit that stops the chassis (protocol::is_critical_error)
-  kLowBattery,     // BMS SOC below low_battery_soc: the chassis cuts the drives
-  kModeUnknown,    // no 0x291 yet: the meaning of 0x111 depends on the motion mode
-  kSwitching,      // motion-mode switch in progress (ours or the remote's)
-  kCmdTimeout,     // no set_command within cmd_timeout
+  kNone,              // commanding the request (or idle: nothing was ever requested)
+  kLinkLost,          // no 0x211 within link_timeout (or never)
+  kRemote,            // the remote control has the chassis (0x211 control mode 0x03)
+  kEstop,             // 0x211 vehicle status emergency stop
+  kCriticalError,     // a 0x211 error bit that stops the chassis
+  kLowBattery,        // BMS SOC below low_battery_soc: the chassis cuts the drives
+  kModeSwitchFailed,  // a motion-mode switch was never confirmed
+  kImplausible,       // the chassis's feedback contradicts the protocol settings
+  kRearmRequired,     // an involuntary stop happened: a zero twist or resume() re-arms
+  kStandby,           // chassis in standby (CAN mode requested, or auto_command_mode = false)
+  kModeUnknown,       // no valid 0x291 yet: the meaning of 0x111 depends on the motion mode
+  kSwitching,         // motion-mode switch in progress (ours or the remote's)
+  kCmdTimeout,        // no set_command within cmd_timeout
+  kBelowMinimum,      // the twist is below what the chassis can express (1 mm/s)
 };
 std::string_view to_string(MotionRefusal r);  // "none", "link_lost", "remote", ...
 
 enum class LinkState { kNeverConnected, kConnected, kStale };
 std::string_view to_string(LinkState s);  // "never_connected", "connected", "stale"
 
-enum class ModeSwitchPhase {
-  kIdle,                  // chassis in the wanted mode
-  kStopping,              // commanding zero, waiting for standstill before sending 0x141
-  kAwaitingConfirmation,  // 0x141 sent, waiting for 0x291: target mode, switching = 0
-};
-std::string_view to_string(ModeSwitchPhase p);  // "idle", "stopping", "awaiting_confirmation"
-
 struct ControllerConfig {
   VehicleGeometry geometry;
   KinematicsLimits limits;
   ModeSelectorConfig mode_selection;
-  SpeedLimits limit_vx;  // acceleration/velocity limiting per axis, ros_controllers semantics
+  ProtocolProfile profile;  // the chassis's protocol interpretations (wire/profile.hpp)
+  SpeedLimits limit_vx;     // acceleration/velocity limiting per axis, ros_controllers semantics
   SpeedLimits limit_vy;
   SpeedLimits limit_wz;
 
-  bool auto_command_mode = true;  // request CAN command mode by itself
+  bool auto_command_mode = true;           // request CAN command mode by itself (at start-up)
+  bool auto_reclaim_after_remote = false;  // the old behaviour: reclaim after remote hands back
+  bool listen_only = false;                // never send anything (monitoring, log replay)
   std::chrono::nanoseconds link_timeout = std::chrono::milliseconds(100);
   std::chrono::nanoseconds control_mode_retry_period = std::chrono::milliseconds(100);
   std::chrono::nanoseconds keep_alive_period = std::chrono::milliseconds(20);
@@ -97,6 +108,9 @@ struct ControllerConfig {
   std::chrono::nanoseconds mode_switch_timeout = std::chrono::milliseconds(1500);
   int mode_switch_max_attempts = 3;
   double standstill_speed = 0.02;  // m/s, every wheel slower than this = standstill
+  // rad: full speed while every wheel is within this of its commanded angle, zero beyond twice
+  // it, linear in between (0 disables steer-first).
+  double steer_first_threshold = 10.0 * M_PI / 180.0;
   std::chrono::nanoseconds ultrasonic_confirm_timeout = std::chrono::milliseconds(500);
   int ultrasonic_max_attempts = 3;
   double low_battery_soc = 10.0;  // %, manual: below 10 % the chassis cuts the drives
@@ -104,31 +118,6 @@ struct ControllerConfig {
   // Checks every field (durations positive, keep_alive_period < 500 ms, attempts >= 1, the
   // nested configs); the message names the field.
   Status validate() const;
-};
-
-// A feedback message with the controller time it arrived at and the frame's own timestamp.
-template <typename T>
-struct Stamped {
-  T value;
-  Timestamp received{0};  // controller clock (`now` passed to on_frame)
-  Timestamp stamp{0};     // CanFrame::stamp (bus clock)
-};
-
-// The last value of every kind of feedback the chassis sends.
-struct ChassisFeedback {
-  std::optional<Stamped<SystemStatus>> system_status;              // 0x211
-  std::optional<Stamped<MotionFeedback>> motion;                   // 0x221
-  std::optional<Stamped<MotionModeFeedback>> motion_mode;          // 0x291
-  std::optional<Stamped<SteeringAnglesFeedback>> steering_angles;  // 0x271
-  std::optional<Stamped<WheelSpeedsFeedback>> wheel_speeds;        // 0x281
-  std::array<std::optional<Stamped<MotorHighSpeedFeedback>>, protocol::kMotorCount>
-      motor_high_speed;  // 0x251..0x258, index motor - 1
-  std::array<std::optional<Stamped<MotorLowSpeedFeedback>>, protocol::kMotorCount>
-      motor_low_speed;  // 0x261..0x268, index motor - 1
-  std::array<std::optional<Stamped<BmsData>>, protocol::kBatteryCount + 1> bms;  // 0 = pack
-  std::array<std::optional<Stamped<BmsAlarm>>, protocol::kBatteryCount + 1> bms_alarm;
-  std::array<std::optional<Stamped<UltrasonicFeedback>>, 2> ultrasonic;  // 0x342, 0x343
-  std::optional<Stamped<UltrasonicSettingFeedback>> ultrasonic_setting;  // 0x45A
 };
 
 struct ControllerCounters {
@@ -145,6 +134,7 @@ struct ControllerCounters {
   std::uint64_t cmd_timeouts = 0;
   std::uint64_t error_clear_requests = 0;  // 0x441
   std::uint64_t ultrasonic_requests = 0;   // 0x451
+  std::uint64_t rearms = 0;                // latch cleared by a zero twist or resume()
 };
 
 struct ControllerState {
@@ -155,26 +145,23 @@ struct ControllerState {
   std::optional<protocol::ControlMode> control_mode;  // last reported by 0x211
   std::uint8_t control_mode_raw = 0;
   bool awaiting_command_mode = false;  // CAN mode requested, 0x211 not yet confirming it
+  bool reclaim_blocked = false;        // remote control had the chassis: no 0x421 until resume()
 
   // Motion mode
-  std::optional<protocol::MotionMode> motion_mode;  // last reported by 0x291
+  std::optional<protocol::MotionMode> motion_mode;  // last valid 0x291
   bool chassis_switching = false;                   // 0x291 switching bit
-  ModeSwitchPhase mode_switch_phase = ModeSwitchPhase::kIdle;
-  std::optional<protocol::MotionMode> mode_switch_target;
-  int mode_switch_attempts = 0;                       // 0x141 sent for the current target
-  bool mode_switch_failed = false;                    // attempts exhausted without confirmation
+  ModeSwitchStatus mode_switch;
   std::optional<protocol::MotionMode> mode_override;  // request_motion_mode()
 
-  // Vehicle status and faults
+  // Vehicle status, faults and the re-arm latch
   std::optional<protocol::VehicleStatus> vehicle_status;
   std::uint32_t error_bits = 0;
-  bool estop = false;
-  bool critical_error = false;
   std::optional<double> battery_soc;  // % from BMS 0x361 (whole pack)
-  bool low_battery = false;
-  // Every active fault by stable snake_case name: 0x211 error bit names
-  // (protocol::error_bit_names), "emergency_stop", "vehicle_abnormal", "low_battery",
-  // "link_lost", "motion_mode_switch_failed", "ultrasonic_setting_unconfirmed".
+  StopCauses active_causes = 0;       // involuntary stop causes active now
+  StopCauses latched_causes = 0;      // causes since the last re-arm (motion needs a re-arm)
+  // Every active fault by stable snake_case name: 0x211 error bit names, "emergency_stop",
+  // "vehicle_abnormal", "low_battery", "link_lost", "motion_mode_switch_failed",
+  // "ultrasonic_setting_unconfirmed".
   std::vector<std::string> faults;
 
   // Commanding
@@ -184,6 +171,8 @@ struct ControllerState {
   MotionRequest requested;   // the last accepted request
   Timestamp last_command_time{0};
   BodyTwist limited;  // requested twist after the speed limiters (what is driven)
+  // 1 = full speed; below 1 the speed is held back until the wheels reach the commanded angle.
+  double steer_first_factor = 1.0;
   std::optional<KinematicsSolution> last_solution;   // for the last motion 0x111
   std::optional<MotionCommand> last_motion_command;  // last 0x111 sent (zero when refused)
   Timestamp last_motion_command_time{0};
@@ -194,13 +183,29 @@ struct ControllerState {
   bool ultrasonic_failed = false;            // not confirmed after the attempts
 
   bool shut_down = false;
-  ChassisFeedback feedback;
   ControllerCounters counters;
   std::string last_error;  // last send/decode error message, for diagnostics
+
+  bool estop() const { return has(active_causes, StopCause::kEstop); }
+  bool low_battery() const { return has(active_causes, StopCause::kLowBattery); }
+  bool critical_error() const { return has(active_causes, StopCause::kCriticalError); }
+  bool rearm_required() const { return latched_causes != 0; }
+};
+
+// A frame the controller has just sent (for cmd_vel_out, latency figures and wire audits).
+struct SentFrame {
+  CanFrame frame;   // as on the wire (stamp = the controller's `now`)
+  Message message;  // what it encodes
+  // 0x111 only: the twist it realises (REP-103; zero for a stop) and the solution behind it.
+  BodyTwist achieved;
+  std::optional<KinematicsSolution> solution;
+  bool shutdown = false;  // the stop sent by shutdown()
 };
 
 class ChassisController {
  public:
+  using SendObserver = std::function<void(const SentFrame&)>;
+
   // `bus` must outlive the controller. The config should pass validate(); the ROS node and CLI
   // check it first.
   explicit ChassisController(Bus& bus, ControllerConfig config = {});
@@ -209,20 +214,25 @@ class ChassisController {
   ChassisController(const ChassisController&) = delete;
   ChassisController& operator=(const ChassisController&) = delete;
 
+  // Called after every successful send, on the caller's thread; must not call back in.
+  void set_send_observer(SendObserver observer) { observer_ = std::move(observer); }
+
   // Feeds a received frame (any ID; error and unknown frames are counted and ignored).
   void on_frame(const CanFrame& frame, Timestamp now);
   // Feeds an already decoded message (`stamp` = its frame's timestamp).
   void on_message(const Message& message, Timestamp stamp, Timestamp now);
 
-  // Runs the state machine and sends what is due (0x421 retries, 0x111 keep-alive, 0x141,
-  // 0x451 retries). Call at least every keep_alive_period / 2, or at next_tick_due().
+  // Runs the state machine and sends what is due (0x421 retries, 0x111 keep-alive or a changed
+  // command, 0x141, 0x451 retries). Call at next_tick_due() (or more often).
   void tick(Timestamp now);
-  // When tick() next has something periodic to do (at most keep_alive_period away).
+  // When tick() next has something to do: keep-alive, a changed command that may go now, retries,
+  // timeouts (at most keep_alive_period away; `now` itself when something is due already).
   Timestamp next_tick_due() const;
 
   // The motion wanted from now on; refreshes the command timeout. A non-finite component is
   // refused with kNotFinite and the controller stops (a NaN is a caller bug, not a command to
-  // keep driving). Sent at the next tick().
+  // keep driving). A zero twist re-arms after an involuntary stop whose cause has cleared.
+  // Sent at the next tick().
   Status set_command(const MotionRequest& request, Timestamp now);
   Status set_command(const BodyTwist& twist, Timestamp now) {
     return set_command(MotionRequest{twist, std::nullopt}, now);
@@ -241,39 +251,60 @@ class ChassisController {
   // Sends 0x451; confirmed when 0x45A reports the same, resent up to ultrasonic_max_attempts.
   Status set_ultrasonic(bool enable, Timestamp now);
 
+  // The explicit re-arm: clears the latch and lifts the remote's hold on CAN mode requests.
+  // Refused (kInvalidArgument, naming it) while a cause is still active — nothing is sent then.
+  Status resume(Timestamp now);
+
+  // Marks the protocol settings as contradicted by the chassis's feedback (`reason` for the
+  // faults list), or clears that mark (empty reason): a stop cause like any other.
+  void set_implausible(std::string reason);
+
   // Sends a zero 0x111 and stops commanding; later calls send nothing. Idempotent.
   void shutdown(Timestamp now);
 
   const ControllerState& state() const { return state_; }
+  const ChassisFeedback& feedback() const { return feedback_; }
   const ControllerConfig& config() const { return config_; }
 
  private:
-  bool send(const Message& message, Timestamp now);
-  void send_motion(const MotionCommand& command, Timestamp now);
+  bool send(const Message& message, Timestamp now, const KinematicsSolution* solution = nullptr,
+            bool shutdown = false);
+  void send_motion(const MotionCommand& command, const KinematicsSolution* solution, Timestamp now,
+                   bool shutdown = false);
+  void on_system_status(const SystemStatus& m, Timestamp now);
+  void on_motion_mode(const MotionModeFeedback& m);
   void update_link(Timestamp now);
+  void lose_link();
+  void update_causes();
   void update_faults();
-  MotionRefusal evaluate_refusal(Timestamp now) const;
+  MotionRefusal evaluate_refusal() const;
   bool at_standstill(Timestamp now) const;
+  double steer_first_factor(const KinematicsSolution& solution, Timestamp now) const;
   void run_control_mode(Timestamp now);
   void run_ultrasonic(Timestamp now);
   void run_motion(Timestamp now);
-  void cancel_mode_switch();
 
   Bus& bus_;
   ControllerConfig config_;
   ControllerState state_;
+  ChassisFeedback feedback_;
   ModeSelector selector_;
+  ModeSwitchSequencer mode_switch_;
+  RearmLatch latch_;
   SpeedLimiter limiter_vx_, limiter_vy_, limiter_wz_;
+  SendObserver observer_;
 
   Timestamp last_status_time_{0};      // last 0x211 (controller clock)
   Timestamp next_control_request_{0};  // earliest time for the next 0x421 retry
   Timestamp next_keep_alive_{0};       // fixed-rate 0x111 schedule
-  Timestamp last_limit_time_{0};       // previous speed-limiter step
+  Timestamp last_prompt_send_{0};      // last 0x111 sent because the command changed
+  bool prompt_sent_ = false;
+  Timestamp last_limit_time_{0};  // previous speed-limiter step
   bool limiter_started_ = false;
-  bool command_changed_ = false;   // a new request not yet sent
-  Timestamp mode_switch_sent_{0};  // last 0x141
+  bool command_changed_ = false;  // a new request (or a new refusal) not yet sent
   Timestamp ultrasonic_sent_{0};
   int ultrasonic_attempts_ = 0;
+  std::string implausible_reason_;
   bool faults_valid_ = false;  // state_.faults matches faults_signature_
   std::uint64_t faults_signature_ = 0;
 };

@@ -1,5 +1,8 @@
-// Kinematics: a REP-103 body twist in, the chassis's motion mode and 0x111 command out, and the
-// rigid-body relations the odometry and the simulator share.
+// Kinematics, inverse and forward side by side: a REP-103 body twist in, the 0x111 command of a
+// motion mode out (solve_kinematics), the twist a command produces (twist_from_command), and the
+// per-wheel rigid-body relations the odometry, the controller and the simulator share. Mode
+// selection with memory lives in mode_selector.hpp; the least-squares fit of a twist to measured
+// wheels in odometry.hpp.
 //
 // The RANGER steers all four wheels and has three motion modes (0x141):
 //   * dual Ackermann: front and rear wheels steer opposite ways, the centre of rotation lies on the
@@ -16,12 +19,12 @@
 #include <cstdint>
 #include <string>
 
-#include "ranger_can/wire/codec.hpp"
-#include "ranger_can/wire/frame.hpp"
 #include "ranger_can/control/geometry.hpp"
-#include "ranger_can/wire/protocol.hpp"
 #include "ranger_can/result.hpp"
 #include "ranger_can/types.hpp"
+#include "ranger_can/wire/codec.hpp"
+#include "ranger_can/wire/frame.hpp"
+#include "ranger_can/wire/protocol.hpp"
 
 namespace ranger {
 
@@ -92,6 +95,14 @@ Result<KinematicsSolution> solve_kinematics(const BodyTwist& twist, protocol::Mo
 BodyTwist twist_from_command(const MotionCommand& command, protocol::MotionMode mode,
                              const VehicleGeometry& geometry);
 
+// The REP-103 angle of each wheel (geometry.hpp order) that a 0x111 command in `mode` steers
+// to, folded into [-90, 90] deg: what 0x271 should report once the wheels have turned. In
+// Ackermann mode from the command's steering (the curvature, whatever the speed), in oblique
+// mode the direction of travel for every wheel, in spin mode the tangent of the spin circle.
+std::array<double, kWheelCount> wheel_angles_for_command(const MotionCommand& command,
+                                                         protocol::MotionMode mode,
+                                                         const VehicleGeometry& geometry);
+
 // Largest |curvature| (1/m) dual Ackermann reaches at the mean front-wheel angle `max_steering`.
 double max_ackermann_curvature(double max_steering, const VehicleGeometry& geometry);
 
@@ -103,70 +114,5 @@ double max_ackermann_curvature(double max_steering, const VehicleGeometry& geome
 // snap back when the body stops).
 WheelStates wheel_states_from_twist(const BodyTwist& twist, const VehicleGeometry& geometry,
                                     const std::array<double, kWheelCount>& hold_angles = {});
-
-// ---- Automatic motion-mode selection with hysteresis and dwell --------------------------------
-
-struct ModeSelectorConfig {
-  // Thresholds with hysteresis: a mode is entered above the *_enter level and, once it is the
-  // current mode, kept until the request falls below the (looser) *_exit level.
-  double lateral_enter = 0.05;   // m/s |vy| above which oblique is chosen
-  double lateral_exit = 0.02;    // m/s |vy| below which oblique may be left
-  double linear_enter = 0.02;    // m/s |(vx,vy)| below which a rotation is a pure rotation (spin)
-  double linear_exit = 0.05;     // m/s |(vx,vy)| above which spin is left
-  double rotation_enter = 0.05;  // rad/s |wz| above which a rotation counts (spin; leaving oblique)
-  double rotation_exit = 0.02;   // rad/s
-  // A different mode must be asked for continuously this long before it is chosen (filters
-  // noisy teleop), and the chassis stays in a mode at least min_dwell after entering it.
-  std::chrono::nanoseconds confirm_time = std::chrono::milliseconds(100);
-  std::chrono::nanoseconds min_dwell = std::chrono::milliseconds(1000);
-  // Oblique mode: while the direction of travel is within this band of +-90 deg, the wheels keep
-  // the side of the previous oblique command (rad, 0 <= x < 90 deg; 0 disables).
-  double oblique_side_band = 5.0 * M_PI / 180.0;
-
-  Status validate() const;
-};
-
-// The choices with memory for a stream of twists, so that noisy teleop does not flap:
-//  * the motion mode (select): lateral velocity -> oblique, pure rotation -> spin, otherwise dual
-//    Ackermann. A zero twist never causes a switch, and oblique is kept while the request has no
-//    rotation (oblique drives straight too).
-//  * in oblique mode, the side the wheels point to (solve): a pure lateral request with a tiny
-//    noisy vx would otherwise swing the wheels by 180 deg (+89.9 deg <-> -89.9 deg with the speed
-//    negated) at every sign change of vx.
-// Deterministic: time comes from the caller.
-class ModeSelector {
- public:
-  explicit ModeSelector(ModeSelectorConfig config = {});
-
-  // The mode the classification alone asks for, given the mode the chassis is in (no timing).
-  protocol::MotionMode classify(const BodyTwist& twist, protocol::MotionMode current) const;
-
-  // The mode to drive `twist` in, given the chassis's current mode (from 0x291) at time `now`.
-  // Returns `current` until a different classification has held for confirm_time and the
-  // chassis has been in `current` for min_dwell (the selector notices changes of `current`).
-  protocol::MotionMode select(const BodyTwist& twist, protocol::MotionMode current, Timestamp now);
-
-  // solve_kinematics with the oblique side hysteresis: while the direction of travel is within
-  // config().oblique_side_band of +-90 deg, the steering keeps the sign of the previous moving
-  // oblique command; beyond the band the pure solution (and its side) is taken. A non-oblique
-  // solution forgets the side (a mode switch turns the wheels to the new mode's neutral).
-  Result<KinematicsSolution> solve(const BodyTwist& twist, protocol::MotionMode mode,
-                                   const VehicleGeometry& geometry, const KinematicsLimits& limits);
-
-  // Forgets pending candidates, dwell timing and the oblique side (e.g. after the link was lost).
-  void reset();
-
-  const ModeSelectorConfig& config() const { return config_; }
-
- private:
-  ModeSelectorConfig config_;
-  bool have_current_ = false;
-  protocol::MotionMode current_ = protocol::MotionMode::kAckermann;
-  Timestamp current_since_{0};
-  bool have_candidate_ = false;
-  protocol::MotionMode candidate_ = protocol::MotionMode::kAckermann;
-  Timestamp candidate_since_{0};
-  double oblique_side_ = 0.0;  // sign of the last moving oblique command's steering, 0 = none
-};
 
 }  // namespace ranger

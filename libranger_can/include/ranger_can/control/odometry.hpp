@@ -21,13 +21,13 @@
 #include <cstdint>
 #include <string_view>
 
-#include "ranger_can/wire/codec.hpp"
-#include "ranger_can/wire/frame.hpp"
 #include "ranger_can/control/geometry.hpp"
 #include "ranger_can/control/kinematics.hpp"
-#include "ranger_can/wire/protocol.hpp"
 #include "ranger_can/result.hpp"
 #include "ranger_can/types.hpp"
+#include "ranger_can/wire/codec.hpp"
+#include "ranger_can/wire/frame.hpp"
+#include "ranger_can/wire/protocol.hpp"
 
 namespace ranger {
 

@@ -1,0 +1,199 @@
+// The driver runtime: everything between a program that wants a body twist and a RANGER on a bus,
+// with no ROS in it. A ROS 1 node, a ROS 2 node, `ranger_can monitor`, `ranger_can scenario` and
+// libranger_can/examples/ all use it as it is.
+//
+// One thread owns the bus, the controller, the odometry, the joint tracker and the frame
+// statistics; nothing else touches them. Everything that comes in — a twist, a mode request,
+// clear-errors, ultrasonic, resume — is a message in a mailbox the thread drains; everything that
+// goes out is an immutable snapshot (DriverSnapshot) that other threads read without waiting for
+// the driver, plus a callback for every frame sent (the stop on shutdown included). The thread
+// wakes on a mailbox message or when the controller's next_tick_due() comes; received frames are
+// handled in a batch at each wake-up (odometry integrates over the frames' own timestamps, so
+// batching changes no estimate).
+//
+// Time comes from an injected Clock. Without start(), the owner drives the same runtime in
+// lock-step: step(now) does one iteration (`ranger_can scenario`, tests, no sleeps anywhere).
+#pragma once
+
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "ranger_can/clock.hpp"
+#include "ranger_can/control/controller.hpp"
+#include "ranger_can/control/feedback.hpp"
+#include "ranger_can/control/frame_stats.hpp"
+#include "ranger_can/control/joint_tracker.hpp"
+#include "ranger_can/control/odometry.hpp"
+#include "ranger_can/result.hpp"
+#include "ranger_can/transport/bus.hpp"
+#include "ranger_can/transport/bus_source.hpp"
+
+namespace ranger {
+
+struct DriverConfig {
+  ControllerConfig controller;  // geometry, limits, protocol profile, timeouts, ...
+  OdometryConfig odometry;      // should share the controller's geometry
+  // Retry period while the bus cannot be opened (an adapter not plugged in yet).
+  std::chrono::nanoseconds reconnect_interval = std::chrono::seconds(1);
+  // How long clear_errors waits for the chassis's answer (a 0x211 sent after the 0x441 arrived).
+  std::chrono::nanoseconds request_answer_timeout = std::chrono::milliseconds(500);
+  std::string thread_name = "ranger_driver";  // for top -H and the performance script
+
+  Status validate() const;  // the controller's and the odometry's checks
+};
+
+// What became of a request posted through the mailbox.
+struct RequestOutcome {
+  enum class State { kPending, kSent, kAnswered, kFailed };
+  std::uint64_t id = 0;
+  std::string what;  // "clear_errors 0x00", "ultrasonic on", "resume"
+  State state = State::kPending;
+  std::string message;  // why it failed, or what the answer was
+  // clear_errors: the 0x211 error word the chassis reported after it received the 0x441.
+  std::optional<std::uint32_t> error_word;
+  Timestamp sent{0};  // driver clock
+};
+std::string_view to_string(RequestOutcome::State s);  // "pending", "sent", "answered", "failed"
+
+// A frame the driver sent, as the observer sees it.
+struct SentEvent {
+  SentFrame sent;                              // frame, message, achieved twist, shutdown flag
+  std::chrono::system_clock::time_point wall;  // wall time right after the send
+};
+
+// A consistent copy of the runtime's state, published after every iteration that changed it.
+struct DriverSnapshot {
+  std::uint64_t sequence = 0;  // increases with every publication
+  Timestamp now{0};            // driver clock at publication
+
+  std::string bus_name;    // the spec: "can0", "sim", "replay:FILE"
+  bool bus_open = false;   // false until the first successful open
+  bool read_only = false;  // a replayed log: nothing is sent
+  std::string bus_error;   // why the bus is not open (while !bus_open)
+  BusStatus bus;           // state, detail, counters of the open bus
+
+  ControllerState controller;
+  ChassisFeedback feedback;
+  // Odometry, TF and joint states are known only while the chassis is heard: false before the
+  // first frame and while the link is lost (the pose resumes from where it was).
+  bool motion_known = false;
+  OdometryState odometry;
+  WheelJoints joints;
+  FrameStats frames;
+  ProtocolProfile profile;  // the settings in use
+
+  std::vector<RequestOutcome> requests;  // the most recent ones, oldest first (at most 16)
+  std::uint64_t loop_iterations = 0;
+
+  // The outcome of request `id`, if it is still in the list.
+  const RequestOutcome* request(std::uint64_t id) const;
+};
+
+class Driver {
+ public:
+  using SentObserver = std::function<void(const SentEvent&)>;
+  using FrameTap = std::function<void(const CanFrame&)>;
+
+  // `source` gives the bus (opened at the first step, retried every reconnect_interval until it
+  // opens); `clock` must outlive the driver. The config should pass validate().
+  Driver(DriverConfig config, std::shared_ptr<BusSource> source, const Clock& clock);
+  ~Driver();  // stop()
+  Driver(const Driver&) = delete;
+  Driver& operator=(const Driver&) = delete;
+
+  // Called on the driver thread (or in step()) after every frame sent, outside the driver's
+  // locks; must not block. Set before start().
+  void set_sent_observer(SentObserver observer) { sent_observer_ = std::move(observer); }
+  // Called with every received frame (any ID), before the driver handles it. Set before start().
+  void set_frame_tap(FrameTap tap) { frame_tap_ = std::move(tap); }
+
+  // Starts the thread. Without it the owner calls step() instead.
+  void start();
+  // Sends the stop (a zero 0x111, seen by the observer), then ends the thread. Idempotent; the
+  // snapshot stays readable.
+  void stop();
+
+  // ---- the mailbox (any thread; never waits for the bus) ----
+  // The motion wanted from now on. kNotFinite for NaN/inf (the driver then commands zero);
+  // kInterfaceDown while the bus was never opened (the message says why).
+  Status command(const MotionRequest& request);
+  void set_motion_mode(std::optional<protocol::MotionMode> mode);
+  // kInvalidArgument (nothing posted) for a code outside 0x00..0x10; else the request's id.
+  Result<std::uint64_t> clear_errors(std::uint8_t code);
+  std::uint64_t set_ultrasonic(bool enable);
+  std::uint64_t resume();
+
+  // Blocks the calling thread until request `id` is answered or failed, or `timeout` passes
+  // (then the outcome as it stands). Only with start(); in lock-step read the snapshot instead.
+  RequestOutcome wait_for(std::uint64_t id, std::chrono::nanoseconds timeout);
+
+  // The latest snapshot (never null). Cheap: a shared pointer copy under a short lock.
+  std::shared_ptr<const DriverSnapshot> snapshot() const;
+
+  // ---- lock-step ----
+  // One iteration at `now`: open the bus if due, drain it, apply the mailbox, tick, publish.
+  void step(Timestamp now);
+  // When step() next has something to do (the controller's next tick, or the next open attempt).
+  Timestamp next_due() const;
+
+ private:
+  struct Mail;
+  void loop();
+  void wake();
+  void wait(std::chrono::nanoseconds timeout);
+  void try_open(Timestamp now);
+  void apply_mail(Timestamp now);
+  void handle_frame(const CanFrame& frame, Timestamp now);
+  void update_requests(Timestamp now);
+  void publish(Timestamp now);
+  void deliver_events();
+  RequestOutcome& add_request(std::string what);  // mail lock held
+
+  const DriverConfig config_;
+  const std::shared_ptr<BusSource> source_;
+  const Clock& clock_;
+  SentObserver sent_observer_;
+  FrameTap frame_tap_;
+
+  // ---- owned by the driver thread (or the lock-step caller) ----
+  std::unique_ptr<Bus> bus_;
+  std::unique_ptr<ChassisController> controller_;
+  Odometry odometry_;
+  WheelJointTracker joints_;
+  FrameStats frames_;
+  std::string bus_error_;
+  Timestamp next_open_attempt_{0};
+  std::uint64_t loop_iterations_ = 0;
+  std::uint64_t status_frames_ = 0;  // 0x211 received (to tell an answer from a stale frame)
+  std::vector<SentEvent> events_;    // sent during this iteration, delivered after it
+  bool stopped_ = false;
+
+  // ---- the mailbox ----
+  mutable std::mutex mail_mutex_;
+  std::unique_ptr<Mail> mail_;
+  std::deque<RequestOutcome> requests_;  // guarded by mail_mutex_
+  std::uint64_t next_request_id_ = 1;
+  bool opened_once_ = false;  // guarded by mail_mutex_
+  std::string open_error_;    // guarded by mail_mutex_
+
+  // ---- the snapshot ----
+  mutable std::mutex snapshot_mutex_;
+  std::condition_variable snapshot_changed_;
+  std::shared_ptr<const DriverSnapshot> snapshot_;
+
+  // ---- the thread ----
+  int wake_fd_ = -1;
+  bool stop_requested_ = false;  // guarded by mail_mutex_
+  std::thread thread_;
+};
+
+}  // namespace ranger

@@ -1,0 +1,79 @@
+// The virtual chassis as a bus source: `sim` (or `sim:VARIANT`) wherever a bus is named — the ROS
+// node's port_name, every `ranger_can` command, the example program. The chassis runs on an
+// in-process LoopbackNetwork, either on a thread of its own against a real clock
+// (VirtualChassisRunner), or in lock-step with the caller's simulated clock (step()).
+#pragma once
+
+#include <memory>
+#include <mutex>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "ranger_can/clock.hpp"
+#include "ranger_can/result.hpp"
+#include "ranger_can/sim/virtual_chassis.hpp"
+#include "ranger_can/sim/virtual_chassis_runner.hpp"
+#include "ranger_can/transport/bus_source.hpp"
+#include "ranger_can/transport/loopback_bus.hpp"
+
+namespace ranger::sim {
+
+// The names `sim:VARIANT` accepts ("manual" is the plain `sim`).
+const std::vector<std::string>& variant_names();
+// `config` changed the way VARIANT's chassis differs from the manual. kInvalidArgument naming
+// the valid variants for an unknown one.
+Result<VirtualChassisConfig> apply_variant(std::string_view variant, VirtualChassisConfig config);
+
+struct SimSourceOptions {
+  VirtualChassisConfig chassis;       // before the variant is applied
+  std::uint32_t boot_error_bits = 0;  // 0x211 error bits the chassis boots with
+  bool lock_step = false;  // true: no thread; the owner calls step() with its simulated clock
+};
+
+class SimBusSource final : public BusSource {
+ public:
+  // `spec` is "sim" or "sim:VARIANT" (checked by open_bus_source). Boots the chassis at
+  // clock.now(); `clock` must outlive the source.
+  SimBusSource(std::string spec, VirtualChassisConfig config, const SimSourceOptions& options,
+               const Clock& clock);
+  ~SimBusSource() override;
+
+  Result<std::unique_ptr<Bus>> open() override;  // a new endpoint on the chassis's network
+  std::string name() const override { return spec_; }
+
+  // Runs `f(VirtualChassis&)` with the chassis held (fault injection, ground truth).
+  template <typename F>
+  auto with_chassis(F&& f) {
+    if (runner_) return runner_->with_chassis(std::forward<F>(f));
+    std::lock_guard<std::mutex> lock(mutex_);
+    return f(*chassis_);
+  }
+  ChassisSnapshot snapshot() {
+    return with_chassis([](VirtualChassis& c) { return c.snapshot(); });
+  }
+  // Why the chassis thread ended early (empty otherwise).
+  std::string failure() const { return runner_ ? runner_->failure() : std::string(); }
+
+  // Lock-step only: hands the chassis every frame waiting for it and steps it to `now`.
+  void step(Timestamp now);
+  // Lock-step only: when step() next has something to do.
+  Timestamp next_deadline();
+
+  LoopbackNetwork& network() { return *network_; }
+
+ private:
+  std::string spec_;
+  std::unique_ptr<LoopbackNetwork> network_;
+  std::unique_ptr<Bus> chassis_bus_;
+  std::unique_ptr<VirtualChassisRunner> runner_;  // threaded
+  std::mutex mutex_;                              // lock-step
+  std::unique_ptr<VirtualChassis> chassis_;       // lock-step
+};
+
+// A bus source for any spec: sim and sim:VARIANT here (the chassis from `options`), everything
+// else from ranger::open_bus_source. An unknown variant is refused with the valid names.
+Result<std::shared_ptr<BusSource>> open_bus_source(std::string_view spec, const Clock& clock,
+                                                   const SimSourceOptions& options = {});
+
+}  // namespace ranger::sim

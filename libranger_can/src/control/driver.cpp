@@ -1,0 +1,460 @@
+#include "ranger_can/control/driver.hpp"
+
+#include <poll.h>
+#include <pthread.h>
+#include <sys/eventfd.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <utility>
+
+#include "ranger_can/wire/codec.hpp"
+#include "ranger_can/wire/protocol.hpp"
+
+namespace ranger {
+namespace {
+
+using namespace std::chrono_literals;
+
+constexpr std::size_t kMaxFramesPerIteration = 512;
+constexpr std::size_t kMaxRequests = 16;
+// A 0x211 that arrives this soon after a request was sent may have left the chassis before the
+// request reached it: the answer is the first one after this.
+constexpr std::chrono::nanoseconds kAnswerDelay =
+    std::chrono::milliseconds(protocol::kFastPeriodMs);
+
+bool finite(const BodyTwist& t) {
+  return std::isfinite(t.vx) && std::isfinite(t.vy) && std::isfinite(t.wz);
+}
+bool is_zero(const BodyTwist& t) {
+  return t.vx == 0.0 && t.vy == 0.0 && t.wz == 0.0;
+}
+
+std::string hex2(std::uint8_t v) {
+  static const char* digits = "0123456789ABCDEF";
+  return std::string("0x") + digits[v >> 4] + digits[v & 0xF];
+}
+
+}  // namespace
+
+std::string_view to_string(RequestOutcome::State s) {
+  switch (s) {
+    case RequestOutcome::State::kPending:
+      return "pending";
+    case RequestOutcome::State::kSent:
+      return "sent";
+    case RequestOutcome::State::kAnswered:
+      return "answered";
+    case RequestOutcome::State::kFailed:
+      return "failed";
+  }
+  return "unknown";
+}
+
+Status DriverConfig::validate() const {
+  if (Status st = controller.validate(); !st) return st;
+  if (Status st = odometry.validate(); !st) return st;
+  if (reconnect_interval.count() <= 0 || request_answer_timeout.count() <= 0) {
+    return Error{Errc::kOutOfRange,
+                 "driver: reconnect_interval and request_answer_timeout must be > 0"};
+  }
+  return ok_status();
+}
+
+const RequestOutcome* DriverSnapshot::request(std::uint64_t id) const {
+  for (const RequestOutcome& r : requests) {
+    if (r.id == id) return &r;
+  }
+  return nullptr;
+}
+
+// What callers posted since the driver last looked. Guarded by mail_mutex_.
+struct Driver::Mail {
+  std::optional<MotionRequest> command;  // the latest twist
+  bool zero_seen = false;                // a zero twist came before the latest (it re-arms)
+  std::optional<std::optional<protocol::MotionMode>> mode;
+  struct Action {
+    enum Kind { kClearErrors, kUltrasonic, kResume } kind;
+    std::uint64_t id;
+    std::uint8_t code;
+    bool enable;
+  };
+  std::vector<Action> actions;
+};
+
+Driver::Driver(DriverConfig config, std::shared_ptr<BusSource> source, const Clock& clock)
+    : config_(std::move(config)),
+      source_(std::move(source)),
+      clock_(clock),
+      odometry_(config_.odometry),
+      joints_(config_.odometry.geometry.wheel_radius),
+      mail_(std::make_unique<Mail>()),
+      snapshot_(std::make_shared<DriverSnapshot>()) {
+  wake_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
+  auto first = std::make_shared<DriverSnapshot>();
+  first->bus_name = source_ ? source_->name() : "";
+  first->profile = config_.controller.profile;
+  snapshot_ = std::move(first);
+}
+
+Driver::~Driver() {
+  stop();
+  if (wake_fd_ >= 0) ::close(wake_fd_);
+}
+
+void Driver::start() {
+  if (thread_.joinable() || stopped_) return;
+  thread_ = std::thread([this] { loop(); });
+}
+
+void Driver::stop() {
+  {
+    std::lock_guard<std::mutex> lock(mail_mutex_);
+    stop_requested_ = true;
+  }
+  wake();
+  if (thread_.joinable()) {
+    thread_.join();  // the thread sends the stop on its way out
+  } else if (!stopped_) {
+    // Lock-step owner (or a thread that never started): stop here.
+    if (controller_) controller_->shutdown(clock_.now());
+    deliver_events();
+    publish(clock_.now());
+  }
+  stopped_ = true;
+}
+
+// ---- mailbox --------------------------------------------------------------------------------
+
+Status Driver::command(const MotionRequest& request) {
+  Status st = ok_status();
+  {
+    std::lock_guard<std::mutex> lock(mail_mutex_);
+    if (!opened_once_) {
+      return Error{Errc::kInterfaceDown, "not connected to " +
+                                             (source_ ? source_->name() : std::string("a bus")) +
+                                             (open_error_.empty() ? "" : ": " + open_error_)};
+    }
+    if (!finite(request.twist)) {
+      st = Error{Errc::kNotFinite,
+                 "command refused (NaN or infinite component): the chassis is commanded to stop"};
+    }
+    if (mail_->command && is_zero(mail_->command->twist)) mail_->zero_seen = true;
+    mail_->command = request;
+  }
+  wake();
+  return st;
+}
+
+void Driver::set_motion_mode(std::optional<protocol::MotionMode> mode) {
+  {
+    std::lock_guard<std::mutex> lock(mail_mutex_);
+    mail_->mode = mode;
+  }
+  wake();
+}
+
+RequestOutcome& Driver::add_request(std::string what) {
+  RequestOutcome r;
+  r.id = next_request_id_++;
+  r.what = std::move(what);
+  requests_.push_back(std::move(r));
+  while (requests_.size() > kMaxRequests)
+    requests_.pop_front();
+  return requests_.back();
+}
+
+Result<std::uint64_t> Driver::clear_errors(std::uint8_t code) {
+  if (code > protocol::kMaxErrorClearCode) {
+    return Error{Errc::kInvalidArgument, "code " + std::to_string(code) +
+                                             " is not an error-clearing code (valid 0.." +
+                                             std::to_string(protocol::kMaxErrorClearCode) + ")"};
+  }
+  std::uint64_t id = 0;
+  {
+    std::lock_guard<std::mutex> lock(mail_mutex_);
+    id = add_request("clear_errors " + hex2(code)).id;
+    mail_->actions.push_back({Mail::Action::kClearErrors, id, code, false});
+  }
+  wake();
+  return id;
+}
+
+std::uint64_t Driver::set_ultrasonic(bool enable) {
+  std::uint64_t id = 0;
+  {
+    std::lock_guard<std::mutex> lock(mail_mutex_);
+    id = add_request(std::string("ultrasonic ") + (enable ? "on" : "off")).id;
+    mail_->actions.push_back({Mail::Action::kUltrasonic, id, 0, enable});
+  }
+  wake();
+  return id;
+}
+
+std::uint64_t Driver::resume() {
+  std::uint64_t id = 0;
+  {
+    std::lock_guard<std::mutex> lock(mail_mutex_);
+    id = add_request("resume").id;
+    mail_->actions.push_back({Mail::Action::kResume, id, 0, false});
+  }
+  wake();
+  return id;
+}
+
+RequestOutcome Driver::wait_for(std::uint64_t id, std::chrono::nanoseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  std::unique_lock<std::mutex> lock(snapshot_mutex_);
+  for (;;) {
+    const RequestOutcome* r = snapshot_->request(id);
+    const bool done = r && (r->state == RequestOutcome::State::kAnswered ||
+                            r->state == RequestOutcome::State::kFailed);
+    if (done) return *r;
+    if (snapshot_changed_.wait_until(lock, deadline) == std::cv_status::timeout) {
+      r = snapshot_->request(id);
+      if (r) return *r;
+      RequestOutcome lost;
+      lost.id = id;
+      lost.state = RequestOutcome::State::kFailed;
+      lost.message = "unknown request";
+      return lost;
+    }
+  }
+}
+
+std::shared_ptr<const DriverSnapshot> Driver::snapshot() const {
+  std::lock_guard<std::mutex> lock(snapshot_mutex_);
+  return snapshot_;
+}
+
+// ---- the iteration ---------------------------------------------------------------------------
+
+Timestamp Driver::next_due() const {
+  if (!bus_) return next_open_attempt_;
+  return controller_->next_tick_due();
+}
+
+void Driver::try_open(Timestamp now) {
+  if (now < next_open_attempt_ || !source_) return;
+  next_open_attempt_ = now + config_.reconnect_interval;
+  auto bus = source_->open();
+  if (!bus) {
+    bus_error_ = bus.error().message;
+    std::lock_guard<std::mutex> lock(mail_mutex_);
+    open_error_ = bus_error_;
+    return;
+  }
+  bus_error_.clear();
+  bus_ = std::move(*bus);
+  bus_->set_filter(protocol::all_ids());
+  ControllerConfig controller_config = config_.controller;
+  if (source_->read_only()) controller_config.listen_only = true;
+  controller_ = std::make_unique<ChassisController>(*bus_, controller_config);
+  controller_->set_send_observer([this](const SentFrame& sent) {
+    events_.push_back(SentEvent{sent, std::chrono::system_clock::now()});
+  });
+  std::lock_guard<std::mutex> lock(mail_mutex_);
+  opened_once_ = true;
+  open_error_.clear();
+}
+
+void Driver::handle_frame(const CanFrame& frame, Timestamp now) {
+  if (frame_tap_) frame_tap_(frame);
+  if (frame.is_error) {
+    controller_->on_frame(frame, now);  // counts it
+    return;
+  }
+  Result<Message> message = decode(frame);
+  const int layout = protocol::expected_dlc(frame.id);
+  frames_.record(frame.id, now, message.ok(), layout >= 0 ? frame.dlc - layout : 0);
+  if (!message) {
+    controller_->on_frame(frame, now);  // counts and records the decode error
+    return;
+  }
+  if (std::holds_alternative<SystemStatus>(*message)) ++status_frames_;
+  controller_->on_message(*message, frame.stamp, now);
+  odometry_.on_message(*message, frame.stamp);
+  joints_.on_message(*message, frame.stamp);
+}
+
+void Driver::apply_mail(Timestamp now) {
+  Mail mail;
+  {
+    std::lock_guard<std::mutex> lock(mail_mutex_);
+    std::swap(mail, *mail_);
+  }
+  if (mail.mode) controller_->request_motion_mode(*mail.mode, now);
+  if (mail.command) {
+    if (mail.zero_seen && !is_zero(mail.command->twist)) {
+      controller_->set_command(MotionRequest{}, now);  // its re-arm must not be lost
+    }
+    controller_->set_command(*mail.command, now);
+  }
+  for (const Mail::Action& a : mail.actions) {
+    Status st = ok_status();
+    switch (a.kind) {
+      case Mail::Action::kClearErrors:
+        st = controller_->clear_errors(a.code, now);
+        break;
+      case Mail::Action::kUltrasonic:
+        st = controller_->set_ultrasonic(a.enable, now);
+        break;
+      case Mail::Action::kResume:
+        st = controller_->resume(now);
+        break;
+    }
+    std::lock_guard<std::mutex> lock(mail_mutex_);
+    for (RequestOutcome& r : requests_) {
+      if (r.id != a.id) continue;
+      r.sent = now;
+      if (!st) {
+        r.state = RequestOutcome::State::kFailed;
+        r.message = st.error().message;
+      } else if (a.kind == Mail::Action::kResume) {
+        r.state = RequestOutcome::State::kAnswered;
+        r.message = "re-armed";
+      } else {
+        r.state = RequestOutcome::State::kSent;
+      }
+    }
+  }
+}
+
+void Driver::update_requests(Timestamp now) {
+  const ControllerState& c = controller_->state();
+  const auto& status = controller_->feedback().system_status;
+  std::lock_guard<std::mutex> lock(mail_mutex_);
+  for (RequestOutcome& r : requests_) {
+    if (r.state != RequestOutcome::State::kSent) continue;
+    if (r.what.rfind("clear_errors", 0) == 0) {
+      if (status && status->received >= r.sent + kAnswerDelay) {
+        r.state = RequestOutcome::State::kAnswered;
+        r.error_word = c.error_bits;
+        r.message = "the chassis reports " +
+                    std::to_string(protocol::error_bit_names(c.error_bits).size()) +
+                    " error bit(s) set";
+      } else if (now - r.sent > config_.request_answer_timeout) {
+        r.state = RequestOutcome::State::kFailed;
+        r.message = "the chassis did not answer (no 0x211) within " +
+                    std::to_string(seconds(config_.request_answer_timeout)) + " s";
+      }
+    } else if (r.what.rfind("ultrasonic", 0) == 0) {
+      const bool want = r.what == "ultrasonic on";
+      if (c.ultrasonic_failed) {
+        r.state = RequestOutcome::State::kFailed;
+        r.message = "the chassis did not confirm the ultrasonic setting (0x45A)";
+      } else if (!c.ultrasonic_requested && c.ultrasonic_enabled == want) {
+        r.state = RequestOutcome::State::kAnswered;
+        r.message = std::string("ultrasonic avoidance ") + (want ? "enabled" : "disabled") +
+                    " (confirmed by the chassis)";
+      }
+    }
+  }
+}
+
+void Driver::publish(Timestamp now) {
+  auto s = std::make_shared<DriverSnapshot>();
+  s->now = now;
+  s->bus_name = source_ ? source_->name() : "";
+  s->bus_open = bus_ != nullptr;
+  s->read_only = source_ && source_->read_only();
+  s->bus_error = bus_error_;
+  if (bus_) s->bus = bus_->status();
+  if (controller_) {
+    s->controller = controller_->state();
+    s->feedback = controller_->feedback();
+  }
+  s->motion_known = controller_ && s->controller.link == LinkState::kConnected;
+  s->odometry = odometry_.state();
+  s->joints = joints_.joints();
+  s->frames = frames_;
+  s->profile = config_.controller.profile;
+  s->loop_iterations = loop_iterations_;
+  {
+    std::lock_guard<std::mutex> lock(mail_mutex_);
+    s->requests.assign(requests_.begin(), requests_.end());
+  }
+  {
+    std::lock_guard<std::mutex> lock(snapshot_mutex_);
+    s->sequence = snapshot_->sequence + 1;
+    snapshot_ = std::move(s);
+  }
+  snapshot_changed_.notify_all();
+}
+
+void Driver::deliver_events() {
+  if (events_.empty()) return;
+  std::vector<SentEvent> events;
+  events.swap(events_);
+  if (!sent_observer_) return;
+  for (const SentEvent& e : events)
+    sent_observer_(e);
+}
+
+void Driver::step(Timestamp now) {
+  ++loop_iterations_;
+  if (!bus_) try_open(now);
+  if (bus_) {
+    for (std::size_t i = 0; i < kMaxFramesPerIteration; ++i) {
+      auto frame = bus_->receive(0ns);
+      if (!frame) break;  // kTimeout: nothing more; other errors: the bus reports and reopens
+      handle_frame(*frame, now);
+    }
+    apply_mail(now);
+    controller_->tick(now);
+    update_requests(now);
+  }
+  publish(now);
+  deliver_events();
+}
+
+// ---- the thread ------------------------------------------------------------------------------
+
+void Driver::wake() {
+  if (wake_fd_ < 0) return;
+  const std::uint64_t one = 1;
+  // A full counter (EAGAIN) means a wake-up is pending anyway.
+  [[maybe_unused]] const auto n = ::write(wake_fd_, &one, sizeof one);
+}
+
+void Driver::wait(std::chrono::nanoseconds timeout) {
+  timeout = std::clamp<std::chrono::nanoseconds>(timeout, 0ns, 1s);
+  const timespec ts{static_cast<time_t>(timeout.count() / 1'000'000'000),
+                    static_cast<long>(timeout.count() % 1'000'000'000)};
+  if (wake_fd_ < 0) {
+    ::nanosleep(&ts, nullptr);
+    return;
+  }
+  pollfd fd{wake_fd_, POLLIN, 0};
+  if (::ppoll(&fd, 1, &ts, nullptr) > 0 && (fd.revents & POLLIN)) {
+    std::uint64_t value;
+    [[maybe_unused]] const auto n = ::read(wake_fd_, &value, sizeof value);
+  }
+}
+
+void Driver::loop() {
+  ::pthread_setname_np(::pthread_self(), config_.thread_name.substr(0, 15).c_str());
+  try {
+    for (;;) {
+      {
+        std::lock_guard<std::mutex> lock(mail_mutex_);
+        if (stop_requested_) break;
+      }
+      step(clock_.now());
+      wait(next_due() - clock_.now());
+    }
+  } catch (const std::exception& e) {  // never let an exception escape the thread
+    bus_error_ = std::string("driver thread failed: ") + e.what();
+  } catch (...) {
+    bus_error_ = "driver thread failed";
+  }
+  const Timestamp now = clock_.now();
+  if (controller_) controller_->shutdown(now);
+  publish(now);
+  deliver_events();
+}
+
+}  // namespace ranger

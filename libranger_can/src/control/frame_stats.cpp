@@ -1,0 +1,67 @@
+#include "ranger_can/control/frame_stats.hpp"
+
+#include <algorithm>
+
+namespace ranger {
+
+FrameStats::FrameStats(std::chrono::nanoseconds window)
+    : window_(window.count() > 0 ? window : std::chrono::seconds(1)), bucket_(window_ / kBuckets) {
+  if (bucket_.count() <= 0) bucket_ = std::chrono::nanoseconds(1);
+  index_.fill(-1);
+}
+
+bool FrameStats::record(std::uint32_t id, Timestamp now, bool decoded, int extra_bytes) {
+  ++total_;
+  const std::size_t key = id & 0x7FFu;
+  if (index_[key] < 0) {
+    index_[key] = static_cast<std::int16_t>(entries_.size());
+    Entry e;
+    e.counts.id = id & 0x7FFu;
+    e.last_bucket = bucket_of(now);
+    entries_.push_back(e);
+  }
+  Entry& e = entries_[static_cast<std::size_t>(index_[key])];
+  const std::int64_t b = bucket_of(now);
+  if (b > e.last_bucket) {
+    // Empty the buckets that passed without a frame (all of them after a long silence).
+    const std::int64_t passed = std::min<std::int64_t>(b - e.last_bucket, kBuckets);
+    for (std::int64_t k = 1; k <= passed; ++k) {
+      e.buckets[static_cast<std::size_t>((e.last_bucket + k) % kBuckets)] = 0;
+    }
+    e.last_bucket = b;
+  }
+  ++e.buckets[static_cast<std::size_t>(e.last_bucket % kBuckets)];
+  ++e.counts.frames;
+  if (!decoded) ++e.counts.rejected;
+  if (extra_bytes > 0) {
+    ++e.counts.padded;
+    return e.counts.padded == 1;
+  }
+  return false;
+}
+
+double FrameStats::rate(std::uint32_t id, Timestamp now) const {
+  const std::int16_t i = index_[id & 0x7FFu];
+  if (i < 0) return 0.0;
+  const Entry& e = entries_[static_cast<std::size_t>(i)];
+  const std::int64_t newest = bucket_of(now);
+  // Buckets newest-(kBuckets-1) .. newest form the window; older counts have expired.
+  std::uint64_t sum = 0;
+  for (std::int64_t b = std::max(e.last_bucket - kBuckets + 1, newest - kBuckets + 1);
+       b <= std::min(e.last_bucket, newest); ++b) {
+    sum += e.buckets[static_cast<std::size_t>(b % kBuckets)];
+  }
+  return static_cast<double>(sum) / seconds(bucket_ * kBuckets);
+}
+
+std::vector<FrameIdCounts> FrameStats::counts() const {
+  std::vector<FrameIdCounts> out;
+  out.reserve(entries_.size());
+  for (const Entry& e : entries_)
+    out.push_back(e.counts);
+  std::sort(out.begin(), out.end(),
+            [](const FrameIdCounts& a, const FrameIdCounts& b) { return a.id < b.id; });
+  return out;
+}
+
+}  // namespace ranger
