@@ -96,7 +96,8 @@ def node():
     """ROS node
     ranger_base_node, `port_name:=sim` (the virtual chassis, a thread of the node, sends the full
     feedback), `odom`, `/tf`, `joint_states` at 50 Hz to subscribers, `cmd_vel` at 20 Hz; CPU in
-    % of one core. Latency: `cmd_vel` published -> the 0x111's send stamp (`cmd_vel_out`)."""
+    % of one core. Latency: `cmd_vel` published -> the 0x111's send stamp (`cmd_vel_out`); it
+    includes up to `min_command_interval` (5 ms by default, see ranger_base/README.md)."""
     doc = json.loads(read("node.json"))
     load, lat = doc["load"], doc["latency_cmd_vel_to_0x111"]
     cpu = load["driver_cpu_percent"]
