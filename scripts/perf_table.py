@@ -1,7 +1,7 @@
 #!/usr/bin/python3
-"""Prints the tables of docs/PERFORMANCE.md from scripts/perf.sh's RAW directory (NAME.cmd: a
-step's command, NAME.out: its output); every row names its target, where one exists, and its
-command.   scripts/perf_table.py RAW >> docs/PERFORMANCE.md"""
+"""Usage: scripts/perf_table.py RAW. Prints the tables of docs/PERFORMANCE.md (scripts/perf.sh
+writes the header) from RAW = build/perf/raw (NAME.cmd: a step's command, NAME.out: its output);
+every row names its target, where one exists, and the command that produced it."""
 
 import json
 import os
