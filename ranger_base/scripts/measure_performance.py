@@ -1,20 +1,21 @@
 #!/usr/bin/python3
 """Measures ranger_base_node's cost and command latency against the in-process virtual chassis
-(port_name:=sim, so the chassis's full feedback, ~790 frames/s, flows through the real CAN thread,
-controller and odometry). A benchmark, not a test: it prints figures, it asserts nothing.
+(port_name:=sim: the chassis's full feedback, ~790 frames/s, flows through the real CAN thread,
+controller and odometry). A benchmark: it prints figures, it asserts nothing.
 
-  1. CPU and memory: the node drives at 20 Hz cmd_vel for --duration seconds with 50 Hz odometry;
-     CPU share (of one core) from /proc/<pid>/stat and per thread from /proc/<pid>/task, RSS from
-     /proc/<pid>/status. The node process also runs the virtual chassis (its thread is reported
-     separately): the driver's own share is the node total minus that thread.
-  2. Latency cmd_vel -> 0x111: a new twist is published every 50-70 ms (random, so every phase
-     against the 20 ms keep-alive occurs); the node (publish_cmd:=true)
-     stamps each 0x111 with its send time on cmd_vel_out; latency = that stamp - the time the
-     twist was published (same host clock). Includes the ROS transport of cmd_vel.
+Both phases run a node of their own with subscribers on odom, /tf and joint_states (a separate
+process, as in real use, so the node serialises and sends those messages at 50 Hz).
+  1. Load: cmd_vel at 20 Hz for --duration s. CPU (% of one core) of the node process and of
+     each thread from /proc/<pid>/task, RSS from /proc/<pid>/status. The process also hosts the
+     virtual chassis: its thread (named ranger_sim; before the driver rewrite unnamed, created
+     just before the CAN thread) is not the driver's cost: driver CPU = node total - that thread.
+  2. Latency cmd_vel -> 0x111: --samples twists 50-70 ms apart (at random, so every phase
+     against the 20 ms keep-alive occurs); the node (publish_cmd:=true) stamps each 0x111 with its
+     send time on cmd_vel_out; latency = that stamp - the time the twist was published.
 
   ranger_base/scripts/measure_performance.py [--duration 30] [--samples 400] [--json FILE]
 
-Needs a built and sourced workspace (ranger_base_node findable by rospack/catkin).
+Needs a built and sourced workspace (ranger_base_node findable by rospack).
 """
 
 import argparse
@@ -22,6 +23,7 @@ import json
 import os
 import platform
 import random
+import select
 import shutil
 import signal
 import socket
@@ -33,225 +35,203 @@ import threading
 import time
 
 CLK_TCK = os.sysconf("SC_CLK_TCK")
-PAGE = os.sysconf("SC_PAGE_SIZE")
+CAN_THREADS = ("ranger_driver", "ranger_can_link")  # after / before the driver rewrite
+
+# The subscribers, in a process of their own: rospy.AnyMsg, so they cost little themselves.
+# They print one line once every topic has delivered, and the message counts when interrupted.
+SUBSCRIBERS = """
+import json, sys, rospy
+ns, topics = sys.argv[1], ["odom", "/tf", "joint_states"]
+count = dict.fromkeys(topics, 0)
+def on(topic):
+    def cb(_):
+        count[topic] += 1
+        if count[topic] == 1 and all(count.values()):
+            print("ready", flush=True)
+    return cb
+rospy.init_node("perf_subscribers", anonymous=True)
+subs = [rospy.Subscriber(t if t[0] == "/" else f"/{ns}/{t}", rospy.AnyMsg, on(t)) for t in topics]
+rospy.spin()
+print(json.dumps(count), flush=True)
+"""
 
 
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def wait_for(condition, timeout=60.0, interval=0.02):
+def wait_for(condition, timeout=60.0):
     end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        value = condition()
-        if value:
-            return value
-        time.sleep(interval)
+    while time.monotonic() < end and not condition():
+        time.sleep(0.02)
     return condition()
 
 
 def cpu_seconds(stat_path):
-    """utime + stime of a process or thread, in seconds."""
+    """utime + stime of a process or thread."""
     with open(stat_path) as f:
         fields = f.read().rsplit(")", 1)[1].split()
     return (int(fields[11]) + int(fields[12])) / CLK_TCK
 
 
 def thread_times(pid):
+    """tid -> (name, CPU seconds)."""
     out = {}
     for tid in os.listdir(f"/proc/{pid}/task"):
         try:
             with open(f"/proc/{pid}/task/{tid}/comm") as f:
-                name = f.read().strip()
-            out[tid] = (name, cpu_seconds(f"/proc/{pid}/task/{tid}/stat"))
-        except FileNotFoundError:
-            pass  # thread ended
+                out[int(tid)] = (f.read().strip(), cpu_seconds(f"/proc/{pid}/task/{tid}/stat"))
+        except (FileNotFoundError, ProcessLookupError):
+            pass  # the thread ended
     return out
+
+
+def chassis_thread(pid, threads):
+    """The virtual chassis's thread: by its name, else (before the rewrite, when it is unnamed)
+    the last unnamed thread created before the CAN thread (the chassis is built first)."""
+    named = [t for t, (name, _) in threads.items() if name == "ranger_sim"]
+    if named:
+        return named[0]
+    can = [t for t, (name, _) in threads.items() if name in CAN_THREADS]
+    unnamed = [t for t, (name, _) in threads.items()
+               if can and name == threads[pid][0] and t != pid and t < min(can)]
+    return max(unnamed, default=None)
 
 
 def rss_kib(pid):
     with open(f"/proc/{pid}/status") as f:
-        for line in f:
-            if line.startswith("VmRSS:"):
-                return int(line.split()[1])
-    return 0
+        return next(int(line.split()[1]) for line in f if line.startswith("VmRSS:"))
 
 
 def percentile(values, p):
     ordered = sorted(values)
-    k = max(0, min(len(ordered) - 1, int(round(p / 100.0 * (len(ordered) - 1)))))
-    return ordered[k]
+    return ordered[max(0, min(len(ordered) - 1, round(p / 100.0 * (len(ordered) - 1))))]
 
 
-class Environment:
-    """A private rosmaster with a throwaway ROS_HOME."""
+class Robot:
+    """ranger_base_node (port_name:=sim) in namespace ns, in CAN command mode, with the
+    subscribers of real use connected; on leaving, both stop and .rates holds what the
+    subscribers received (messages/s per topic)."""
 
-    def __init__(self):
-        self.home = tempfile.mkdtemp(prefix="ranger-perf-roshome-")
-        port = free_port()
-        os.environ.update(ROS_MASTER_URI=f"http://localhost:{port}", ROS_HOME=self.home,
-                          ROS_LOG_DIR=os.path.join(self.home, "log"), ROS_HOSTNAME="localhost")
-        self.master = subprocess.Popen(["rosmaster", "--core", "-p", str(port)],
-                                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    def __init__(self, rospy, ns, params):
+        import roslib.packages
+        from ranger_msgs.msg import SystemState
+        exe = roslib.packages.find_node("ranger_base", "ranger_base_node")
+        if not exe:
+            sys.exit("ranger_base_node not found: build and source the workspace first")
+        self.node = subprocess.Popen([exe[0], "__name:=ranger_base_node", f"__ns:=/{ns}",
+                                      "_port_name:=sim", *params],
+                                     stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        self.subscribers = subprocess.Popen([sys.executable, "-c", SUBSCRIBERS, ns],
+                                            stdout=subprocess.PIPE, text=True)
+        self.rates = {}
+        state = {}
+        sub = rospy.Subscriber(f"/{ns}/system_state", SystemState, lambda m: state.update(m=m))
+        ok = wait_for(lambda: "m" in state and state["m"].link_up
+                      and state["m"].control_mode == SystemState.CONTROL_MODE_CAN)
+        sub.unregister()
+        ready = select.select([self.subscribers.stdout], [], [], 30)[0]
+        if not ok or not ready or self.subscribers.stdout.readline().strip() != "ready":
+            self.__exit__()
+            sys.exit("the node did not reach CAN command mode or publish odom, tf, joint_states")
+        self.t0 = time.monotonic()
 
-    def close(self):
-        self.master.send_signal(signal.SIGINT)
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *_):
+        for p in (self.subscribers, self.node):
+            p.send_signal(signal.SIGINT)
+        seconds = time.monotonic() - getattr(self, "t0", time.monotonic())
         try:
-            self.master.wait(timeout=10)
+            out = self.subscribers.communicate(timeout=20)[0].strip().splitlines()
+            self.node.wait(timeout=20)
         except subprocess.TimeoutExpired:
-            self.master.kill()
-        shutil.rmtree(self.home, ignore_errors=True)
+            self.subscribers.kill()
+            self.node.kill()
+            out = []
+        if out and out[-1].startswith("{") and seconds > 0:
+            self.rates = {t: round(n / seconds, 1) for t, n in json.loads(out[-1]).items()}
 
 
-def start_node(name, *params):
-    import roslib.packages
-    exe = roslib.packages.find_node("ranger_base", "ranger_base_node")
-    if not exe:
-        sys.exit("ranger_base_node not found: build and source the workspace first")
-    return subprocess.Popen([exe[0], f"__name:={name}", "_port_name:=sim", *params],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-
-
-def stop_node(node):
-    node.send_signal(signal.SIGINT)
-    try:
-        node.wait(timeout=20)
-    except subprocess.TimeoutExpired:
-        node.kill()
-
-
-def wait_for_command_mode(rospy, ns):
-    from ranger_msgs.msg import SystemState
-    state = {}
-    sub = rospy.Subscriber(f"/{ns}/system_state", SystemState, lambda m: state.update(m=m))
-    ok = wait_for(lambda: "m" in state and state["m"].link_up
-                  and state["m"].control_mode == SystemState.CONTROL_MODE_CAN)
-    sub.unregister()
-    if not ok:
-        sys.exit("the node did not reach CAN command mode")
-
-
-def measure_load(rospy, duration, extra_args=()):
+def measure_load(rospy, duration, params):
     from diagnostic_msgs.msg import DiagnosticArray
     from geometry_msgs.msg import Twist
-    ns = "perf_load"
-    node = start_node("ranger_base_node", f"__ns:=/{ns}", "_publish_rate:=50", *extra_args)
-    try:
-        wait_for_command_mode(rospy, ns)
-        pub = rospy.Publisher(f"/{ns}/cmd_vel", Twist, queue_size=1)
-        rates = []
+    pub = rospy.Publisher("/perf_load/cmd_vel", Twist, queue_size=1)
+    cmd, stop, rates, rss = Twist(), threading.Event(), [], []
+    cmd.linear.x, cmd.angular.z = 0.4, 0.2  # an operator at 20 Hz, driving a slow circle
 
-        def on_diagnostics(msg):
-            for status in msg.status:
-                if status.name.endswith("Frame rates"):
-                    for kv in status.values:
-                        if kv.key == "Total (frames/s)":
-                            rates.append(float(kv.value))
+    def teleop():
+        while not stop.is_set():
+            pub.publish(cmd)
+            time.sleep(0.05)
+
+    def on_diagnostics(msg):
+        rates.extend(float(kv.value) for s in msg.status if s.name.endswith("Frame rates")
+                     for kv in s.values if kv.key == "Total (frames/s)")
+    with Robot(rospy, "perf_load", params) as robot:
+        pid = robot.node.pid
         diag = rospy.Subscriber("/diagnostics", DiagnosticArray, on_diagnostics)
-        stop = threading.Event()
-
-        def teleop():  # an operator at 20 Hz, driving a slow circle
-            cmd = Twist()
-            cmd.linear.x, cmd.angular.z = 0.4, 0.2
-            while not stop.is_set():
-                pub.publish(cmd)
-                time.sleep(0.05)
         driver = threading.Thread(target=teleop, daemon=True)
         driver.start()
         time.sleep(3.0)  # settle: mode switch done, steady state
-
-        pid = node.pid
-        wall0, cpu0, threads0 = time.monotonic(), cpu_seconds(f"/proc/{pid}/stat"), thread_times(pid)
-        rss = []
+        wall0, cpu0 = time.monotonic(), cpu_seconds(f"/proc/{pid}/stat")
+        threads0 = thread_times(pid)
         while time.monotonic() - wall0 < duration:
             rss.append(rss_kib(pid))
             time.sleep(0.5)
-        wall1, cpu1, threads1 = time.monotonic(), cpu_seconds(f"/proc/{pid}/stat"), thread_times(pid)
+        cpu1, threads1 = cpu_seconds(f"/proc/{pid}/stat"), thread_times(pid)
+        wall = time.monotonic() - wall0
         stop.set()
         driver.join()
         diag.unregister()
 
-        wall = wall1 - wall0
-        per_thread = {}
-        for tid, (name, t1) in threads1.items():
-            t0 = threads0.get(tid, (name, 0.0))[1]
-            label = f"{name} ({tid})"
-            per_thread[label] = 100.0 * (t1 - t0) / wall
-        return {
-            "duration_s": round(wall, 1),
-            "node_cpu_percent_of_one_core": round(100.0 * (cpu1 - cpu0) / wall, 2),
-            "threads_cpu_percent": {k: round(v, 2) for k, v in sorted(
-                per_thread.items(), key=lambda kv: -kv[1])},
-            "rss_kib_median": int(statistics.median(rss)),
-            "rss_kib_max": max(rss),
-            "feedback_frames_per_s": round(statistics.median(rates), 1) if rates else None,
-        }
-    finally:
-        stop_node(node)
+    def share(seconds):
+        return round(100.0 * seconds / wall, 2)
+    threads = [{"tid": tid, "name": name, "cpu_percent": share(t1 - threads0.get(tid, ("", 0))[1])}
+               for tid, (name, t1) in threads1.items()]
+    chassis = chassis_thread(pid, threads1)
+    chassis_cpu = next((t["cpu_percent"] for t in threads if t["tid"] == chassis), None)
+    total = share(cpu1 - cpu0)
+    return {
+        "duration_s": round(wall, 1),
+        "node_cpu_percent": total,
+        "chassis_thread": f"{threads1[chassis][0]} {chassis}" if chassis else None,
+        "chassis_cpu_percent": chassis_cpu,
+        "driver_cpu_percent": round(total - chassis_cpu, 2) if chassis_cpu is not None else None,
+        "threads": sorted(threads, key=lambda t: -t["cpu_percent"]),
+        "rss_kib_median": int(statistics.median(rss)),
+        "rss_kib_max": max(rss),
+        "feedback_frames_per_s": round(statistics.median(rates), 1) if rates else None,
+        "subscribers_messages_per_s": robot.rates,
+    }
 
 
-def measure_latency(rospy, samples, extra_args=()):
+def measure_latency(rospy, samples, params):
     from geometry_msgs.msg import Twist, TwistStamped
-    ns = "perf_latency"
-    node = start_node("ranger_base_node", f"__ns:=/{ns}", "_publish_cmd:=true",
-                      "_cmd_vel_timeout:=1.0", *extra_args)
-    try:
-        wait_for_command_mode(rospy, ns)
-        lock = threading.Lock()
-        sent = {}      # value in mm/s -> publish time
-        latencies = []
+    lock, sent, latencies = threading.Lock(), {}, []  # sent: speed in mm/s -> publish time
 
-        def on_command(msg):
-            key = round(msg.twist.linear.x * 1000.0)
-            with lock:
-                t = sent.pop(key, None)
-            if t is not None:
-                latencies.append(msg.header.stamp.to_sec() - t)
-        sub = rospy.Subscriber(f"/{ns}/cmd_vel_out", TwistStamped, on_command, queue_size=1000,
-                               tcp_nodelay=True)
-        pub = rospy.Publisher(f"/{ns}/cmd_vel", Twist, queue_size=1, tcp_nodelay=True)
+    def on_command(msg):
+        with lock:
+            t = sent.pop(round(msg.twist.linear.x * 1000.0), None)
+        if t is not None:
+            latencies.append(1000.0 * (msg.header.stamp.to_sec() - t))
+    with Robot(rospy, "perf_latency", ["_publish_cmd:=true", "_cmd_vel_timeout:=1.0", *params]):
+        sub = rospy.Subscriber("/perf_latency/cmd_vel_out", TwistStamped, on_command,
+                               queue_size=1000, tcp_nodelay=True)
+        pub = rospy.Publisher("/perf_latency/cmd_vel", Twist, queue_size=1, tcp_nodelay=True)
         wait_for(lambda: pub.get_num_connections() > 0 and sub.get_num_connections() > 0)
         cmd = Twist()
         for k in range(samples + 20):
-            # Distinct forward speeds (1 mm/s apart, the wire's resolution), 200..399 mm/s.
-            value = 200 + (k % 200)
+            value = 200 + k % 200  # distinct speeds, 1 mm/s apart (the wire's resolution)
             cmd.linear.x = value / 1000.0
             with lock:
-                sent[value] = time.time()  # each value recurs only after 10 s
+                sent[value] = time.time()
             pub.publish(cmd)
-            # 50-70 ms apart, at random: every phase against the node's 20 ms keep-alive occurs.
             time.sleep(random.uniform(0.05, 0.07))
         time.sleep(0.5)
         sub.unregister()
-        data = latencies[20:] if len(latencies) > 40 else latencies  # skip the warm-up
-        if not data:
-            sys.exit("no cmd_vel_out matched: is publish_cmd working?")
-        ms = [1000.0 * v for v in data]
-        return {
-            "samples": len(ms),
-            "p50_ms": round(percentile(ms, 50), 3),
-            "p90_ms": round(percentile(ms, 90), 3),
-            "p99_ms": round(percentile(ms, 99), 3),
-            "max_ms": round(max(ms), 3),
-        }
-    finally:
-        stop_node(node)
-
-
-def machine():
-    model = "unknown"
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                if line.startswith("model name"):
-                    model = line.split(":", 1)[1].strip()
-                    break
-    except OSError:
-        pass
-    return {"cpu": model, "cores": os.cpu_count(), "kernel": platform.release(),
-            "date": time.strftime("%Y-%m-%d %H:%M:%S %Z")}
+    ms = latencies[20:] if len(latencies) > 40 else latencies  # skip the warm-up
+    if not ms:
+        sys.exit("no cmd_vel_out matched: is publish_cmd working?")
+    return {"samples": len(ms), "max_ms": round(max(ms), 3),
+            **{f"p{p}_ms": round(percentile(ms, p), 3) for p in (50, 90, 99)}}
 
 
 def main():
@@ -261,23 +241,36 @@ def main():
     parser.add_argument("--json", help="also write the figures to this file")
     parser.add_argument("--node-arg", action="append", default=[],
                         help="extra node argument (both phases), e.g. _min_command_interval:=0.001")
-    parser.add_argument("--skip-latency", action="store_true")
     args = parser.parse_args()
 
-    env = Environment()
+    # A private rosmaster with a throwaway ROS_HOME.
+    home = tempfile.mkdtemp(prefix="ranger-perf-roshome-")
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    os.environ.update(ROS_MASTER_URI=f"http://localhost:{port}", ROS_HOME=home,
+                      ROS_LOG_DIR=os.path.join(home, "log"), ROS_HOSTNAME="localhost")
+    master = subprocess.Popen(["rosmaster", "--core", "-p", str(port)],
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
         import rospy
         wait_for(lambda: subprocess.run(["rosnode", "list"], capture_output=True).returncode == 0)
         rospy.init_node("ranger_perf", anonymous=True, disable_signals=True)
-        figures = {"machine": machine(),
+        with open("/proc/cpuinfo") as f:
+            cpu = next((line.split(":", 1)[1].strip() for line in f
+                        if line.startswith("model name")), "unknown")
+        figures = {"machine": {"cpu": cpu, "cores": os.cpu_count(), "kernel": platform.release()},
+                   "date": time.strftime("%Y-%m-%d %H:%M:%S %Z"),
                    "command": " ".join([os.path.relpath(sys.argv[0])] + sys.argv[1:]),
-                   "mode": "port_name:=sim (in-process virtual chassis, loopback bus)",
-                   "load": measure_load(rospy, args.duration, args.node_arg)}
-        if not args.skip_latency:
-            figures["latency_cmd_vel_to_0x111"] = measure_latency(rospy, args.samples,
-                                                                  args.node_arg)
+                   "load": measure_load(rospy, args.duration, args.node_arg),
+                   "latency_cmd_vel_to_0x111": measure_latency(rospy, args.samples, args.node_arg)}
     finally:
-        env.close()
+        master.send_signal(signal.SIGINT)
+        try:
+            master.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            master.kill()
+        shutil.rmtree(home, ignore_errors=True)
 
     print(json.dumps(figures, indent=2))
     if args.json:

@@ -1,0 +1,149 @@
+#!/usr/bin/python3
+"""Usage: scripts/perf_table.py RAW. Prints the tables of docs/PERFORMANCE.md (scripts/perf.sh
+writes the header) from RAW = build/perf/raw (NAME.cmd: a step's command, NAME.out: its output);
+every row names its target, where one exists, and the command that produced it."""
+
+import json
+import os
+import re
+import statistics
+import sys
+
+raw, out = sys.argv[1], []
+
+
+def read(name):
+    path = os.path.join(raw, name)
+    return open(path).read().strip() if os.path.exists(path) else ""
+
+
+def medians(step):
+    """run name -> Google Benchmark's median aggregate, with 'ns': the CPU time in ns."""
+    runs = {b["run_name"]: dict(b, ns=b["cpu_time"] * {"ns": 1, "us": 1e3}[b["time_unit"]])
+            for b in json.loads(read(f"{step}.out"))["benchmarks"]
+            if b.get("aggregate_name") == "median"}
+    if not runs:
+        raise ValueError(f"no medians in {step}.out")
+    return runs
+
+
+def row(figure, value, step, target="", met=None):
+    goal = f"{target}: {'met' if met else '**missed**'}" if target else ""
+    cmd = read(step + ".cmd")
+    out.append(f"| {figure} | {value} | {goal} | {f'`{cmd}`' if cmd else 'not run'} |")
+
+
+def section(*steps):
+    """A table: title and text from the first step's docstring; a step that did not run or
+    printed nothing usable gets a row saying so."""
+    title, text = steps[0].__doc__.split("\n", 1)
+    out.extend(["", f"## {title}", "", " ".join(text.split()), "",
+                "| Figure | Value | Target | Command |", "|---|---|---|---|"])
+    for step in steps:
+        try:
+            step()
+        except (ValueError, KeyError, TypeError, AttributeError):
+            name = step.__name__
+            row(f"({name})", "not measured: " + (f"failed, see {raw}/{name}.log"
+                                                 if read(name + ".cmd") else "skipped"), name)
+
+
+def codec():
+    """Codec
+    Google Benchmark, median of 5 repetitions, CPU time; the feedback cycle: the 13 frames sent
+    every 20 ms. Instructions: callgrind, collecting in `ranger::decode` only, 1.3 M frames."""
+    b = medians("codec")
+    cycle = b["BM_DecodeFeedbackCycle"]["ns"]
+    row("Feedback cycle decoded (13 frames)", f"{cycle:.1f} ns", "codec", "< 1 µs", cycle < 1000)
+    for what in ("Decode", "Encode"):
+        ns = [v["ns"] for k, v in b.items() if re.fullmatch(rf"BM_{what}/\d+", k)]
+        row(f"{what}, one frame (median over {len(ns)} IDs)",
+            f"{statistics.median(ns):.1f} ns ({min(ns):.1f} .. {max(ns):.1f})", "codec")
+
+
+def callgrind():
+    text = read("callgrind.out")
+    ir = int(re.search(r"Collected\s*:\s*([\d,]+)", text).group(1).replace(",", ""))
+    cycles, frames = re.search(r"decoded (\d+) cycles x (\d+) frames", text).groups()
+    row("Decode, instructions per frame", f"{ir / int(cycles) / int(frames):.1f}" if ir else
+        "none collected: has `ranger::decode`'s signature changed?", "callgrind")
+
+
+def control():
+    """Control
+    The driver's work per 20 ms cycle. Google Benchmark, median of 5 repetitions, CPU time."""
+    names = {"BM_ControllerFeedbackCycleAndTick": "Controller: feedback cycle + command + tick",
+             "BM_OdometryFeedbackCycle": "Odometry: one cycle", "BM_FitBodyTwist": "Body twist "
+             "fitted to 4 wheels", **{f"BM_SolveKinematics/{i}": f"Kinematics solve, {mode}"
+                                     for i, mode in enumerate(("Ackermann", "oblique", "spin"))}}
+    for name, b in medians("control").items():
+        row(names.get(name, f"`{name}`"), f"{b['ns']:.1f} ns", "control")
+
+
+def bus():
+    """Bus (in-process loopback)
+    Google Benchmark, median of 3 repetitions. Throughput (wall clock): at most 128 frames in
+    flight. Latency (wall clock): send -> receive, one frame in flight."""
+    b = {name.split("/")[0]: v for name, v in medians("bus").items()}
+    row("Send + receive, one thread", f"{b['BM_LoopbackSendThenReceive']['ns']:.1f} ns", "bus")
+    row("Throughput, reader thread",
+        f"{b['BM_LoopbackThroughputWithReaderThread']['frames_per_s']:,.0f} frames/s", "bus")
+    for p in ("p50", "p99"):
+        row(f"Latency {p}", f"{b['BM_LoopbackLatency'][p + '_us']:.1f} µs", "bus")
+
+
+def node():
+    """ROS node
+    ranger_base_node, `port_name:=sim` (the virtual chassis, a thread of the node, sends the full
+    feedback), `odom`, `/tf`, `joint_states` at 50 Hz to subscribers, `cmd_vel` at 20 Hz; CPU in
+    % of one core. Latency: `cmd_vel` published -> the 0x111's send stamp (`cmd_vel_out`); it
+    includes up to `min_command_interval` (5 ms by default, see ranger_base/README.md)."""
+    doc = json.loads(read("node.json"))
+    load, lat = doc["load"], doc["latency_cmd_vel_to_0x111"]
+    cpu = load["driver_cpu_percent"]
+    row("Driver CPU (node minus chassis thread)", "chassis thread not found" if cpu is None else
+        f"{cpu} % of one core", "node", "≤ 1 %", cpu is not None and cpu <= 1.0)
+    row("Virtual chassis thread (name tid)", f"{load['chassis_cpu_percent']} % "
+        f"({load['chassis_thread']})", "node")
+    row("Node process (driver + chassis)", f"{load['node_cpu_percent']} % (feedback "
+        f"{load['feedback_frames_per_s']} frames/s)", "node")
+    row("Per thread, % (name tid)", ", ".join(f"{t['name']} {t['tid']}: {t['cpu_percent']}"
+                                             for t in load["threads"] if t["cpu_percent"]), "node")
+    rss = load["rss_kib_median"] * 1.024e-3
+    row("RSS", f"{rss:.1f} MB (median; max {load['rss_kib_max'] * 1.024e-3:.1f})", "node",
+        "≤ 15 MB", rss <= 15.0)
+    for p, limit in (("p50", 0.5), ("p90", None), ("p99", 2.0)):
+        row(f"cmd_vel -> 0x111 latency {p}", f"{lat[p + '_ms']} ms" + (
+            f" (max {lat['max_ms']}, {lat['samples']} samples)" if p == "p99" else ""), "node",
+            f"≤ {limit:g} ms" if limit else "", limit and lat[p + "_ms"] <= limit)
+    row("Received by the subscribers", ", ".join(
+        f"{t} {r} Hz" for t, r in load["subscribers_messages_per_s"].items()), "node")
+
+
+def odometry():
+    """Odometry error against ground truth
+    The end-to-end suite on the in-process bus, per motion mode (lock-step, simulated clock:
+    deterministic)."""
+    lines = re.findall(r"^\[odometry\] bus=\S+ mode=(\S+) distance=([\d.]+) m turns=([\d.]+) "
+                       r"position_error=([\d.]+) m .*? \(([\d.]+) deg/turn\)",
+                       read("odometry.out"), re.M)
+    if not lines:
+        raise ValueError("no [odometry] lines")
+    for mode, *figures in lines:
+        distance, turns, error, per_turn = map(float, figures)
+        where = f"over {distance:.2f} m, {turns:.2f} turns"
+        if distance > 0.5:
+            pct = 100 * error / distance
+            row(f"{mode.capitalize()}: position error", f"{pct:.3g} % of distance "
+                f"({1000 * error:.1f} mm {where})", "odometry", "≤ 1 %", pct <= 1.0)
+        if turns > 0.1:
+            row(f"{mode.capitalize()}: heading error", f"{per_turn:.4f} deg/turn ({where})",
+                "odometry", "≤ 1 deg/turn", per_turn <= 1.0)
+
+
+section(codec, callgrind)
+section(control)
+section(bus)
+section(node)
+section(odometry)
+print("\n".join(out))
