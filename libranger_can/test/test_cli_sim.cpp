@@ -16,7 +16,7 @@
 #include "cli_bus.hpp"
 #include "cli_commands.hpp"
 #include "cli_monitor_view.hpp"
-#include "cli_sim_control.hpp"
+#include "ranger_can/sim/chassis_commands.hpp"
 #include "ranger_can/wire/codec.hpp"
 #include "ranger_can/wire/interpretation.hpp"
 #include "ranger_can/transport/loopback_bus.hpp"
@@ -146,7 +146,7 @@ TEST(CliSimControl, EveryCommandReachesTheChassis) {
   test::FakeBus bus;
   sim::VirtualChassis chassis(bus, {}, Timestamp{0});
   auto apply = [&](const std::string& line) {
-    auto r = apply_sim_command(line, chassis);
+    auto r = sim::apply_chassis_command(line, chassis);
     EXPECT_TRUE(r.ok()) << line << ": " << (r ? "" : r.error().message);
     return r.ok() ? *r : std::string();
   };
@@ -208,7 +208,7 @@ TEST(CliSimControl, BadCommandsAreReportedNotApplied) {
   for (const char* line : {"fly", "estop maybe", "error 32", "error bogus", "battery 101",
                            "battery x", "silent -1", "garbage 0", "ultrasonic 9 100",
                            "ultrasonic 1 -5", "pose 1 2", "clear 17", "remote sideways"}) {
-    auto r = apply_sim_command(line, chassis);
+    auto r = sim::apply_chassis_command(line, chassis);
     EXPECT_FALSE(r.ok()) << line;
   }
   EXPECT_EQ(chassis.snapshot().error_bits, 0u);

@@ -7,7 +7,7 @@
 #include <ostream>
 #include <stdexcept>
 
-#include "cli_args.hpp"
+#include "ranger_can/parse.hpp"
 
 namespace ranger::cli {
 

@@ -9,7 +9,7 @@
 #include <optional>
 #include <string>
 
-#include "cli_args.hpp"
+#include "ranger_can/parse.hpp"
 #include "cli_bus.hpp"
 #include "cli_commands.hpp"
 #include "cli_monitor_view.hpp"

@@ -6,7 +6,7 @@
 #include <ostream>
 #include <string>
 
-#include "cli_args.hpp"
+#include "ranger_can/parse.hpp"
 #include "cli_commands.hpp"
 #include "cli_input.hpp"
 #include "cli_json.hpp"

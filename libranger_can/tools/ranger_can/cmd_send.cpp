@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "cli_args.hpp"
+#include "ranger_can/parse.hpp"
 #include "cli_bus.hpp"
 #include "cli_commands.hpp"
 #include "cli_frame_format.hpp"

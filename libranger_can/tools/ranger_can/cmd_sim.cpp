@@ -22,14 +22,14 @@
 #include <string>
 #include <vector>
 
-#include "cli_args.hpp"
+#include "ranger_can/parse.hpp"
 #include "cli_bus.hpp"
 #include "cli_commands.hpp"
 #include "cli_input.hpp"
 #include "cli_json.hpp"
 #include "cli_options.hpp"
 #include "cli_signals.hpp"
-#include "cli_sim_control.hpp"
+#include "ranger_can/sim/chassis_commands.hpp"
 #include "ranger_can/clock.hpp"
 #include "ranger_can/sim/virtual_chassis_runner.hpp"
 
@@ -38,6 +38,18 @@ namespace ranger::cli {
 namespace {
 
 using namespace std::chrono_literals;
+using sim::apply_chassis_command;
+using sim::parse_error_bit;
+
+// The chassis commands plus the session's own (`ranger_can sim --help` and `help`).
+const std::string& control_help() {
+  static const std::string text =
+      std::string("control ") + sim::kChassisCommandHelp +
+      "  wait SEC                 hold the following commands for SEC seconds (scripting)\n"
+      "  help                     this list\n"
+      "  quit                     stop the simulator\n";
+  return text;
+}
 
 struct SimOptions {
   std::string iface;
@@ -294,7 +306,7 @@ int sim_main(const ParsedArgs& args, Io io) {
       return;
     }
     if (first == "help") {
-      io.out << kSimControlHelp;
+      io.out << control_help();
       io.out.flush();
       return;
     }
@@ -311,7 +323,7 @@ int sim_main(const ParsedArgs& args, Io io) {
       return;
     }
     auto r =
-        runner.with_chassis([&](sim::VirtualChassis& c) { return apply_sim_command(line, c); });
+        runner.with_chassis([&](sim::VirtualChassis& c) { return apply_chassis_command(line, c); });
     if (!r) {
       control_error(r.error().message);
     } else if (!r->empty()) {
@@ -473,7 +485,7 @@ const CommandSpec& sim_command() {
           option("--duration", "SEC", "stop after SEC seconds", number_in(0.0, 1e7)),
           flag("--quiet", "do not print state changes"),
       },
-      kSimControlHelp,
+      control_help(),
       sim_main,
   };
   return spec;

@@ -1,11 +1,11 @@
-#include "cli_args.hpp"
+#include "ranger_can/parse.hpp"
 
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 
-namespace ranger::cli {
+namespace ranger {
 
 std::string number_text(double v) {
   char buf[32];
@@ -54,4 +54,4 @@ Result<std::int64_t> parse_integer(std::string_view what, const std::string& tex
   return static_cast<std::int64_t>(v);
 }
 
-}  // namespace ranger::cli
+}  // namespace ranger

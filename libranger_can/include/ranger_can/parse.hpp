@@ -1,5 +1,6 @@
-// Strict parsing of command-line values: the whole text must be the number, it must be finite,
-// and the error names the option and the offending text ("--soc: 'abc' is not a number").
+// Strict parsing of numbers typed by people (command-line options, simulator control lines,
+// scenario scripts): the whole text must be the number, it must be finite, and the error names
+// what was being read and the offending text ("--soc: 'abc' is not a number").
 #pragma once
 
 #include <cstdint>
@@ -8,7 +9,7 @@
 
 #include "ranger_can/result.hpp"
 
-namespace ranger::cli {
+namespace ranger {
 
 Result<double> parse_double(std::string_view what, const std::string& text);
 // Like parse_double, and inside [min, max].
@@ -21,4 +22,4 @@ Result<std::int64_t> parse_integer(std::string_view what, const std::string& tex
 // A number as help texts show defaults and ranges: "%g" ("0.89", "90", "1e-05").
 std::string number_text(double v);
 
-}  // namespace ranger::cli
+}  // namespace ranger

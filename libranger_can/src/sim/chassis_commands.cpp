@@ -1,4 +1,4 @@
-#include "cli_sim_control.hpp"
+#include "ranger_can/sim/chassis_commands.hpp"
 
 #include <cctype>
 #include <cmath>
@@ -6,13 +6,13 @@
 #include <sstream>
 #include <vector>
 
-#include "cli_args.hpp"
+#include "ranger_can/parse.hpp"
 #include "ranger_can/wire/protocol.hpp"
 
-namespace ranger::cli {
+namespace ranger::sim {
 
-const char* const kSimControlHelp =
-    "control commands (one per line):\n"
+const char* const kChassisCommandHelp =
+    "commands (one per line):\n"
     "  remote on|can|off|lost   the remote control takes over | hands back to CAN command mode |\n"
     "                           is switched off (standby) | loses its signal (standby + error)\n"
     "  estop on|off             press / release the emergency stop\n"
@@ -26,10 +26,7 @@ const char* const kSimControlHelp =
     "  ultrasonic N|all MM      distance of sensor N (1-8) or all sensors, mm (-1..-4: codes)\n"
     "  ultrasonic on|off        obstacle avoidance, as the remote's SWC switch sets it\n"
     "  pose X Y YAW             move the ground truth (m, m, rad)\n"
-    "  status                   print the chassis state\n"
-    "  wait SEC                 hold the following commands for SEC seconds (scripting)\n"
-    "  help                     this list\n"
-    "  quit                     stop the simulator\n";
+    "  status                   print the chassis state\n";
 
 namespace {
 
@@ -99,36 +96,35 @@ std::string describe_chassis(const sim::ChassisSnapshot& s) {
   return out;
 }
 
-Result<std::string> apply_sim_command(std::string_view line, sim::VirtualChassis& chassis) {
+Result<ChassisAction> parse_chassis_command(std::string_view line) {
   const auto w = split(line);
-  if (w.empty() || w[0][0] == '#') return std::string();
+  if (w.empty() || w[0][0] == '#') return ChassisAction([](VirtualChassis&) { return std::string(); });
   const std::string& cmd = w[0];
   auto need = [&](std::size_t n, const char* form) -> Status {
     if (w.size() != n) return usage("usage: " + std::string(form));
     return ok_status();
   };
+  // Wraps a chassis call that prints nothing.
+  auto act = [](std::function<void(VirtualChassis&)> f) {
+    return ChassisAction([f = std::move(f)](VirtualChassis& c) {
+      f(c);
+      return std::string();
+    });
+  };
 
   if (cmd == "remote") {
     if (auto s = need(2, "remote on|can|off|lost"); !s) return s.error();
-    if (w[1] == "on") {
-      chassis.remote_takeover();
-    } else if (w[1] == "can") {
-      chassis.remote_hand_back(false);
-    } else if (w[1] == "off") {
-      chassis.remote_hand_back(true);
-    } else if (w[1] == "lost") {
-      chassis.remote_signal_lost();
-    } else {
-      return usage("remote: expected on|can|off|lost, got '" + w[1] + "'");
-    }
-    return std::string();
+    if (w[1] == "on") return act([](VirtualChassis& c) { c.remote_takeover(); });
+    if (w[1] == "can") return act([](VirtualChassis& c) { c.remote_hand_back(false); });
+    if (w[1] == "off") return act([](VirtualChassis& c) { c.remote_hand_back(true); });
+    if (w[1] == "lost") return act([](VirtualChassis& c) { c.remote_signal_lost(); });
+    return usage("remote: expected on|can|off|lost, got '" + w[1] + "'");
   }
   if (cmd == "estop") {
     if (auto s = need(2, "estop on|off"); !s) return s.error();
     auto on = parse_on_off(cmd, w[1]);
     if (!on) return on.error();
-    chassis.set_emergency_stop(*on);
-    return std::string();
+    return act([on = *on](VirtualChassis& c) { c.set_emergency_stop(on); });
   }
   if (cmd == "error") {
     if (w.size() != 2 && w.size() != 3) return usage("usage: error BIT|NAME [on|off]");
@@ -140,8 +136,7 @@ Result<std::string> apply_sim_command(std::string_view line, sim::VirtualChassis
       if (!v) return v.error();
       on = *v;
     }
-    chassis.set_error_bit(*bit, on);
-    return std::string();
+    return act([bit = *bit, on](VirtualChassis& c) { c.set_error_bit(bit, on); });
   }
   if (cmd == "clear") {
     if (w.size() > 2) return usage("usage: clear [CODE]");
@@ -151,62 +146,54 @@ Result<std::string> apply_sim_command(std::string_view line, sim::VirtualChassis
       if (!c) return c.error();
       code = *c;
     }
-    chassis.clear_errors(static_cast<std::uint8_t>(code));
-    return std::string();
+    return act([code](VirtualChassis& c) { c.clear_errors(static_cast<std::uint8_t>(code)); });
   }
   if (cmd == "battery") {
     if (auto s = need(2, "battery PCT"); !s) return s.error();
     auto pct = parse_double_in("battery PCT", w[1], 0.0, 100.0);
     if (!pct) return pct.error();
-    chassis.set_battery_soc(*pct);
-    return std::string();
+    return act([pct = *pct](VirtualChassis& c) { c.set_battery_soc(pct); });
   }
   if (cmd == "silent") {
     if (auto s = need(2, "silent SEC|on|off"); !s) return s.error();
     if (w[1] == "on" || w[1] == "off") {
-      chassis.set_silent(w[1] == "on");
-    } else {
-      auto sec = parse_double_in("silent SEC", w[1], 0.0, 86400.0);
-      if (!sec) return sec.error();
-      chassis.silence_for(std::chrono::duration_cast<std::chrono::nanoseconds>(
-          std::chrono::duration<double>(*sec)));
+      return act([on = w[1] == "on"](VirtualChassis& c) { c.set_silent(on); });
     }
-    return std::string();
+    auto sec = parse_double_in("silent SEC", w[1], 0.0, 86400.0);
+    if (!sec) return sec.error();
+    return act([d = from_seconds(*sec)](VirtualChassis& c) { c.silence_for(d); });
   }
   if (cmd == "garbage") {
     if (auto s = need(2, "garbage N"); !s) return s.error();
     auto n = parse_integer("garbage N", w[1], 1, 100000);
     if (!n) return n.error();
-    chassis.inject_garbage(static_cast<int>(*n));
-    return std::string();
+    return act([n = static_cast<int>(*n)](VirtualChassis& c) { c.inject_garbage(n); });
   }
   if (cmd == "stuck") {
     if (auto s = need(2, "stuck on|off"); !s) return s.error();
     auto on = parse_on_off(cmd, w[1]);
     if (!on) return on.error();
-    chassis.set_mode_switch_stuck(*on);
-    return std::string();
+    return act([on = *on](VirtualChassis& c) { c.set_mode_switch_stuck(on); });
   }
   if (cmd == "ultrasonic") {
     if (w.size() == 2) {
       auto on = parse_on_off(cmd, w[1]);
       if (!on) return on.error();
-      chassis.set_ultrasonic_enabled(*on);
-      return std::string();
+      return act([on = *on](VirtualChassis& c) { c.set_ultrasonic_enabled(on); });
     }
     if (w.size() != 3) return usage("usage: ultrasonic N|all MM  or  ultrasonic on|off");
     auto mm = parse_integer("ultrasonic MM", w[2], -4, 32767);
     if (!mm) return mm.error();
+    const auto raw = static_cast<std::int16_t>(*mm);
     if (w[1] == "all") {
-      for (int n = 1; n <= protocol::kUltrasonicCount; ++n) {
-        chassis.set_ultrasonic(n, static_cast<std::int16_t>(*mm));
-      }
-    } else {
-      auto n = parse_integer("ultrasonic N", w[1], 1, protocol::kUltrasonicCount);
-      if (!n) return n.error();
-      chassis.set_ultrasonic(static_cast<int>(*n), static_cast<std::int16_t>(*mm));
+      return act([raw](VirtualChassis& c) {
+        for (int n = 1; n <= protocol::kUltrasonicCount; ++n)
+          c.set_ultrasonic(n, raw);
+      });
     }
-    return std::string();
+    auto n = parse_integer("ultrasonic N", w[1], 1, protocol::kUltrasonicCount);
+    if (!n) return n.error();
+    return act([n = static_cast<int>(*n), raw](VirtualChassis& c) { c.set_ultrasonic(n, raw); });
   }
   if (cmd == "pose") {
     if (auto s = need(4, "pose X Y YAW"); !s) return s.error();
@@ -216,11 +203,29 @@ Result<std::string> apply_sim_command(std::string_view line, sim::VirtualChassis
     if (!y) return y.error();
     auto yaw = parse_double("pose YAW", w[3]);
     if (!yaw) return yaw.error();
-    chassis.set_pose(Pose2D{*x, *y, wrap_angle(*yaw)});
-    return std::string();
+    return act([p = Pose2D{*x, *y, wrap_angle(*yaw)}](VirtualChassis& c) { c.set_pose(p); });
   }
-  if (cmd == "status") return describe_chassis(chassis.snapshot());
-  return usage("unknown command '" + cmd + "' (try 'help')");
+  if (cmd == "status") {
+    if (auto s = need(1, "status"); !s) return s.error();
+    return ChassisAction([](VirtualChassis& c) { return describe_chassis(c.snapshot()); });
+  }
+  std::string names;
+  for (const auto& n : chassis_command_names())
+    names += (names.empty() ? "" : ", ") + n;
+  return usage("unknown command '" + cmd + "' (valid: " + names + ")");
 }
 
-}  // namespace ranger::cli
+Result<std::string> apply_chassis_command(std::string_view line, VirtualChassis& chassis) {
+  auto action = parse_chassis_command(line);
+  if (!action) return action.error();
+  return (*action)(chassis);
+}
+
+const std::vector<std::string>& chassis_command_names() {
+  static const std::vector<std::string> names = {"remote",  "estop", "error",      "clear",
+                                                 "battery", "silent", "garbage", "stuck",
+                                                 "ultrasonic", "pose", "status"};
+  return names;
+}
+
+}  // namespace ranger::sim

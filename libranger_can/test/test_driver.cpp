@@ -1,0 +1,340 @@
+// The driver runtime in lock-step with the virtual chassis (sim::SimBusSource, lock_step) under a
+// ManualClock: the mailbox, the snapshot, the sent-frame events (the shutdown stop included),
+// request outcomes, "motion known" only while the chassis is heard, and the bus sources
+// (replay:FILE, a missing interface). No threads of the driver's, no sleeping.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "ranger_can/control/driver.hpp"
+#include "ranger_can/sim/sim_bus_source.hpp"
+#include "ranger_can/wire/candump_log.hpp"
+
+namespace ranger {
+namespace {
+
+using namespace std::chrono_literals;
+
+class DriverRig {
+ public:
+  explicit DriverRig(DriverConfig config = {}) {
+    sim::SimSourceOptions options;
+    options.lock_step = true;
+    auto source = sim::open_bus_source("sim", clock_, options);
+    EXPECT_TRUE(source.ok());
+    sim_ = std::static_pointer_cast<sim::SimBusSource>(*source);
+    driver_ = std::make_unique<Driver>(config, *source, clock_);
+    driver_->set_sent_observer([this](const SentEvent& e) { sent_.push_back(e); });
+  }
+  ~DriverRig() { driver_.reset(); }
+
+  void step() {
+    clock_.advance(1ms);
+    sim_->step(clock_.now());
+    driver_->step(clock_.now());
+  }
+  void run_for(std::chrono::nanoseconds d) {
+    const Timestamp end = clock_.now() + d;
+    while (clock_.now() < end)
+      step();
+  }
+  bool run_until(const std::function<bool()>& done, std::chrono::nanoseconds timeout) {
+    const Timestamp end = clock_.now() + timeout;
+    while (!done()) {
+      if (clock_.now() >= end) return false;
+      step();
+    }
+    return true;
+  }
+  // The caller keeps publishing `twist` every 50 ms for `d`.
+  void drive(const BodyTwist& twist, std::chrono::nanoseconds d) {
+    const Timestamp end = clock_.now() + d;
+    while (clock_.now() < end) {
+      EXPECT_TRUE(driver_->command(MotionRequest{twist, std::nullopt}).ok());
+      run_for(50ms);
+    }
+  }
+
+  Driver& driver() { return *driver_; }
+  std::shared_ptr<const DriverSnapshot> snapshot() const { return driver_->snapshot(); }
+  sim::SimBusSource& sim() { return *sim_; }
+  const std::vector<SentEvent>& sent() const { return sent_; }
+  ManualClock& clock() { return clock_; }
+
+ private:
+  ManualClock clock_{Timestamp(1000s)};
+  std::shared_ptr<sim::SimBusSource> sim_;
+  std::unique_ptr<Driver> driver_;
+  std::vector<SentEvent> sent_;
+};
+
+bool ready(const DriverSnapshot& s) {
+  return s.controller.control_mode == protocol::ControlMode::kCan && s.controller.motion_mode &&
+         s.controller.refusal == MotionRefusal::kNone;
+}
+
+TEST(Driver, BeforeTheFirstOpenCommandsSayWhy) {
+  ManualClock clock;
+  auto source = open_bus_source("nosuchcan0", clock);
+  ASSERT_TRUE(source.ok());
+  Driver driver(DriverConfig{}, std::move(*source), clock);
+  driver.step(clock.now());
+  const Status st = driver.command(MotionRequest{BodyTwist{0.2, 0, 0}, std::nullopt});
+  ASSERT_FALSE(st.ok());
+  EXPECT_EQ(st.error().code, Errc::kInterfaceDown);
+  EXPECT_NE(st.error().message.find("nosuchcan0"), std::string::npos) << st.error().message;
+  const auto s = driver.snapshot();
+  EXPECT_FALSE(s->bus_open);
+  EXPECT_NE(s->bus_error.find("nosuchcan0"), std::string::npos) << s->bus_error;
+  EXPECT_FALSE(s->motion_known);
+  // Retried every reconnect_interval, not at every step.
+  EXPECT_EQ(driver.next_due(), clock.now() + DriverConfig{}.reconnect_interval);
+}
+
+TEST(Driver, ConnectsDrivesAndPublishesWhatItKnows) {
+  DriverRig rig;
+  rig.step();
+  EXPECT_FALSE(rig.snapshot()->motion_known) << "nothing heard yet: no odometry to publish";
+  ASSERT_TRUE(rig.run_until([&] { return ready(*rig.snapshot()); }, 2s));
+  EXPECT_TRUE(rig.snapshot()->motion_known);
+  rig.drive({0.5, 0, 0}, 2s);
+  const auto s = rig.snapshot();
+  EXPECT_GT(s->odometry.pose.x, 0.3);
+  EXPECT_NEAR(s->odometry.pose.x, rig.sim().snapshot().pose.x, 0.02);
+  EXPECT_GT(s->joints.wheel_velocity[0], 0.0);
+  EXPECT_GT(s->frames.rate(protocol::kSystemStatusId, s->now), 40.0);
+  EXPECT_GT(s->sequence, 100u);
+  // Odometry is stamped with the frames' time (the bus clock), not the time of publication.
+  EXPECT_LE(s->odometry.stamp, s->now);
+  EXPECT_GT(s->odometry.stamp, s->now - 40ms);
+}
+
+TEST(Driver, ACommandGoesOutAtTheNextStepAndEverySendIsAnEvent) {
+  DriverRig rig;
+  ASSERT_TRUE(rig.run_until([&] { return ready(*rig.snapshot()); }, 2s));
+  const std::size_t before = rig.sent().size();
+  ASSERT_TRUE(rig.driver().command(MotionRequest{BodyTwist{0.4, 0, 0}, std::nullopt}).ok());
+  rig.step();
+  ASSERT_GT(rig.sent().size(), before);
+  const SentEvent& e = rig.sent().back();
+  EXPECT_EQ(e.sent.frame.id, protocol::kMotionCommandId);
+  EXPECT_NEAR(e.sent.achieved.vx, 0.4, 1e-9);
+  EXPECT_FALSE(e.sent.shutdown);
+}
+
+TEST(Driver, StopSendsAZeroThatTheObserverSees) {
+  DriverRig rig;
+  ASSERT_TRUE(rig.run_until([&] { return ready(*rig.snapshot()); }, 2s));
+  rig.drive({0.6, 0, 0}, 500ms);
+  rig.driver().stop();
+  ASSERT_FALSE(rig.sent().empty());
+  const SentEvent& last = rig.sent().back();
+  EXPECT_TRUE(last.sent.shutdown);
+  EXPECT_EQ(last.sent.frame.id, protocol::kMotionCommandId);
+  const auto m = decode(last.sent.frame);
+  ASSERT_TRUE(m.ok());
+  EXPECT_EQ(std::get<MotionCommand>(*m).linear_speed, 0.0);
+  EXPECT_EQ(last.sent.achieved.vx, 0.0);
+  EXPECT_TRUE(rig.snapshot()->controller.shut_down);
+  const std::size_t n = rig.sent().size();
+  rig.driver().stop();  // idempotent
+  EXPECT_EQ(rig.sent().size(), n);
+}
+
+TEST(Driver, NonFiniteCommandsAreRefusedAndStop) {
+  DriverRig rig;
+  ASSERT_TRUE(rig.run_until([&] { return ready(*rig.snapshot()); }, 2s));
+  rig.drive({0.6, 0, 0}, 500ms);
+  const Status st = rig.driver().command(MotionRequest{BodyTwist{NAN, 0, 0}, std::nullopt});
+  EXPECT_EQ(st.error().code, Errc::kNotFinite);
+  rig.step();
+  const auto m = decode(rig.sent().back().sent.frame);
+  ASSERT_TRUE(m.ok());
+  EXPECT_EQ(std::get<MotionCommand>(*m).linear_speed, 0.0);
+}
+
+TEST(Driver, ClearErrorsAnswersWithTheChassisErrorWordAfterItAnswered) {
+  DriverRig rig;
+  ASSERT_TRUE(rig.run_until([&] { return ready(*rig.snapshot()); }, 2s));
+  rig.sim().with_chassis([](sim::VirtualChassis& c) {
+    c.set_error_bit(protocol::error_bit_index(6, 7), true);  // over-current
+    return 0;
+  });
+  rig.run_for(100ms);
+  ASSERT_NE(rig.snapshot()->controller.error_bits, 0u);
+  EXPECT_FALSE(rig.driver().clear_errors(0x11).ok()) << "not a code";
+  auto id = rig.driver().clear_errors(0x0F);
+  ASSERT_TRUE(id.ok());
+  rig.step();
+  const RequestOutcome* r = rig.snapshot()->request(*id);
+  ASSERT_NE(r, nullptr);
+  EXPECT_EQ(r->state, RequestOutcome::State::kSent) << "the old 0x211 is no answer";
+  ASSERT_TRUE(rig.run_until(
+      [&] {
+        const RequestOutcome* o = rig.snapshot()->request(*id);
+        return o && o->state == RequestOutcome::State::kAnswered;
+      },
+      200ms));
+  r = rig.snapshot()->request(*id);
+  ASSERT_TRUE(r->error_word.has_value());
+  EXPECT_EQ(*r->error_word, 0u) << "the chassis cleared it";
+}
+
+TEST(Driver, ClearErrorsWithoutAnAnswerFailsAfterTheTimeout) {
+  DriverRig rig;
+  ASSERT_TRUE(rig.run_until([&] { return ready(*rig.snapshot()); }, 2s));
+  rig.sim().with_chassis([](sim::VirtualChassis& c) {
+    c.set_silent(true);
+    return 0;
+  });
+  auto id = rig.driver().clear_errors(0x00);
+  ASSERT_TRUE(id.ok());
+  rig.run_for(600ms);
+  const RequestOutcome* r = rig.snapshot()->request(*id);
+  ASSERT_NE(r, nullptr);
+  EXPECT_EQ(r->state, RequestOutcome::State::kFailed);
+  EXPECT_NE(r->message.find("did not answer"), std::string::npos) << r->message;
+}
+
+TEST(Driver, ResumeIsRefusedWhileTheEstopIsPressedAndRearmsAfter) {
+  DriverRig rig;
+  ASSERT_TRUE(rig.run_until([&] { return ready(*rig.snapshot()); }, 2s));
+  rig.drive({0.5, 0, 0}, 500ms);
+  rig.sim().with_chassis([](sim::VirtualChassis& c) {
+    c.set_emergency_stop(true);
+    return 0;
+  });
+  rig.drive({0.5, 0, 0}, 200ms);
+  EXPECT_EQ(rig.snapshot()->controller.refusal, MotionRefusal::kEstop);
+  const std::size_t sent_before = rig.sent().size();
+  const auto refused = rig.driver().resume();
+  rig.step();
+  const RequestOutcome* r = rig.snapshot()->request(refused);
+  ASSERT_NE(r, nullptr);
+  EXPECT_EQ(r->state, RequestOutcome::State::kFailed);
+  EXPECT_NE(r->message.find("emergency_stop"), std::string::npos) << r->message;
+  for (std::size_t i = sent_before; i < rig.sent().size(); ++i)
+    EXPECT_EQ(rig.sent()[i].sent.frame.id, protocol::kMotionCommandId) << "resume sent something";
+
+  rig.sim().with_chassis([](sim::VirtualChassis& c) {
+    c.set_emergency_stop(false);
+    return 0;
+  });
+  rig.drive({0.5, 0, 0}, 500ms);
+  EXPECT_EQ(rig.snapshot()->controller.refusal, MotionRefusal::kRearmRequired);
+  EXPECT_EQ(rig.sim().snapshot().speed, 0.0);
+  const auto ok = rig.driver().resume();
+  rig.step();
+  EXPECT_EQ(rig.snapshot()->request(ok)->state, RequestOutcome::State::kAnswered);
+  rig.drive({0.5, 0, 0}, 1s);
+  EXPECT_GT(rig.sim().snapshot().speed, 0.4);
+}
+
+TEST(Driver, AZeroTwistInTheSameBatchAsAMovingOneStillRearms) {
+  DriverRig rig;
+  ASSERT_TRUE(rig.run_until([&] { return ready(*rig.snapshot()); }, 2s));
+  rig.sim().with_chassis([](sim::VirtualChassis& c) {
+    c.set_emergency_stop(true);
+    return 0;
+  });
+  rig.run_for(100ms);
+  rig.sim().with_chassis([](sim::VirtualChassis& c) {
+    c.set_emergency_stop(false);
+    return 0;
+  });
+  rig.run_for(100ms);
+  ASSERT_EQ(rig.snapshot()->controller.refusal, MotionRefusal::kRearmRequired);
+  // Two commands before the driver looks: the zero must not be lost behind the moving one.
+  ASSERT_TRUE(rig.driver().command(MotionRequest{}).ok());
+  ASSERT_TRUE(rig.driver().command(MotionRequest{BodyTwist{0.3, 0, 0}, std::nullopt}).ok());
+  rig.step();
+  EXPECT_EQ(rig.snapshot()->controller.refusal, MotionRefusal::kNone);
+}
+
+TEST(Driver, LinkLossHidesTheMotionAndTheReturnResumesFromTheLastPose) {
+  DriverRig rig;
+  ASSERT_TRUE(rig.run_until([&] { return ready(*rig.snapshot()); }, 2s));
+  rig.drive({0.5, 0, 0}, 1s);
+  rig.drive({}, 1s);
+  const double x = rig.snapshot()->odometry.pose.x;
+  rig.sim().with_chassis([](sim::VirtualChassis& c) {
+    c.silence_for(1s);
+    return 0;
+  });
+  ASSERT_TRUE(rig.run_until([&] { return !rig.snapshot()->motion_known; }, 200ms));
+  ASSERT_TRUE(rig.run_until([&] { return rig.snapshot()->motion_known; }, 2s));
+  EXPECT_NEAR(rig.snapshot()->odometry.pose.x, x, 1e-3);
+}
+
+TEST(Driver, AReplayedLogRunsThroughTheDriverAndNothingIsSent) {
+  // A short log: the chassis in CAN mode, Ackermann, driving straight at 0.5 m/s for 1 s.
+  const std::string path = ::testing::TempDir() + "driver_replay.log";
+  {
+    std::ofstream log(path);
+    for (int i = 0; i <= 50; ++i) {
+      const Timestamp t = Timestamp(1700000000s) + i * 20ms;
+      SystemStatus st;
+      st.control_mode_raw = 1;
+      st.control_mode = protocol::ControlMode::kCan;
+      st.battery_voltage = 48.0;
+      WheelSpeedsFeedback ws;
+      ws.speeds = {0.5, 0.5, 0.5, 0.5};
+      SteeringAnglesFeedback sa;
+      MotionModeFeedback mm;
+      for (const Message& m : {Message{st}, Message{ws}, Message{sa}, Message{mm}}) {
+        auto f = encode(m);
+        ASSERT_TRUE(f.ok());
+        f->stamp = t;
+        log << format_candump_line(*f, "can0") << "\n";
+      }
+    }
+  }
+  ManualClock clock(Timestamp(5s));
+  auto source = open_bus_source("replay:" + path, clock);
+  ASSERT_TRUE(source.ok()) << source.error().message;
+  EXPECT_TRUE((*source)->read_only());
+  Driver driver(DriverConfig{}, std::move(*source), clock);
+  std::vector<SentEvent> sent;
+  driver.set_sent_observer([&](const SentEvent& e) { sent.push_back(e); });
+  for (int i = 0; i < 1500; ++i) {
+    clock.advance(1ms);
+    driver.step(clock.now());
+  }
+  EXPECT_TRUE(driver.command(MotionRequest{BodyTwist{0.2, 0, 0}, std::nullopt}).ok());
+  for (int i = 0; i < 100; ++i) {
+    clock.advance(1ms);
+    driver.step(clock.now());
+  }
+  const auto s = driver.snapshot();
+  EXPECT_TRUE(s->read_only);
+  EXPECT_NEAR(s->odometry.pose.x, 0.5, 0.03);
+  EXPECT_TRUE(sent.empty()) << "a replayed log is read-only";
+  std::remove(path.c_str());
+}
+
+TEST(Driver, BusSourceSpecsAreCheckedWithAMessage) {
+  ManualClock clock;
+  EXPECT_FALSE(bus_kind("").ok());
+  EXPECT_FALSE(bus_kind("replay:").ok());
+  EXPECT_EQ(*bus_kind("can0"), BusKind::kSocketCan);
+  EXPECT_EQ(*bus_kind("replay:x.log"), BusKind::kReplay);
+  EXPECT_EQ(*bus_kind("sim:manual"), BusKind::kSim);
+  auto sim = open_bus_source("sim", clock);
+  ASSERT_FALSE(sim.ok());
+  EXPECT_NE(sim.error().message.find("sim::open_bus_source"), std::string::npos);
+  auto variant = sim::open_bus_source("sim:nosuchvariant", clock);
+  ASSERT_FALSE(variant.ok());
+  EXPECT_NE(variant.error().message.find("valid:"), std::string::npos) << variant.error().message;
+  auto missing = open_bus_source("replay:/nonexistent/file.log", clock);
+  ASSERT_TRUE(missing.ok());  // the file is read at open()
+  auto opened = (*missing)->open();
+  ASSERT_FALSE(opened.ok());
+  EXPECT_NE(opened.error().message.find("/nonexistent/file.log"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace ranger
