@@ -21,6 +21,15 @@ TEST(SocketCanOpen, MissingInterfaceIsNamed) {
   EXPECT_EQ(r.error().code, Errc::kNoSuchInterface);
   EXPECT_NE(r.error().message.find("'rcan_nothere0' does not exist"), std::string::npos)
       << r.error().message;
+  // It says what a user can do about it: list the interfaces, or (a kernel without CAN) load
+  // CAN support and bring the interface up. Never a pointer at the project's own test VM.
+  const std::string& m = r.error().message;
+  const bool lists = m.find("`ip link show`") != std::string::npos;
+  const bool loads =
+      m.find("`sudo modprobe can-raw`") != std::string::npos &&
+      m.find("`sudo ip link set rcan_nothere0 up type can bitrate 500000`") != std::string::npos;
+  EXPECT_TRUE(lists || loads) << m;
+  EXPECT_EQ(m.find("tests/vm"), std::string::npos) << m;
 }
 
 TEST(SocketCanOpen, OverlongAndEmptyNamesAreRefused) {

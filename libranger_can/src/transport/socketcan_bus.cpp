@@ -83,9 +83,15 @@ bool kernel_has_can() {
   return s.valid() || (errno != EAFNOSUPPORT && errno != EPROTONOSUPPORT);
 }
 
-const char* kNoCanSupportHint =
-    "this kernel has no CAN support: load it with `modprobe can-raw` (and `modprobe vcan` for a "
-    "virtual bus); where that is impossible run the vcan tests in the VM (tests/vm/run_in_vm.sh)";
+// What a user can do on a kernel without CAN support, for interface `name`.
+std::string no_can_support_hint(const std::string& name) {
+  return "this kernel has no CAN support loaded: load it with `sudo modprobe can-raw` (a "
+         "USB-to-CAN adapter also needs `sudo modprobe gs_usb`), then bring the interface up with "
+         "`sudo ip link set " +
+         name +
+         " up type can bitrate 500000`; without any CAN support only the virtual chassis (`sim`) "
+         "or a recorded log (`replay:FILE`) can be used";
+}
 
 void fill_ifreq(struct ifreq& ifr, const std::string& name) {
   std::memset(&ifr, 0, sizeof ifr);
@@ -182,7 +188,7 @@ Result<UniqueFd> open_can_socket(const std::string& name, const std::vector<std:
     std::string msg = "CAN interface '" + name + "' does not exist";
     if (err != ENODEV && err != ENXIO) msg += " (" + errno_text(err) + ")";
     msg += kernel_has_can() ? "; `ip link show` lists the interfaces"
-                            : std::string("; also, ") + kNoCanSupportHint;
+                            : "; also, " + no_can_support_hint(name);
     return Error{Errc::kNoSuchInterface, msg};
   }
 
@@ -209,7 +215,7 @@ Result<UniqueFd> open_can_socket(const std::string& name, const std::vector<std:
   if (!fd.valid()) {
     const int err = errno;
     if (err == EAFNOSUPPORT || err == EPROTONOSUPPORT) {
-      return Error{Errc::kIoError, "cannot open '" + name + "': " + kNoCanSupportHint};
+      return Error{Errc::kIoError, "cannot open '" + name + "': " + no_can_support_hint(name)};
     }
     return Error{errc_for(err), "cannot open a CAN socket for '" + name + "': " + errno_text(err)};
   }
@@ -221,8 +227,9 @@ Result<UniqueFd> open_can_socket(const std::string& name, const std::vector<std:
   }
   if (!(ifr.ifr_flags & IFF_UP)) {
     return Error{Errc::kInterfaceDown,
-                 "CAN interface '" + name + "' is down: bring it up with `ip link set " + name +
-                     " up` (a real adapter also needs `type can bitrate 500000`)"};
+                 "CAN interface '" + name + "' is down: bring it up with `sudo ip link set " +
+                     name + " up type can bitrate 500000` (a vcan interface: `sudo ip link set " +
+                     name + " up`)"};
   }
 
   if (auto st = apply_filter(fd.get(), filter, name); !st) return st.error();
