@@ -13,6 +13,7 @@ lib_pkgs=(build-essential cmake ninja-build pkg-config git libgtest-dev libbench
 # ROS 1 as Debian 12 / Ubuntu 22.04+ package it (installed under /usr).
 ros_pkgs=(ros-base-dev libroscpp-dev librostest-dev python3-rostest python3-roslaunch
   python3-rosnode python3-rostopic ros-message-generation python3-genmsg libstd-msgs-dev
+  libstd-srvs-dev python3-std-srvs
   libgeometry-msgs-dev libsensor-msgs-dev libnav-msgs-dev libtf2-ros-dev libtf2-geometry-msgs-dev
   libdiagnostic-updater-dev libdiagnostic-aggregator-dev libdiagnostic-aggregator-tools
   ros-robot-state-publisher rviz liburdfdom-tools libeigen3-dev catkin rosbash
@@ -24,7 +25,7 @@ ros_pkgs=(ros-base-dev libroscpp-dev librostest-dev python3-rostest python3-rosl
   python3-diagnostic-msgs python3-tf2-msgs)
 # ROS Noetic from packages.ros.org (Ubuntu 20.04), for users who already have /opt/ros/noetic.
 noetic_pkgs=(ros-noetic-ros-base ros-noetic-rostest ros-noetic-tf2-ros ros-noetic-tf2-geometry-msgs
-  ros-noetic-nav-msgs ros-noetic-sensor-msgs ros-noetic-diagnostic-updater
+  ros-noetic-nav-msgs ros-noetic-sensor-msgs ros-noetic-std-srvs ros-noetic-diagnostic-updater
   ros-noetic-diagnostic-aggregator ros-noetic-robot-state-publisher ros-noetic-rviz
   liburdfdom-tools libeigen3-dev python3-colcon-common-extensions python3-matplotlib)
 test_pkgs=(can-utils iproute2 kmod qemu-system-x86 linux-image-amd64 busybox-static cpio gzip

@@ -9,7 +9,6 @@
 #include <limits>
 
 #include <ranger_can/control/geometry.hpp>
-#include <ranger_can/wire/protocol.hpp>
 
 namespace ranger_base {
 namespace {
@@ -35,10 +34,19 @@ geometry_msgs::Quaternion yaw_quaternion(double yaw) {
   return tf2::toMsg(q);
 }
 
+// A BMS report older than this many of its periods counts as absent (an unfitted battery slot).
+constexpr int kStalePeriods = 3;
+
 template <typename T>
 bool fresh(const std::optional<ranger::Stamped<T>>& v, Timestamp now, int period_ms) {
-  return v && now - v->received <= std::chrono::milliseconds(kStalePeriods * period_ms);
+  return ranger::is_fresh(v, now, std::chrono::milliseconds(kStalePeriods * period_ms));
 }
+
+// The decoded ultrasonic value (codec.hpp's UltrasonicFeedback::raw) is in millimetres. The
+// library's control layer has no name for that unit yet: this is the node's one use of it.
+constexpr double kUltrasonicMetresPerUnit = 0.001;
+
+const float kNaN = std::numeric_limits<float>::quiet_NaN();
 
 std::string joint_of_motor(int motor) {
   if (motor >= 1 && motor <= ranger::kWheelCount) {
@@ -53,11 +61,11 @@ std::string joint_of_motor(int motor) {
 
 }  // namespace
 
-ros::Time TimeMapper::to_ros(Timestamp t) const {
-  if (t.count() == 0) return ros::Time();
-  const double offset = std::chrono::duration<double>(link_now_ - t).count();
-  const double seconds = ros_now_.toSec() - offset;
-  return seconds > 0.0 ? ros::Time(seconds) : ros::Time();
+ros::Time to_ros_time(Timestamp bus_stamp) {
+  if (bus_stamp.count() <= 0) return ros::Time();
+  ros::Time t;
+  t.fromNSec(static_cast<std::uint64_t>(bus_stamp.count()));
+  return t;
 }
 
 // ---- cmd_vel ----------------------------------------------------------------------------------
@@ -68,6 +76,11 @@ ranger::BodyTwist to_body_twist(const geometry_msgs::Twist& twist) {
 
 bool has_non_planar_components(const geometry_msgs::Twist& twist) {
   return twist.linear.z != 0.0 || twist.angular.x != 0.0 || twist.angular.y != 0.0;
+}
+
+std::optional<ranger::BodyTwist> achieved_twist(const ranger::SentEvent& event) {
+  if (!std::holds_alternative<ranger::MotionCommand>(event.sent.message)) return std::nullopt;
+  return event.sent.achieved;
 }
 
 geometry_msgs::TwistStamped to_twist_stamped(const ranger::BodyTwist& twist, const ros::Time& stamp,
@@ -83,10 +96,10 @@ geometry_msgs::TwistStamped to_twist_stamped(const ranger::BodyTwist& twist, con
 
 // ---- odometry, TF, joints ---------------------------------------------------------------------
 
-nav_msgs::Odometry to_odometry(const ranger::OdometryState& odometry, const NodeParameters& params,
-                               const ros::Time& stamp) {
+nav_msgs::Odometry to_odometry(const ranger::OdometryState& odometry,
+                               const NodeParameters& params) {
   nav_msgs::Odometry out;
-  out.header.stamp = stamp;
+  out.header.stamp = to_ros_time(odometry.stamp);
   out.header.frame_id = params.odom_frame;
   out.child_frame_id = params.base_frame;
   out.pose.pose.position.x = odometry.pose.x;
@@ -116,7 +129,14 @@ geometry_msgs::TransformStamped to_transform(const nav_msgs::Odometry& odometry)
   return out;
 }
 
-sensor_msgs::JointState to_joint_state(const WheelJoints& joints, const ros::Time& stamp) {
+Timestamp joints_stamp(const ranger::ChassisFeedback& feedback) {
+  Timestamp t{0};
+  if (feedback.steering_angles) t = std::max(t, feedback.steering_angles->stamp);
+  if (feedback.wheel_speeds) t = std::max(t, feedback.wheel_speeds->stamp);
+  return t;
+}
+
+sensor_msgs::JointState to_joint_state(const ranger::WheelJoints& joints, const ros::Time& stamp) {
   sensor_msgs::JointState out;
   out.header.stamp = stamp;
   for (int i = 0; i < ranger::kWheelCount; ++i) {
@@ -239,12 +259,83 @@ ranger_msgs::BmsFlags to_bms_flags(std::uint8_t status1, std::uint8_t status2) {
 
 // ---- chassis state ----------------------------------------------------------------------------
 
-ranger_msgs::SystemState to_system_state(const ranger::ControllerState& state,
+std::vector<std::string> cause_names(ranger::StopCauses causes) {
+  std::vector<std::string> out;
+  const std::string all = ranger::describe(causes);  // "emergency_stop,remote"
+  std::size_t start = 0;
+  while (start < all.size()) {
+    const std::size_t comma = all.find(',', start);
+    const std::size_t end = comma == std::string::npos ? all.size() : comma;
+    out.push_back(all.substr(start, end - start));
+    start = end + 1;
+  }
+  return out;
+}
+
+std::string describe_refusal(const ranger::ControllerState& c) {
+  using R = ranger::MotionRefusal;
+  const auto join = [](const std::vector<std::string>& names) {
+    std::string out;
+    for (const auto& n : names)
+      out += (out.empty() ? "" : ", ") + n;
+    return out;
+  };
+  switch (c.refusal) {
+    case R::kNone:
+      if (c.steer_first_factor < 1.0) {
+        return "steering first: speed held at " +
+               std::to_string(static_cast<int>(std::lround(c.steer_first_factor * 100.0))) +
+               " % until the wheels reach the commanded angle";
+      }
+      return "";
+    case R::kLinkLost:
+      return c.link == ranger::LinkState::kNeverConnected
+                 ? "no chassis heard yet (waiting for its system status)"
+                 : "chassis silent (link lost): motion stopped";
+    case R::kRemote:
+      return "remote control has the chassis: cmd_vel not applied";
+    case R::kEstop:
+      return "emergency stop pressed: release it, then call resume";
+    case R::kCriticalError:
+      return "critical chassis error (" + join(c.faults) +
+             "): clear it (clear_errors), then call resume";
+    case R::kLowBattery:
+      return "battery below low_battery_soc: the chassis cuts the drives";
+    case R::kModeSwitchFailed:
+      return "motion-mode switch not confirmed by the chassis: send a zero cmd_vel or call resume";
+    case R::kImplausible:
+      return "the chassis's feedback contradicts the protocol settings";
+    case R::kRearmRequired:
+      return "rearm_required after " + join(cause_names(c.latched_causes)) +
+             ": call resume (or send a zero cmd_vel) to drive again";
+    case R::kStandby:
+      if (c.reclaim_blocked) {
+        return "remote control had the chassis: call resume to take CAN control";
+      }
+      return c.awaiting_command_mode ? "standby: requesting CAN command mode"
+                                     : "standby (auto_command_mode is off)";
+    case R::kModeUnknown:
+      return "motion mode unknown (no motion-mode feedback yet)";
+    case R::kSwitching:
+      return "motion-mode switch in progress";
+    case R::kCmdTimeout:
+      return "no recent cmd_vel (cmd_vel_timeout): chassis commanded to stop";
+    case R::kBelowMinimum:
+      return "below_minimum: cmd_vel is below what the chassis can express (mode_selection/"
+             "min_linear_speed, min_yaw_rate): not driven";
+  }
+  return std::string(ranger::to_string(c.refusal));
+}
+
+ranger_msgs::SystemState to_system_state(const ranger::DriverSnapshot& snapshot,
                                          const ros::Time& stamp) {
+  const ranger::ControllerState& state = snapshot.controller;
+  const ranger::ChassisFeedback& feedback = snapshot.feedback;
   ranger_msgs::SystemState out;
   out.header.stamp = stamp;
   out.link_up = state.link == ranger::LinkState::kConnected;
-  if (const auto& s = state.feedback.system_status) {
+  out.motion_known = snapshot.motion_known;
+  if (const auto& s = feedback.system_status) {
     out.vehicle_status = s->value.vehicle_status_raw;
     out.vehicle_status_name = std::string(protocol::to_string(s->value.vehicle_status));
     out.control_mode = s->value.control_mode_raw;
@@ -254,7 +345,7 @@ ranger_msgs::SystemState to_system_state(const ranger::ControllerState& state,
     out.vehicle_status_name = "unknown";
     out.control_mode_name = "unknown";
   }
-  if (const auto& m = state.feedback.motion_mode) {
+  if (const auto& m = feedback.motion_mode) {
     out.motion_mode = m->value.mode_raw;
     out.motion_mode_name = std::string(protocol::to_string(m->value.mode));
     out.motion_mode_switching = m->value.switching;
@@ -267,11 +358,17 @@ ranger_msgs::SystemState to_system_state(const ranger::ControllerState& state,
   if (state.refusal != ranger::MotionRefusal::kNone) {
     out.motion_inhibited_reason = std::string(ranger::to_string(state.refusal));
   }
+  out.motion_inhibited_detail = describe_refusal(state);
+  out.rearm_required = state.rearm_required();
+  out.latched_causes = cause_names(state.latched_causes);
+  out.active_causes = cause_names(state.active_causes);
+  out.reclaim_blocked = state.reclaim_blocked;
+  out.steer_first_factor = static_cast<float>(state.steer_first_factor);
   return out;
 }
 
 ranger_msgs::ActuatorStateArray to_actuator_state(const ranger::ChassisFeedback& feedback,
-                                                  const TimeMapper& time, const ros::Time& stamp) {
+                                                  const ros::Time& stamp) {
   ranger_msgs::ActuatorStateArray out;
   out.header.stamp = stamp;
   for (int motor = 1; motor <= protocol::kMotorCount; ++motor) {
@@ -283,7 +380,7 @@ ranger_msgs::ActuatorStateArray to_actuator_state(const ranger::ChassisFeedback&
       a.rpm = h->value.rpm;
       a.current = h->value.current;
       a.position = h->value.position;
-      a.high_speed_stamp = time.to_ros(h->received);
+      a.high_speed_stamp = to_ros_time(h->stamp);
     }
     if (const auto& l = feedback.motor_low_speed[i]) {
       a.driver_voltage = l->value.driver_voltage;
@@ -291,15 +388,14 @@ ranger_msgs::ActuatorStateArray to_actuator_state(const ranger::ChassisFeedback&
       a.motor_temperature = l->value.motor_temperature;
       a.driver_status = l->value.driver_status;
       a.driver_status_bits = to_driver_status(l->value.driver_status);
-      a.low_speed_stamp = time.to_ros(l->received);
+      a.low_speed_stamp = to_ros_time(l->stamp);
     }
     out.actuators.push_back(a);
   }
   return out;
 }
 
-ranger_msgs::BmsStateArray to_bms_state(const ranger::ChassisFeedback& feedback,
-                                        const TimeMapper& time, Timestamp link_now,
+ranger_msgs::BmsStateArray to_bms_state(const ranger::ChassisFeedback& feedback, Timestamp now,
                                         const ros::Time& stamp) {
   ranger_msgs::BmsStateArray out;
   out.header.stamp = stamp;
@@ -308,9 +404,9 @@ ranger_msgs::BmsStateArray to_bms_state(const ranger::ChassisFeedback& feedback,
     ranger_msgs::BmsState s;
     s.battery = static_cast<std::uint8_t>(b);
     const auto& data = feedback.bms[i];
-    s.present = fresh(data, link_now, protocol::kBmsPeriodMs);
+    s.present = fresh(data, now, protocol::kBmsPeriodMs);
     if (data) {
-      s.header.stamp = time.to_ros(data->received);
+      s.header.stamp = to_ros_time(data->stamp);
       s.soc = static_cast<float>(data->value.soc);
       s.soh = static_cast<float>(data->value.soh);
       s.voltage = static_cast<float>(data->value.voltage);
@@ -330,22 +426,28 @@ ranger_msgs::BmsStateArray to_bms_state(const ranger::ChassisFeedback& feedback,
   return out;
 }
 
-sensor_msgs::BatteryState to_battery_state(const ranger::ControllerState& state, Timestamp link_now,
+const PackDesign& pack_design() {
+  // User manual: "48 V batteries, 24 Ah each, up to four"; battery type lithium iron phosphate;
+  // normal voltage range 46-50 V.
+  static const PackDesign design{48.0, 46.0, 50.0};
+  return design;
+}
+
+sensor_msgs::BatteryState to_battery_state(const ranger::ChassisFeedback& fb, Timestamp now,
                                            const ros::Time& stamp) {
   using sensor_msgs::BatteryState;
   BatteryState out;
   out.header.stamp = stamp;
-  out.voltage = out.current = out.temperature = out.charge = out.capacity = out.percentage =
-      std::numeric_limits<float>::quiet_NaN();
-  out.design_capacity = std::numeric_limits<float>::quiet_NaN();
+  out.voltage = out.current = out.temperature = out.charge = out.capacity = out.percentage = kNaN;
+  out.design_capacity = kNaN;  // 24 Ah per battery, but how many are fitted is not reported
   out.power_supply_status = BatteryState::POWER_SUPPLY_STATUS_UNKNOWN;
   out.power_supply_health = BatteryState::POWER_SUPPLY_HEALTH_UNKNOWN;
-  out.power_supply_technology = BatteryState::POWER_SUPPLY_TECHNOLOGY_LION;
+  out.power_supply_technology = BatteryState::POWER_SUPPLY_TECHNOLOGY_LIFE;  // LiFePO4
   out.location = "pack";
 
-  const auto& fb = state.feedback;
   const auto& pack = fb.bms[0];
-  if (fresh(pack, link_now, protocol::kBmsPeriodMs)) {
+  if (fresh(pack, now, protocol::kBmsPeriodMs)) {
+    out.header.stamp = to_ros_time(pack->stamp);
     out.present = true;
     out.voltage = static_cast<float>(pack->value.voltage);
     out.current = static_cast<float>(pack->value.current);
@@ -373,57 +475,60 @@ sensor_msgs::BatteryState to_battery_state(const ranger::ControllerState& state,
       }
     }
   } else if (const auto& status = fb.system_status) {
+    out.header.stamp = to_ros_time(status->stamp);
     out.present = true;  // the chassis runs, so it has a battery; the BMS is not reporting
     out.voltage = static_cast<float>(status->value.battery_voltage);
   }
   for (int b = 1; b <= protocol::kBatteryCount; ++b) {
     const auto& slot = fb.bms[static_cast<std::size_t>(b)];
-    const bool present = fresh(slot, link_now, protocol::kBmsPeriodMs);
-    out.cell_voltage.push_back(present ? static_cast<float>(slot->value.voltage)
-                                       : std::numeric_limits<float>::quiet_NaN());
-    out.cell_temperature.push_back(present ? static_cast<float>(slot->value.temperature)
-                                           : std::numeric_limits<float>::quiet_NaN());
+    const bool present = fresh(slot, now, protocol::kBmsPeriodMs);
+    out.cell_voltage.push_back(present ? static_cast<float>(slot->value.voltage) : kNaN);
+    out.cell_temperature.push_back(present ? static_cast<float>(slot->value.temperature) : kNaN);
   }
   return out;
 }
 
-std::string ultrasonic_frame_id(int sensor) {
-  return "ultrasonic_" + std::to_string(sensor) + "_link";
+std::string ultrasonic_frame_id(const std::string& frame_prefix, int sensor) {
+  return frame_prefix + "ultrasonic_" + std::to_string(sensor) + "_link";
 }
 
-sensor_msgs::Range to_range(int sensor, std::int16_t raw, const UltrasonicRangeParameters& params,
+float ultrasonic_range_m(std::int16_t raw) {
+  // Whatever the library does not call "ok" (no reading, an error code) is no distance.
+  if (protocol::ultrasonic_status_name(raw) != "ok") return kNaN;
+  return static_cast<float>(raw * kUltrasonicMetresPerUnit);
+}
+
+sensor_msgs::Range to_range(int sensor, std::int16_t raw, const NodeParameters& params,
                             const ros::Time& stamp) {
+  const auto& u = params.ultrasonic;
   sensor_msgs::Range out;
   out.header.stamp = stamp;
-  out.header.frame_id = ultrasonic_frame_id(sensor);
+  out.header.frame_id = ultrasonic_frame_id(params.frame_prefix, sensor);
   out.radiation_type = sensor_msgs::Range::ULTRASOUND;
-  out.field_of_view = static_cast<float>(params.field_of_view);
-  out.min_range = static_cast<float>(params.min_range);
-  out.max_range = static_cast<float>(params.max_range);
-  if (raw < 0) {
-    out.range = std::numeric_limits<float>::quiet_NaN();
-  } else {
-    const double m = raw / 1000.0;
-    out.range =
-        m > params.max_range ? std::numeric_limits<float>::infinity() : static_cast<float>(m);
+  out.field_of_view = static_cast<float>(u.field_of_view);
+  out.min_range = static_cast<float>(u.min_range);
+  out.max_range = static_cast<float>(u.max_range);
+  out.range = ultrasonic_range_m(raw);
+  if (std::isfinite(out.range) && out.range > u.max_range) {
+    out.range = std::numeric_limits<float>::infinity();
   }
   return out;
 }
 
-ranger_msgs::UltrasonicState to_ultrasonic_state(const ranger::ControllerState& state,
+ranger_msgs::UltrasonicState to_ultrasonic_state(const ranger::DriverSnapshot& snapshot,
                                                  const ros::Time& stamp) {
+  const auto& state = snapshot.controller;
   ranger_msgs::UltrasonicState out;
   out.header.stamp = stamp;
   out.avoidance_known = state.ultrasonic_enabled.has_value();
   out.avoidance_enabled = state.ultrasonic_enabled.value_or(false);
-  for (const auto& group : state.feedback.ultrasonic) {
+  for (const auto& group : snapshot.feedback.ultrasonic) {
     if (!group) continue;
     for (int k = 0; k < 4; ++k) {
       ranger_msgs::UltrasonicReading r;
       r.sensor = static_cast<std::uint8_t>(group->value.first_sensor + k);
       r.raw = group->value.raw[static_cast<std::size_t>(k)];
-      r.range =
-          r.raw < 0 ? std::numeric_limits<float>::quiet_NaN() : static_cast<float>(r.raw / 1000.0);
+      r.range = ultrasonic_range_m(r.raw);
       r.status = std::string(protocol::ultrasonic_status_name(r.raw));
       out.sensors.push_back(r);
     }

@@ -6,13 +6,12 @@
 #include <cstdio>
 #include <string>
 
-#include <ranger_can/wire/protocol.hpp>
+#include "ranger_base/conversions.hpp"
 
 namespace ranger_base {
 namespace {
 
 using diagnostic_msgs::DiagnosticStatus;
-using diagnostic_updater::DiagnosticStatusWrapper;
 namespace protocol = ranger::protocol;
 
 std::string hex(std::uint32_t v, int width) {
@@ -21,22 +20,30 @@ std::string hex(std::uint32_t v, int width) {
   return buf;
 }
 
+std::string join(const std::vector<std::string>& names) {
+  std::string out;
+  for (const auto& n : names)
+    out += (out.empty() ? "" : ", ") + n;
+  return out.empty() ? "none" : out;
+}
+
 // A fault that stops the chassis is an ERROR; anything else it reports is a WARN.
 bool stops_chassis(const ranger::ControllerState& c) {
-  return c.estop || c.critical_error || c.low_battery;
+  return c.estop() || c.critical_error() || c.low_battery();
 }
 
 }  // namespace
 
-void diagnose_link(const LinkSnapshot& s, DiagnosticStatusWrapper& out) {
-  out.add("Port", s.port_name);
+void diagnose_link(const DriverSnapshot& s, DiagnosticStatusWrapper& out) {
+  out.add("Port", s.bus_name);
   if (!s.bus_open) {
-    out.summary(DiagnosticStatus::ERROR, "CAN interface " + s.port_name + " not open: " +
+    out.summary(DiagnosticStatus::ERROR, "CAN interface " + s.bus_name + " not open: " +
                                              (s.bus_error.empty() ? "opening" : s.bus_error));
     return;
   }
   out.add("Bus state", std::string(ranger::to_string(s.bus.state)));
   out.add("Bus detail", s.bus.detail);
+  out.add("Read only (replayed log)", s.read_only ? "yes" : "no");
   out.add("Frames received", s.bus.stats.rx_frames);
   out.add("Frames sent", s.bus.stats.tx_frames);
   out.add("Receive drops", s.bus.stats.rx_dropped);
@@ -47,6 +54,7 @@ void diagnose_link(const LinkSnapshot& s, DiagnosticStatusWrapper& out) {
   const auto& c = s.controller;
   out.add("Chassis link", std::string(ranger::to_string(c.link)));
   out.add("Chassis link losses", c.counters.link_losses);
+  out.add("Odometry published", s.motion_known ? "yes" : "no (chassis not heard)");
   out.add("Undecodable frames", c.counters.decode_errors);
   out.add("Send failures", c.counters.send_failures);
   if (!c.last_error.empty()) out.add("Last error", c.last_error);
@@ -54,7 +62,7 @@ void diagnose_link(const LinkSnapshot& s, DiagnosticStatusWrapper& out) {
   switch (s.bus.state) {
     case ranger::BusState::kDown:
       out.summary(DiagnosticStatus::ERROR,
-                  "CAN interface " + s.port_name + " down (reconnecting): " + s.bus.detail);
+                  "CAN interface " + s.bus_name + " down (reconnecting): " + s.bus.detail);
       return;
     case ranger::BusState::kBusOff:
       out.summary(DiagnosticStatus::ERROR, "CAN controller bus-off: " + s.bus.detail);
@@ -73,15 +81,17 @@ void diagnose_link(const LinkSnapshot& s, DiagnosticStatusWrapper& out) {
       break;
     case ranger::LinkState::kNeverConnected:
       out.mergeSummary(DiagnosticStatus::ERROR,
-                       "no system status (0x211) from the chassis yet: is it powered on?");
+                       "waiting for the chassis on " + s.bus_name +
+                           ": nothing heard from it yet (is it powered on?)");
       break;
     case ranger::LinkState::kStale:
-      out.mergeSummary(DiagnosticStatus::ERROR, "chassis silent: no system status (0x211)");
+      out.mergeSummary(DiagnosticStatus::ERROR,
+                       "chassis silent: no system status; odometry paused until it returns");
       break;
   }
 }
 
-void diagnose_control(const LinkSnapshot& s, DiagnosticStatusWrapper& out) {
+void diagnose_control(const DriverSnapshot& s, DiagnosticStatusWrapper& out) {
   const auto& c = s.controller;
   out.add("Control mode",
           c.control_mode ? std::string(protocol::to_string(*c.control_mode)) : "unknown");
@@ -89,37 +99,43 @@ void diagnose_control(const LinkSnapshot& s, DiagnosticStatusWrapper& out) {
           c.motion_mode ? std::string(protocol::to_string(*c.motion_mode)) : "unknown");
   out.add("Motion mode pinned",
           c.mode_override ? std::string(protocol::to_string(*c.mode_override)) : "automatic");
-  out.add("Mode switch", std::string(ranger::to_string(c.mode_switch_phase)));
+  out.add("Mode switch", std::string(ranger::to_string(c.mode_switch.phase)));
   out.add("Motion refused because", std::string(ranger::to_string(c.refusal)));
+  out.add("Re-arm required", c.rearm_required() ? "yes" : "no");
+  out.add("Latched stop causes", join(cause_names(c.latched_causes)));
+  out.add("Active stop causes", join(cause_names(c.active_causes)));
+  out.add("CAN control blocked after remote", c.reclaim_blocked ? "yes (call resume)" : "no");
+  out.add("Steer-first speed factor", c.steer_first_factor);
   out.add("cmd_vel timeouts", c.counters.cmd_timeouts);
+  out.add("Re-arms", c.counters.rearms);
   out.add("Motion commands sent", c.counters.motion_commands_sent);
   out.add("Control mode requests", c.counters.control_mode_requests);
   out.add("Mode switch requests", c.counters.mode_switch_requests);
   if (c.last_solution) {
     out.add("Last command limits", ranger::kinematics_flags_to_string(c.last_solution->flags));
   }
+  const std::string detail = describe_refusal(c);
 
-  if (!s.has_controller || c.link != ranger::LinkState::kConnected) {
+  if (!s.bus_open || c.link != ranger::LinkState::kConnected) {
     out.summary(DiagnosticStatus::ERROR, "no chassis");
   } else if (c.control_mode == protocol::ControlMode::kRemote) {
     out.summary(DiagnosticStatus::WARN, "remote control has the chassis: cmd_vel not applied");
   } else if (c.control_mode != protocol::ControlMode::kCan) {
-    out.summary(DiagnosticStatus::WARN, c.awaiting_command_mode
-                                            ? "standby: requesting CAN command mode"
-                                            : "standby (auto_command_mode is off)");
-  } else if (c.mode_switch_failed) {
+    out.summary(DiagnosticStatus::WARN, detail.empty() ? "standby" : detail);
+  } else if (c.mode_switch.failed) {
     out.summary(DiagnosticStatus::ERROR, "motion-mode switch not confirmed by the chassis");
   } else if (c.refusal == ranger::MotionRefusal::kCmdTimeout) {
     out.summary(DiagnosticStatus::OK, "CAN command mode, idle (no recent cmd_vel)");
   } else if (c.refusal != ranger::MotionRefusal::kNone) {
-    out.summary(DiagnosticStatus::WARN,
-                "CAN command mode, motion refused: " + std::string(ranger::to_string(c.refusal)));
+    out.summary(DiagnosticStatus::WARN, "CAN command mode, motion refused: " + detail);
+  } else if (!detail.empty()) {
+    out.summary(DiagnosticStatus::OK, "CAN command mode, " + detail);
   } else {
     out.summary(DiagnosticStatus::OK, "CAN command mode");
   }
 }
 
-void diagnose_errors(const LinkSnapshot& s, DiagnosticStatusWrapper& out) {
+void diagnose_errors(const DriverSnapshot& s, DiagnosticStatusWrapper& out) {
   const auto& c = s.controller;
   out.add("Error word", hex(c.error_bits, 8));
   out.add("Vehicle status",
@@ -130,18 +146,21 @@ void diagnose_errors(const LinkSnapshot& s, DiagnosticStatusWrapper& out) {
     out.summary(DiagnosticStatus::OK, "no faults");
     return;
   }
-  std::string list;
-  for (const auto& fault : c.faults)
-    list += (list.empty() ? "" : ", ") + fault;
-  out.summary(stops_chassis(c) ? DiagnosticStatus::ERROR : DiagnosticStatus::WARN, list);
+  out.summary(stops_chassis(c) ? DiagnosticStatus::ERROR : DiagnosticStatus::WARN, join(c.faults));
 }
 
-void diagnose_battery(const LinkSnapshot& s, DiagnosticStatusWrapper& out) {
-  const auto& fb = s.controller.feedback;
-  if (fb.system_status) out.add("Voltage (0x211)", fb.system_status->value.battery_voltage);
+void diagnose_battery(const DriverSnapshot& s, DiagnosticStatusWrapper& out) {
+  const auto& fb = s.feedback;
+  const PackDesign& design = pack_design();
+  out.add("Technology", "LiFePO4");
+  out.add("Nominal voltage (V)", design.nominal_voltage);
+  out.add("Normal voltage range (V)",
+          std::to_string(static_cast<int>(design.normal_min_voltage)) + "-" +
+              std::to_string(static_cast<int>(design.normal_max_voltage)));
+  if (fb.system_status) out.add("Voltage (system status)", fb.system_status->value.battery_voltage);
   const auto& pack = fb.bms[0];
   if (!pack) {
-    out.summary(DiagnosticStatus::WARN, "no BMS report (0x361) yet");
+    out.summary(DiagnosticStatus::WARN, "no BMS report yet");
     return;
   }
   const auto& d = pack->value;
@@ -150,7 +169,7 @@ void diagnose_battery(const LinkSnapshot& s, DiagnosticStatusWrapper& out) {
   out.add("Voltage (V)", d.voltage);
   out.add("Current (A)", d.current);
   out.add("Temperature (degC)", d.temperature);
-  if (s.controller.low_battery) {
+  if (s.controller.low_battery()) {
     out.summary(DiagnosticStatus::ERROR, "battery below the cut-off: the chassis refuses motion");
   } else if (d.soc < 15.0) {  // manual: the lights flash below 15 %
     out.summary(DiagnosticStatus::WARN, "battery low");
@@ -169,61 +188,61 @@ void diagnose_battery(const LinkSnapshot& s, DiagnosticStatusWrapper& out) {
   }
 }
 
-void FrameRateMonitor::diagnose(const LinkSnapshot& s, DiagnosticStatusWrapper& out) {
-  out.add("Frames received", s.frames_received);
-  if (!previous_time_ || s.now <= *previous_time_) {
-    previous_time_ = s.now;
-    previous_counts_ = s.frames_by_id;
-    out.summary(DiagnosticStatus::OK, "measuring");
-    return;
-  }
-  const double dt = ranger::seconds(s.now - *previous_time_);
+void FrameRateMonitor::diagnose(const DriverSnapshot& s, DiagnosticStatusWrapper& out) {
+  out.add("Frames received", s.frames.total());
+  out.add("Rate window (s)", ranger::seconds(s.frames.window()));
   double total = 0.0;
-  for (const auto& [id, count] : s.frames_by_id) {
-    const auto before = previous_counts_.count(id) ? previous_counts_.at(id) : 0;
-    const double rate = static_cast<double>(count - before) / dt;
+  std::uint64_t new_rejects = 0, padded = 0;
+  std::map<std::uint32_t, std::uint64_t> rejected;
+  for (const auto& id : s.frames.counts()) {
+    const double rate = s.frames.rate(id.id, s.now);
     total += rate;
-    char key[48];
-    std::snprintf(key, sizeof key, "0x%03X %s (Hz)", id,
-                  std::string(protocol::frame_name(id)).c_str());
+    char key[64];
+    std::snprintf(key, sizeof key, "0x%03X %s (Hz)", id.id,
+                  std::string(protocol::frame_name(id.id)).c_str());
     out.add(key, rate);
+    if (id.rejected > 0) {
+      std::snprintf(key, sizeof key, "0x%03X rejected", id.id);
+      out.add(key, id.rejected);
+    }
+    if (id.padded > 0) {
+      std::snprintf(key, sizeof key, "0x%03X longer than its layout", id.id);
+      out.add(key, id.padded);
+    }
+    padded += id.padded;
+    rejected[id.id] = id.rejected;
+    const auto it = previous_rejected_.find(id.id);
+    new_rejects += id.rejected - (it == previous_rejected_.end() ? 0 : it->second);
   }
   out.add("Total (frames/s)", total);
-  // The system status arrives every 20 ms; well under half of that means frames are lost.
-  const auto it = s.frames_by_id.find(protocol::kSystemStatusId);
-  const auto before = previous_counts_.count(protocol::kSystemStatusId)
-                          ? previous_counts_.at(protocol::kSystemStatusId)
-                          : 0;
-  const double status_rate =
-      it == s.frames_by_id.end() ? 0.0 : static_cast<double>(it->second - before) / dt;
-  const double nominal = 1000.0 / protocol::kFastPeriodMs;
-  if (status_rate < 0.5 * nominal) {
-    out.summary(DiagnosticStatus::WARN,
-                "system status (0x211) at " + std::to_string(static_cast<int>(status_rate)) +
-                    " Hz, expected " + std::to_string(static_cast<int>(nominal)));
+  out.add("Padded frames", padded);
+  previous_rejected_ = std::move(rejected);
+  if (s.frames.total() == 0) {
+    out.summary(DiagnosticStatus::WARN, "no frames received");
+  } else if (new_rejects > 0) {
+    out.summary(DiagnosticStatus::WARN, std::to_string(new_rejects) +
+                                            " frame(s) rejected since the last report (content "
+                                            "the protocol settings cannot decode)");
   } else {
     out.summary(DiagnosticStatus::OK, std::to_string(static_cast<int>(total)) + " frames/s");
   }
-  previous_time_ = s.now;
-  previous_counts_ = s.frames_by_id;
 }
 
-ChassisDiagnostics::ChassisDiagnostics(diagnostic_updater::Updater& updater,
-                                       const ChassisLink& link)
-    : link_(link) {
-  updater.add(kDiagLink, [this](DiagnosticStatusWrapper& out) { diagnose_link(current_, out); });
+ChassisDiagnostics::ChassisDiagnostics(diagnostic_updater::Updater& updater, SnapshotSource source)
+    : source_(std::move(source)), current_(std::make_shared<DriverSnapshot>()) {
+  updater.add(kDiagLink, [this](DiagnosticStatusWrapper& out) { diagnose_link(*current_, out); });
   updater.add(kDiagControl,
-              [this](DiagnosticStatusWrapper& out) { diagnose_control(current_, out); });
+              [this](DiagnosticStatusWrapper& out) { diagnose_control(*current_, out); });
   updater.add(kDiagErrors,
-              [this](DiagnosticStatusWrapper& out) { diagnose_errors(current_, out); });
+              [this](DiagnosticStatusWrapper& out) { diagnose_errors(*current_, out); });
   updater.add(kDiagBattery,
-              [this](DiagnosticStatusWrapper& out) { diagnose_battery(current_, out); });
+              [this](DiagnosticStatusWrapper& out) { diagnose_battery(*current_, out); });
   updater.add(kDiagFrameRates,
-              [this](DiagnosticStatusWrapper& out) { rates_.diagnose(current_, out); });
+              [this](DiagnosticStatusWrapper& out) { rates_.diagnose(*current_, out); });
 }
 
 void ChassisDiagnostics::refresh() {
-  current_ = link_.snapshot();
+  current_ = source_();
 }
 
 }  // namespace ranger_base

@@ -10,9 +10,8 @@
 #include <set>
 #include <sstream>
 
-#include <ranger_can/wire/codec.hpp>
-#include <ranger_can/wire/interpretation.hpp>
-#include <ranger_can/wire/protocol.hpp>
+#include <ranger_can/sim/chassis_commands.hpp>
+#include <ranger_can/transport/bus_source.hpp>
 
 namespace ranger_base {
 namespace {
@@ -211,53 +210,85 @@ class Reader {
   std::vector<std::string> names_;
 };
 
-// ros_controllers' per-axis limits (diff_drive_controller's SpeedLimiter parameters): a missing
-// min_* defaults to -max_*.
+// ros_controllers' per-axis limits (diff_drive_controller's SpeedLimiter parameters): defaults
+// from the library's SpeedLimits{} (as SpeedLimiter's: 0, limits off); a missing min_* defaults
+// to -max_*.
 ranger::SpeedLimits read_speed_limits(Reader& r, const std::string& axis, const std::string& unit,
                                       double max_velocity_bound) {
   ranger::SpeedLimits l;
   const std::string vel_unit = unit + "/s", acc_unit = unit + "/s^2";
-  l.has_velocity_limits = r.flag(axis + "/has_velocity_limits", false);
-  l.max_velocity = r.number(axis + "/max_velocity", 1.0, closed(0.0, max_velocity_bound), vel_unit);
+  l.has_velocity_limits = r.flag(axis + "/has_velocity_limits", l.has_velocity_limits);
+  l.max_velocity =
+      r.number(axis + "/max_velocity", l.max_velocity, closed(0.0, max_velocity_bound), vel_unit);
   l.min_velocity = r.number(axis + "/min_velocity", -l.max_velocity,
                             closed(-max_velocity_bound, l.max_velocity), vel_unit);
-  l.has_acceleration_limits = r.flag(axis + "/has_acceleration_limits", false);
+  l.has_acceleration_limits = r.flag(axis + "/has_acceleration_limits", l.has_acceleration_limits);
   l.max_acceleration =
-      r.number(axis + "/max_acceleration", 1.0, open_closed(0.0, 1000.0), acc_unit);
+      r.number(axis + "/max_acceleration", l.max_acceleration, open_closed(0.0, 1000.0), acc_unit);
   l.min_acceleration = r.number(axis + "/min_acceleration", -l.max_acceleration,
                                 Interval{-1000.0, 0.0, false, true}, acc_unit);
   return l;
 }
 
+// A port_name: what ranger::sim::open_bus_source accepts.
+void check_port_name(Reader& r, const std::string& port) {
+  const std::string forms =
+      "expected a CAN interface name (1-15 characters, e.g. can0, vcan0), sim[:VARIANT] (the "
+      "in-process virtual chassis; variants: " +
+      [] {
+        std::string v;
+        for (const auto& n : ranger::sim::variant_names())
+          v += (v.empty() ? "" : ", ") + n;
+        return v;
+      }() +
+      ") or replay:FILE (a candump log, read-only)";
+  const auto kind = ranger::bus_kind(port);
+  if (!kind) {
+    r.fail("port_name", "= \"" + port + "\": " + forms);
+    return;
+  }
+  if (*kind == ranger::BusKind::kSocketCan && port.find_first_of("/ \t:") != std::string::npos) {
+    r.fail("port_name", "= \"" + port + "\": " + forms);
+  } else if (*kind == ranger::BusKind::kSim && port.size() > 3) {
+    if (auto v = ranger::sim::apply_variant(port.substr(4), {}); !v) {
+      r.fail("port_name", "= \"" + port + "\": " + v.error().message);
+    }
+  }
+}
+
 // Reads everything; `r` collects the problems.
 NodeParameters read_all(Reader& r) {
   NodeParameters p;
-  auto& c = p.controller;
-  auto& o = p.odometry;
+  auto& c = p.driver.controller;
+  auto& o = p.driver.odometry;
 
   // ---- connection and frames
   p.port_name = r.text("port_name", p.port_name);
-  if (p.port_name.empty() || p.port_name.size() > 15 ||
-      p.port_name.find_first_of("/ \t") != std::string::npos) {
-    r.fail("port_name", "= \"" + p.port_name +
-                            "\": expected a CAN interface name (1-15 characters, e.g. can0, "
-                            "vcan0) or \"sim\" for the in-process virtual chassis");
-  }
+  check_port_name(r, p.port_name);
   p.odom_frame = r.frame("odom_frame", p.odom_frame);
   p.base_frame = r.frame("base_frame", p.base_frame);
   if (p.odom_frame == p.base_frame) {
     r.fail("base_frame", "= \"" + p.base_frame + "\" must differ from odom_frame");
+  }
+  p.frame_prefix = r.text("frame_prefix", p.frame_prefix);
+  if (p.frame_prefix.find_first_of(" \t") != std::string::npos ||
+      (!p.frame_prefix.empty() && p.frame_prefix.front() == '/')) {
+    r.fail("frame_prefix", "= \"" + p.frame_prefix +
+                               "\": expected a tf2 frame prefix such as \"robot1/\" (no spaces, "
+                               "no leading '/')");
   }
   p.publish_odom_tf = r.flag("publish_odom_tf", p.publish_odom_tf);
   p.publish_rate = r.number("publish_rate", p.publish_rate, open_closed(0.0, 1000.0), "Hz");
   p.state_publish_rate =
       r.number("state_publish_rate", p.state_publish_rate, open_closed(0.0, 100.0), "Hz");
   p.publish_cmd = r.flag("publish_cmd", p.publish_cmd);
-  p.reconnect_interval = r.seconds("reconnect_interval", p.reconnect_interval, closed(0.05, 60.0));
+  p.driver.reconnect_interval =
+      r.seconds("reconnect_interval", p.driver.reconnect_interval, closed(0.05, 60.0));
 
   // ---- control
   c.cmd_timeout = r.seconds("cmd_vel_timeout", c.cmd_timeout, closed(0.02, 60.0));
   c.auto_command_mode = r.flag("auto_command_mode", c.auto_command_mode);
+  c.auto_reclaim_after_remote = r.flag("auto_reclaim_after_remote", c.auto_reclaim_after_remote);
   c.link_timeout = r.seconds("link_timeout", c.link_timeout, closed(0.02, 10.0));
   c.min_command_interval =
       r.seconds("min_command_interval", c.min_command_interval, closed(0.001, 0.02));
@@ -266,57 +297,78 @@ NodeParameters read_all(Reader& r) {
   c.mode_switch_max_attempts =
       r.integer("mode_switch_max_attempts", c.mode_switch_max_attempts, 1, 100);
   c.standstill_speed = r.number("standstill_speed", c.standstill_speed, closed(0.0, 1.0), "m/s");
+  c.steer_first_threshold = r.number("steer_first_threshold", c.steer_first_threshold,
+                                     closed(0.0, M_PI / 2), "rad (0 disables)");
   c.low_battery_soc = r.number("low_battery_soc", c.low_battery_soc, closed(0.0, 100.0), "%");
 
   // ---- geometry (ranger_description/config/geometry.yaml)
-  ranger::VehicleGeometry g;
+  ranger::VehicleGeometry g = c.geometry;
   g.wheelbase = r.number("wheelbase", g.wheelbase, open_closed(0.0, 10.0), "m");
   g.track = r.number("track", g.track, open_closed(0.0, 10.0), "m");
   g.wheel_radius = r.number("wheel_radius", g.wheel_radius, open_closed(0.0, 5.0), "m");
   c.geometry = g;
   o.geometry = g;
-  p.sim.geometry = g;
+  p.sim.chassis.geometry = g;
 
-  // ---- kinematic limits (the chassis's own ranges are the upper bounds)
+  // ---- kinematic limits: the library's defaults are the protocol's full ranges for steering and
+  // spin; its KinematicsLimits::validate() knows the speed range.
   auto& k = c.limits;
-  const double vmax = ranger::interpretation::kMaxLinearSpeedMps;
-  k.max_linear_speed =
-      r.number("max_linear_speed", k.max_linear_speed, open_closed(0.0, vmax), "m/s");
-  k.max_speed_at_large_steering = r.number(
-      "max_speed_at_large_steering", k.max_speed_at_large_steering, open_closed(0.0, vmax), "m/s");
+  const ranger::KinematicsLimits full;
+  const auto degrees = [](double rad) {
+    std::ostringstream out;
+    out << "rad (" << std::lround(rad * 180.0 / M_PI) << " deg)";
+    return out.str();
+  };
+  const auto speed_limit = [&r](const std::string& name, double& field) {
+    const double v = r.number(name, field, open_closed(0.0, 1e3), "m/s");
+    ranger::KinematicsLimits probe;
+    (name == "max_linear_speed" ? probe.max_linear_speed : probe.max_speed_at_large_steering) = v;
+    if (const auto st = probe.validate(); !st) {
+      r.fail(name, "is out of range: " + st.error().message + " m/s");
+    } else {
+      field = v;
+    }
+  };
+  speed_limit("max_linear_speed", k.max_linear_speed);
+  speed_limit("max_speed_at_large_steering", k.max_speed_at_large_steering);
   k.max_ackermann_steering =
       r.number("max_ackermann_steering", k.max_ackermann_steering,
-               open_closed(0.0, ranger::kMaxAckermannSteeringRad), "rad (40 deg)");
+               open_closed(0.0, full.max_ackermann_steering), degrees(full.max_ackermann_steering));
   k.max_oblique_steering =
       r.number("max_oblique_steering", k.max_oblique_steering,
-               open_closed(0.0, ranger::kMaxObliqueSteeringRad), "rad (90 deg)");
+               open_closed(0.0, full.max_oblique_steering), degrees(full.max_oblique_steering));
   k.max_spin_wheel_speed = r.number("max_spin_wheel_speed", k.max_spin_wheel_speed,
-                                    open_closed(0.0, ranger::kMaxSpinSpeedMps), "m/s");
+                                    open_closed(0.0, full.max_spin_wheel_speed), "m/s");
 
   // ---- velocity / acceleration limits per axis (ros_controllers names)
-  c.limit_vx = read_speed_limits(r, "linear/x", "m", vmax);
-  c.limit_vy = read_speed_limits(r, "linear/y", "m", vmax);
+  c.limit_vx = read_speed_limits(r, "linear/x", "m", 10.0);
+  c.limit_vy = read_speed_limits(r, "linear/y", "m", 10.0);
   c.limit_wz = read_speed_limits(r, "angular/z", "rad", 10.0);
 
   // ---- automatic motion-mode selection
   auto& m = c.mode_selection;
   m.lateral_enter =
-      r.number("mode_selection/lateral_enter", m.lateral_enter, closed(0.0, 2.6), "m/s");
-  m.lateral_exit = r.number("mode_selection/lateral_exit", m.lateral_exit, closed(0.0, 2.6), "m/s");
-  m.linear_enter = r.number("mode_selection/linear_enter", m.linear_enter, closed(0.0, 2.6), "m/s");
-  m.linear_exit = r.number("mode_selection/linear_exit", m.linear_exit, closed(0.0, 2.6), "m/s");
+      r.number("mode_selection/lateral_enter", m.lateral_enter, closed(0.0, 10.0), "m/s");
+  m.lateral_exit =
+      r.number("mode_selection/lateral_exit", m.lateral_exit, closed(0.0, 10.0), "m/s");
+  m.linear_enter =
+      r.number("mode_selection/linear_enter", m.linear_enter, closed(0.0, 10.0), "m/s");
+  m.linear_exit = r.number("mode_selection/linear_exit", m.linear_exit, closed(0.0, 10.0), "m/s");
   m.rotation_enter =
       r.number("mode_selection/rotation_enter", m.rotation_enter, closed(0.0, 10.0), "rad/s");
   m.rotation_exit =
       r.number("mode_selection/rotation_exit", m.rotation_exit, closed(0.0, 10.0), "rad/s");
+  m.min_linear_speed =
+      r.number("mode_selection/min_linear_speed", m.min_linear_speed, closed(0.0, 1.0), "m/s");
+  m.min_yaw_rate =
+      r.number("mode_selection/min_yaw_rate", m.min_yaw_rate, closed(0.0, 1.0), "rad/s");
   m.confirm_time = r.seconds("mode_selection/confirm_time", m.confirm_time, closed(0.0, 10.0));
   m.min_dwell = r.seconds("mode_selection/min_dwell", m.min_dwell, closed(0.0, 60.0));
-  m.oblique_side_band =
-      r.number("mode_selection/oblique_side_band", m.oblique_side_band,
-               Interval{0.0, ranger::kMaxObliqueSteeringRad, false, true}, "rad (< 90 deg)");
+  m.oblique_side_band = r.number("mode_selection/oblique_side_band", m.oblique_side_band,
+                                 Interval{0.0, M_PI / 2, false, true}, "rad (< 90 deg)");
 
   // ---- odometry
-  const std::string source = r.text("odometry_source", "wheels");
+  const std::string source = r.text("odometry_source", std::string(ranger::to_string(o.source)));
   if (auto parsed = ranger::parse_odometry_source(source)) {
     o.source = *parsed;
   } else {
@@ -344,23 +396,20 @@ NodeParameters read_all(Reader& r) {
   u.max_range = r.number("ultrasonic/max_range", u.max_range,
                          Interval{u.min_range, 32.767, true, false}, "m");
 
-  // ---- the in-process virtual chassis (port_name = sim)
-  auto& s = p.sim;
+  // ---- the in-process virtual chassis (port_name sim[:VARIANT])
+  auto& s = p.sim.chassis;
   s.initial_soc = r.number("sim/initial_soc", s.initial_soc, closed(0.0, 100.0), "%");
   s.mode_switch_duration =
       r.seconds("sim/mode_switch_duration", s.mode_switch_duration, closed(0.0, 10.0));
   s.boot_in_remote_mode = r.flag("sim/boot_in_remote_mode", s.boot_in_remote_mode);
-  const double ultrasonic_m = r.number("sim/ultrasonic_range", 3.0, closed(0.0, 32.767), "m");
+  const double ultrasonic_m =
+      r.number("sim/ultrasonic_range", s.ultrasonic[0] / 1000.0, closed(0.0, 32.767), "m");
   s.ultrasonic.fill(static_cast<std::int16_t>(std::lround(ultrasonic_m * 1000.0)));
   for (const auto& name : r.text_list("sim/errors")) {
-    const auto& bits = ranger::protocol::system_error_bits();
-    const auto it =
-        std::find_if(bits.begin(), bits.end(), [&name](const auto& b) { return b.name == name; });
-    if (it == bits.end()) {
-      r.fail("sim/errors", "contains \"" + name +
-                               "\": not a 0x211 error bit name (see ranger_msgs/SystemErrors)");
+    if (auto bit = ranger::sim::parse_error_bit(name)) {
+      p.sim.boot_error_bits |= 1u << *bit;
     } else {
-      p.sim_error_bits |= 1u << it->index;
+      r.fail("sim/errors", "contains \"" + name + "\": " + bit.error().message);
     }
   }
   return p;
@@ -405,6 +454,15 @@ std::vector<std::string> MapParameterSource::names() const {
   return out;
 }
 
+bool NodeParameters::is_sim() const {
+  const auto kind = ranger::bus_kind(port_name);
+  return kind && *kind == ranger::BusKind::kSim;
+}
+
+std::string hardware_id(const std::string& ns, const std::string& port_name) {
+  return "ranger:" + (ns.empty() ? std::string("/") : ns) + ":" + port_name;
+}
+
 ranger::Result<NodeParameters> load_parameters(const ParameterSource& source) {
   Reader reader(source);
   NodeParameters p = read_all(reader);
@@ -413,10 +471,7 @@ ranger::Result<NodeParameters> load_parameters(const ParameterSource& source) {
   // The library's own checks catch combinations the per-parameter ranges cannot (e.g.
   // min_velocity above max_velocity after defaults, hysteresis thresholds in the wrong order).
   if (errors.empty()) {
-    if (auto st = p.controller.validate(); !st) {
-      errors.push_back("parameters rejected: " + st.error().message);
-    }
-    if (auto st = p.odometry.validate(); !st) {
+    if (auto st = p.driver.validate(); !st) {
       errors.push_back("parameters rejected: " + st.error().message);
     }
   }

@@ -12,11 +12,15 @@
 
 #include <pthread.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cinttypes>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
-#include <ranger_can/wire/protocol.hpp>
+#include <ranger_can/sim/chassis_commands.hpp>
+#include <ranger_can/transport/bus_source.hpp>
 
 #include "ranger_base/conversions.hpp"
 
@@ -24,35 +28,72 @@ namespace ranger_base {
 namespace {
 
 namespace protocol = ranger::protocol;
+using std::chrono::milliseconds;
+using std::chrono::nanoseconds;
+using State = ranger::RequestOutcome::State;
 
-ChassisLinkOptions link_options(const NodeParameters& p) {
-  ChassisLinkOptions o;
-  o.port_name = p.port_name;
-  o.controller = p.controller;
-  o.odometry = p.odometry;
-  o.reconnect_interval = p.reconnect_interval;
-  if (p.is_sim()) {
-    o.sim = p.sim;
-    o.sim_error_bits = p.sim_error_bits;
-  }
-  return o;
+// How long a service waits beyond the driver's own answer timeout (the driver decides; this only
+// covers its next iteration).
+constexpr nanoseconds kAnswerMargin = milliseconds(200);
+// A service waits for its answer in slices this long, so that shutdown never waits for it.
+constexpr nanoseconds kWaitSlice = milliseconds(20);
+// While the chassis was never heard, "still waiting" is repeated this often.
+constexpr nanoseconds kWaitingReminder = std::chrono::seconds(30);
+
+const ranger::Clock& driver_clock() {
+  static const ranger::SteadyClock clock;
+  return clock;
+}
+const ranger::Clock& bus_clock() {
+  static const ranger::SystemClock clock;
+  return clock;
 }
 
-// Longest a service waits for the chassis to confirm a setting.
-std::chrono::nanoseconds confirmation_budget(const ranger::ControllerConfig& c) {
-  return c.ultrasonic_confirm_timeout * (c.ultrasonic_max_attempts + 1);
+double secs(nanoseconds d) {
+  return ranger::seconds(d);
+}
+
+std::string join(const std::vector<std::string>& items, const char* separator = ", ") {
+  std::string out;
+  for (const auto& i : items)
+    out += (out.empty() ? "" : separator) + i;
+  return out;
+}
+
+bool is_socketcan(const std::string& port) {
+  const auto kind = ranger::bus_kind(port);
+  return kind && *kind == ranger::BusKind::kSocketCan;
+}
+
+std::string hex_word(std::uint32_t word) {
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "0x%08" PRIX32, word);
+  return buf;
 }
 
 }  // namespace
 
+ranger::Result<std::unique_ptr<RangerNode>> RangerNode::create(const ros::NodeHandle& nh,
+                                                               const ros::NodeHandle& private_nh,
+                                                               NodeParameters params) {
+  auto source = ranger::sim::open_bus_source(params.port_name, bus_clock(), params.sim);
+  if (!source) {
+    return ranger::Error{source.error().code,
+                         "port_name \"" + params.port_name + "\": " + source.error().message};
+  }
+  return std::unique_ptr<RangerNode>(new RangerNode(nh, private_nh, std::move(params), *source));
+}
+
 RangerNode::RangerNode(const ros::NodeHandle& nh, const ros::NodeHandle& private_nh,
-                       NodeParameters params)
+                       NodeParameters params, std::shared_ptr<ranger::BusSource> source)
     : nh_(nh),
       private_nh_(private_nh),
       cmd_nh_(nh),
       service_nh_(nh),
       params_(std::move(params)),
-      link_(std::make_unique<ChassisLink>(link_options(params_), clock_)),
+      source_(std::move(source)),
+      sim_(std::dynamic_pointer_cast<ranger::sim::SimBusSource>(source_)),
+      driver_(std::make_unique<ranger::Driver>(params_.driver, source_, driver_clock())),
       updater_(nh, private_nh) {
   cmd_nh_.setCallbackQueue(&cmd_queue_);
   service_nh_.setCallbackQueue(&service_queue_);
@@ -71,12 +112,12 @@ RangerNode::RangerNode(const ros::NodeHandle& nh, const ros::NodeHandle& private
   if (params_.publish_cmd) {
     cmd_vel_out_pub_ = nh_.advertise<geometry_msgs::TwistStamped>("cmd_vel_out", 100);
   }
-  if (params_.is_sim()) {
-    ground_truth_pub_ = nh_.advertise<nav_msgs::Odometry>("sim/ground_truth", 10);
-  }
+  if (sim_) ground_truth_pub_ = nh_.advertise<nav_msgs::Odometry>("sim/ground_truth", 10);
 
-  updater_.setHardwareID("ranger:" + params_.port_name);
-  diagnostics_ = std::make_unique<ChassisDiagnostics>(updater_, *link_);
+  updater_.setHardwareID(hardware_id(nh_.getNamespace(), params_.port_name));
+  diagnostics_ =
+      std::make_unique<ChassisDiagnostics>(updater_, [this] { return driver_->snapshot(); });
+  driver_->set_sent_observer([this](const ranger::SentEvent& e) { on_sent(e); });
 }
 
 RangerNode::~RangerNode() {
@@ -84,12 +125,16 @@ RangerNode::~RangerNode() {
 }
 
 void RangerNode::start() {
-  link_->start([this](const MotionCommandEvent& e) { on_motion_command(e); });
+  driver_->start();
 
   // Latest command wins: a queue of one drops stale twists under a flood instead of replaying
   // them late; TCP_NODELAY keeps the latency down.
   cmd_vel_sub_ = cmd_nh_.subscribe("cmd_vel", 1, &RangerNode::on_cmd_vel, this,
                                    ros::TransportHints().tcpNoDelay());
+  if (sim_) {
+    sim_inject_sub_ = service_nh_.subscribe("sim/inject", 10, &RangerNode::on_sim_inject, this);
+  }
+  resume_srv_ = service_nh_.advertiseService("resume", &RangerNode::on_resume, this);
   clear_errors_srv_ =
       service_nh_.advertiseService("clear_errors", &RangerNode::on_clear_errors, this);
   set_ultrasonic_srv_ =
@@ -102,9 +147,10 @@ void RangerNode::start() {
   cmd_spinner_->start();
   service_spinner_->start();
   publisher_ = std::thread([this] { publish_loop(); });
-  ROS_INFO("ranger_base_node: %s, publishing odom at %.1f Hz (%s -> %s%s)",
-           params_.is_sim() ? "in-process virtual chassis (port_name = sim)"
-                            : ("CAN interface " + params_.port_name).c_str(),
+  ROS_INFO("ranger_base_node on %s (%s), publishing odom at %.1f Hz (%s -> %s%s)",
+           params_.port_name.c_str(),
+           sim_ ? "the in-process virtual chassis"
+                : (source_->read_only() ? "a replayed log: nothing is sent" : "SocketCAN"),
            params_.publish_rate, params_.odom_frame.c_str(), params_.base_frame.c_str(),
            params_.publish_odom_tf ? ", TF on" : ", TF off");
 }
@@ -112,25 +158,40 @@ void RangerNode::start() {
 void RangerNode::shutdown() {
   if (shut_down_) return;
   shut_down_ = true;
+  stopping_ = true;
   // Commands stop first: no cmd_vel may restart the chassis after the stop.
   cmd_vel_sub_.shutdown();
-  link_->stop();  // zero 0x111, then the CAN thread ends
+  sim_inject_sub_.shutdown();
+  driver_->stop();  // the zero motion command (on_sent logs it), then the driver thread ends
+  if (!stop_sent_) {
+    const auto s = driver_->snapshot();
+    ROS_INFO("no stop sent to the chassis: %s",
+             !s->bus_open ? ("the bus " + params_.port_name + " was never opened").c_str()
+                          : (s->read_only ? "a replayed log is read-only"
+                                          : "the driver had nothing to stop"));
+  }
   {
     std::lock_guard<std::mutex> lock(publisher_mutex_);
     publisher_stop_ = true;
   }
   publisher_wake_.notify_all();
   if (publisher_.joinable()) publisher_.join();
+  // Disabled queues wake their spinner threads at once instead of after their poll timeout.
+  cmd_queue_.disable();
+  service_queue_.disable();
   if (cmd_spinner_) cmd_spinner_->stop();
   if (service_spinner_) service_spinner_->stop();
 }
+
+// ---- callbacks
+// -----------------------------------------------------------------------------------
 
 void RangerNode::on_cmd_vel(const geometry_msgs::Twist::ConstPtr& msg) {
   const ranger::BodyTwist twist = to_body_twist(*msg);
   if (has_non_planar_components(*msg)) {
     ROS_WARN_THROTTLE(5.0, "cmd_vel: linear.z, angular.x and angular.y are ignored (planar base)");
   }
-  const ranger::Status st = link_->set_command(ranger::MotionRequest{twist, std::nullopt});
+  const ranger::Status st = driver_->command(ranger::MotionRequest{twist, std::nullopt});
   if (!st) {
     if (st.error().code == ranger::Errc::kNotFinite) {
       ROS_ERROR_THROTTLE(1.0, "cmd_vel refused, chassis stopped: %s", st.error().message.c_str());
@@ -140,17 +201,159 @@ void RangerNode::on_cmd_vel(const geometry_msgs::Twist::ConstPtr& msg) {
   }
 }
 
-void RangerNode::on_motion_command(const MotionCommandEvent& e) {
+void RangerNode::on_sent(const ranger::SentEvent& e) {
+  const auto achieved = achieved_twist(e);
+  if (!achieved) return;  // not a motion command
+  if (e.sent.shutdown) {
+    stop_sent_ = true;
+    ROS_INFO("stop sent to the chassis (zero motion command, frame 0x%03" PRIX32 ")",
+             e.sent.frame.id);
+  }
   if (!params_.publish_cmd) return;
-  const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(e.sent.time_since_epoch());
   ros::Time stamp;
-  stamp.fromNSec(static_cast<std::uint64_t>(ns.count()));
-  const ranger::BodyTwist achieved = e.solution ? e.solution->achieved : ranger::BodyTwist{};
-  // A zero 0x111 (refusal, timeout, stop) realises a zero twist whatever the last solution was.
-  const bool zero = e.command.linear_speed == 0.0 && e.command.spin_speed == 0.0;
-  cmd_vel_out_pub_.publish(
-      to_twist_stamped(zero ? ranger::BodyTwist{} : achieved, stamp, params_.base_frame));
+  stamp.fromNSec(static_cast<std::uint64_t>(
+      std::chrono::duration_cast<nanoseconds>(e.wall.time_since_epoch()).count()));
+  cmd_vel_out_pub_.publish(to_twist_stamped(*achieved, stamp, params_.base_frame));
 }
+
+void RangerNode::on_sim_inject(const std_msgs::String::ConstPtr& msg) {
+  if (!sim_) return;
+  const std::string& line = msg->data;
+  auto action = ranger::sim::parse_chassis_command(line);
+  if (!action) {
+    ROS_WARN("sim/inject \"%s\" not applied: %s (valid commands: %s; see ranger_base/README.md)",
+             line.c_str(), action.error().message.c_str(),
+             join(ranger::sim::chassis_command_names()).c_str());
+    return;
+  }
+  const std::string said = sim_->with_chassis(*action);
+  ROS_INFO("sim/inject \"%s\" applied to the virtual chassis%s%s", line.c_str(),
+           said.empty() ? "" : ": ", said.c_str());
+}
+
+ranger::RequestOutcome RangerNode::wait_for(std::uint64_t id, nanoseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  for (;;) {
+    const auto left = deadline - std::chrono::steady_clock::now();
+    auto outcome = driver_->wait_for(
+        id, std::max<nanoseconds>(nanoseconds(0), std::min<nanoseconds>(left, kWaitSlice)));
+    if (outcome.state == State::kAnswered || outcome.state == State::kFailed) return outcome;
+    if (stopping_) {
+      outcome.message = "shutting down";
+      return outcome;
+    }
+    if (left <= nanoseconds(0)) return outcome;
+  }
+}
+
+bool RangerNode::on_resume(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  const auto before = driver_->snapshot();
+  if (!before->bus_open) {
+    res.success = false;
+    res.message = "resume refused: not connected to " + params_.port_name +
+                  (before->bus_error.empty() ? "" : ": " + before->bus_error);
+    ROS_WARN("%s", res.message.c_str());
+    return true;
+  }
+  const auto outcome = wait_for(driver_->resume(), params_.driver.request_answer_timeout);
+  res.success = outcome.state == State::kAnswered;
+  if (res.success) {
+    res.message = "re-armed: cmd_vel drives the chassis again";
+    ROS_INFO("resume: %s", res.message.c_str());
+  } else {
+    res.message = outcome.message.empty()
+                      ? "resume not applied (" + std::string(ranger::to_string(outcome.state)) + ")"
+                      : outcome.message;
+    ROS_WARN("resume: %s", res.message.c_str());
+  }
+  return true;
+}
+
+bool RangerNode::on_clear_errors(ranger_msgs::ClearErrors::Request& req,
+                                 ranger_msgs::ClearErrors::Response& res) {
+  res.success = false;
+  const auto posted = driver_->clear_errors(req.code);
+  if (!posted) {
+    res.message = posted.error().message;
+    res.error_word = driver_->snapshot()->controller.error_bits;
+    return true;
+  }
+  const auto outcome = wait_for(*posted, params_.driver.request_answer_timeout + kAnswerMargin);
+  const std::string asked = "clear_errors code " + std::to_string(req.code) + " (" +
+                            protocol::error_clear_description(req.code) + ")";
+  if (outcome.state == State::kAnswered && outcome.error_word) {
+    res.success = true;
+    res.error_word = *outcome.error_word;
+    const auto names = protocol::error_bit_names(res.error_word);
+    res.message = asked + ": the chassis answered with error word " + hex_word(res.error_word) +
+                  (names.empty() ? " (no errors)" : " (" + join(names) + ")");
+    ROS_INFO("%s", res.message.c_str());
+  } else {
+    res.error_word = driver_->snapshot()->controller.error_bits;
+    res.message = asked + ": " +
+                  (outcome.state == State::kFailed ? outcome.message
+                                                   : std::string("the chassis did not answer"));
+    ROS_WARN("%s", res.message.c_str());
+  }
+  return true;
+}
+
+bool RangerNode::on_set_ultrasonic(ranger_msgs::SetUltrasonic::Request& req,
+                                   ranger_msgs::SetUltrasonic::Response& res) {
+  const auto known = driver_->snapshot()->controller.ultrasonic_enabled;
+  res.enabled = known.value_or(false);
+  if (req.enable == req.disable) {
+    res.success = false;
+    res.message = std::string(req.enable ? "contradictory request (enable and disable both true)"
+                                         : "empty request (neither enable nor disable)") +
+                  ": set exactly one of them; nothing sent";
+    return true;
+  }
+  const auto& c = params_.driver.controller;
+  const auto budget = c.ultrasonic_confirm_timeout * (c.ultrasonic_max_attempts + 1);
+  const auto outcome = wait_for(driver_->set_ultrasonic(req.enable), budget);
+  res.success = outcome.state == State::kAnswered;
+  res.enabled = driver_->snapshot()->controller.ultrasonic_enabled.value_or(false);
+  res.message = outcome.message.empty()
+                    ? "the chassis did not confirm the ultrasonic setting in time"
+                    : outcome.message;
+  if (res.success) ROS_INFO("set_ultrasonic: %s", res.message.c_str());
+  return true;
+}
+
+bool RangerNode::on_set_motion_mode(ranger_msgs::SetMotionMode::Request& req,
+                                    ranger_msgs::SetMotionMode::Response& res) {
+  using Req = ranger_msgs::SetMotionMode::Request;
+  std::optional<protocol::MotionMode> mode;
+  switch (req.mode) {
+    case Req::ACKERMANN:
+      mode = protocol::MotionMode::kAckermann;
+      break;
+    case Req::OBLIQUE:
+      mode = protocol::MotionMode::kOblique;
+      break;
+    case Req::SPIN:
+      mode = protocol::MotionMode::kSpin;
+      break;
+    case Req::AUTOMATIC:
+      break;
+    default:
+      res.success = false;
+      res.message = "mode " + std::to_string(req.mode) +
+                    " unknown: use 0 (Ackermann), 1 (oblique), 2 (spin) or 255 (automatic)";
+      return true;
+  }
+  driver_->set_motion_mode(mode);
+  res.success = true;
+  res.message = mode ? "motion mode pinned to " + std::string(protocol::to_string(*mode)) +
+                           " (the switch happens at standstill)"
+                     : "automatic motion-mode selection";
+  ROS_INFO("set_motion_mode: %s", res.message.c_str());
+  return true;
+}
+
+// ---- publishing
+// ----------------------------------------------------------------------------------
 
 void RangerNode::publish_loop() {
   ::pthread_setname_np(::pthread_self(), "ranger_publish");
@@ -191,80 +394,149 @@ void RangerNode::publish_loop() {
 }
 
 void RangerNode::publish_motion() {
-  const LinkSnapshot s = link_->snapshot();
-  const ros::Time stamp = ros::Time::now();
-  const nav_msgs::Odometry odom = to_odometry(s.odometry, params_, stamp);
-  odom_pub_.publish(odom);
-  if (params_.publish_odom_tf) tf_broadcaster_.sendTransform(to_transform(odom));
-  joint_state_pub_.publish(to_joint_state(s.joints, stamp));
-  if (s.sim && ground_truth_pub_) {
-    ground_truth_pub_.publish(to_ground_truth(*s.sim, params_, stamp));
+  const auto s = driver_->snapshot();
+  // Publish only what is known: nothing while the chassis is not heard (never, or link lost),
+  // and each estimate once, stamped with the time of the frames that produced it.
+  if (s->motion_known) {
+    if (s->odometry.stamp > last_odom_stamp_) {
+      last_odom_stamp_ = s->odometry.stamp;
+      const nav_msgs::Odometry odom = to_odometry(s->odometry, params_);
+      odom_pub_.publish(odom);
+      if (params_.publish_odom_tf) tf_broadcaster_.sendTransform(to_transform(odom));
+    }
+    const ranger::Timestamp joints = joints_stamp(s->feedback);
+    if ((s->joints.has_steering || s->joints.has_wheels) && joints > last_joints_stamp_) {
+      last_joints_stamp_ = joints;
+      joint_state_pub_.publish(to_joint_state(s->joints, to_ros_time(joints)));
+    }
+  }
+  if (sim_ && ground_truth_pub_) {
+    const auto truth = sim_->snapshot();
+    ground_truth_pub_.publish(to_ground_truth(truth, params_, to_ros_time(truth.time)));
   }
 }
 
 void RangerNode::publish_states() {
-  const LinkSnapshot s = link_->snapshot();
+  const auto s = driver_->snapshot();
   const ros::Time stamp = ros::Time::now();
-  const TimeMapper time(stamp, s.now);
-  const auto& c = s.controller;
-  system_state_pub_.publish(to_system_state(c, stamp));
-  actuator_state_pub_.publish(to_actuator_state(c.feedback, time, stamp));
-  bms_state_pub_.publish(to_bms_state(c.feedback, time, s.now, stamp));
-  battery_state_pub_.publish(to_battery_state(c, s.now, stamp));
-  ultrasonic_state_pub_.publish(to_ultrasonic_state(c, stamp));
-  for (const auto& group : c.feedback.ultrasonic) {
-    if (!group) continue;
-    for (int k = 0; k < 4; ++k) {
-      const int sensor = group->value.first_sensor + k;
-      if (sensor < 1 || sensor > static_cast<int>(range_pubs_.size())) continue;
-      range_pubs_[static_cast<std::size_t>(sensor - 1)].publish(
-          to_range(sensor, group->value.raw[static_cast<std::size_t>(k)], params_.ultrasonic,
-                   time.to_ros(group->received)));
+  system_state_pub_.publish(to_system_state(*s, stamp));
+  actuator_state_pub_.publish(to_actuator_state(s->feedback, stamp));
+  bms_state_pub_.publish(to_bms_state(s->feedback, s->now, stamp));
+  battery_state_pub_.publish(to_battery_state(s->feedback, s->now, stamp));
+  ultrasonic_state_pub_.publish(to_ultrasonic_state(*s, stamp));
+  if (s->motion_known) {
+    for (std::size_t g = 0; g < s->feedback.ultrasonic.size(); ++g) {
+      const auto& group = s->feedback.ultrasonic[g];
+      if (!group || group->stamp <= last_ultrasonic_stamp_[g]) continue;  // no new reading
+      last_ultrasonic_stamp_[g] = group->stamp;
+      for (int k = 0; k < 4; ++k) {
+        const int sensor = group->value.first_sensor + k;
+        if (sensor < 1 || sensor > static_cast<int>(range_pubs_.size())) continue;
+        range_pubs_[static_cast<std::size_t>(sensor - 1)].publish(
+            to_range(sensor, group->value.raw[static_cast<std::size_t>(k)], params_,
+                     to_ros_time(group->stamp)));
+      }
     }
   }
-  log_state_changes(s);
+  log_state_changes(*s);
 }
 
-void RangerNode::log_state_changes(const LinkSnapshot& s) {
+void RangerNode::log_state_changes(const ranger::DriverSnapshot& s) {
+  const std::string& port = params_.port_name;
   if (s.bus_error != last_bus_error_) {
     if (!s.bus_error.empty()) {
-      ROS_ERROR("CAN interface %s: %s (retrying every %.1f s)", s.port_name.c_str(),
-                s.bus_error.c_str(),
-                std::chrono::duration<double>(params_.reconnect_interval).count());
-    } else {
-      ROS_INFO("CAN interface %s open", s.port_name.c_str());
+      if (is_socketcan(port)) {
+        ROS_ERROR(
+            "cannot open CAN interface %s: %s. Bring the adapter up with `rosrun "
+            "ranger_bringup bringup_can2usb.bash` (or `sudo ip link set %s up type can "
+            "bitrate 500000`); retrying every %.1f s",
+            port.c_str(), s.bus_error.c_str(), port.c_str(),
+            secs(params_.driver.reconnect_interval));
+      } else {
+        ROS_ERROR("cannot open %s: %s (retrying every %.1f s)", port.c_str(), s.bus_error.c_str(),
+                  secs(params_.driver.reconnect_interval));
+      }
     }
     last_bus_error_ = s.bus_error;
   }
-  if (!s.has_controller) return;
+  if (s.bus_open && !last_bus_open_) {
+    if (s.controller.link == ranger::LinkState::kNeverConnected) {
+      ROS_INFO("%s open: waiting for the chassis on %s", port.c_str(), port.c_str());
+    } else {
+      ROS_INFO("%s open", port.c_str());
+    }
+    waiting_since_ = s.now;
+    next_waiting_log_ = s.now + kWaitingReminder;
+  }
+  last_bus_open_ = s.bus_open;
+  if (!s.bus_open) return;
+
   const auto& c = s.controller;
+  if (c.link == ranger::LinkState::kNeverConnected && s.now >= next_waiting_log_) {
+    ROS_INFO(
+        "still waiting for the chassis on %s: nothing heard for %.0f s (is it powered on, "
+        "and the bus at 500 kbit/s?)",
+        port.c_str(), secs(s.now - waiting_since_));
+    next_waiting_log_ = s.now + kWaitingReminder;
+  }
   if (!last_link_ || *last_link_ != c.link) {
     if (c.link == ranger::LinkState::kConnected) {
-      ROS_INFO("chassis connected on %s", s.port_name.c_str());
+      if (last_link_ == ranger::LinkState::kStale) {
+        ROS_INFO("chassis heard again on %s: odometry resumes from the last pose", port.c_str());
+      } else {
+        ROS_INFO("chassis connected on %s", port.c_str());
+      }
     } else if (c.link == ranger::LinkState::kStale) {
-      ROS_ERROR("chassis silent on %s: no system status (0x211); commands stopped",
-                s.port_name.c_str());
+      ROS_WARN(
+          "chassis on %s went silent (no system status for %.2f s): motion stopped, no "
+          "odometry until it is heard again",
+          port.c_str(), secs(params_.driver.controller.link_timeout));
     }
     last_link_ = c.link;
   }
   if (!last_refusal_ || *last_refusal_ != c.refusal) {
-    if (c.refusal == ranger::MotionRefusal::kNone) {
-      ROS_INFO("chassis accepts motion commands");
-    } else if (c.refusal == ranger::MotionRefusal::kCmdTimeout) {
-      ROS_INFO("no cmd_vel for cmd_vel_timeout (%.2f s): chassis commanded to stop",
-               std::chrono::duration<double>(params_.controller.cmd_timeout).count());
-    } else {
-      ROS_WARN("chassis motion inhibited: %s", std::string(ranger::to_string(c.refusal)).c_str());
+    using R = ranger::MotionRefusal;
+    const std::string detail = describe_refusal(c);
+    switch (c.refusal) {
+      case R::kNone:
+        ROS_INFO("chassis accepts motion commands");
+        break;
+      case R::kLinkLost:  // the link messages above say it
+        break;
+      case R::kCmdTimeout:
+      case R::kModeUnknown:
+      case R::kSwitching:
+        ROS_INFO("%s", detail.c_str());
+        break;
+      case R::kStandby:
+        if (c.reclaim_blocked) {
+          ROS_WARN("motion refused: %s", detail.c_str());
+        } else {
+          ROS_INFO("%s", detail.c_str());
+        }
+        break;
+      default:
+        ROS_WARN("motion refused: %s", detail.c_str());
+        break;
     }
     last_refusal_ = c.refusal;
   }
   if (c.error_bits != last_error_bits_) {
-    std::string names;
-    for (const auto& n : protocol::error_bit_names(c.error_bits))
-      names += " " + n;
-    ROS_WARN("chassis error word 0x%08X:%s", c.error_bits,
-             names.empty() ? " (clear)" : names.c_str());
+    const auto names = protocol::error_bit_names(c.error_bits);
+    if (names.empty()) {
+      ROS_INFO("chassis errors cleared (error word %s)", hex_word(c.error_bits).c_str());
+    } else {
+      ROS_WARN("chassis error word %s: %s", hex_word(c.error_bits).c_str(), join(names).c_str());
+    }
     last_error_bits_ = c.error_bits;
+  }
+  for (const auto& id : s.frames.counts()) {
+    if (id.padded == 0 || padded_ids_reported_.count(id.id)) continue;
+    padded_ids_reported_.insert(id.id);
+    ROS_INFO("0x%03" PRIX32
+             " (%s) frames arrive longer than their layout: decoded from their "
+             "leading bytes, the rest ignored",
+             id.id, std::string(protocol::frame_name(id.id)).c_str());
   }
   if (c.last_solution && c.last_solution->flags != ranger::kKinematicsExact) {
     ROS_WARN_THROTTLE(5.0, "cmd_vel adjusted to what the chassis can do: %s",
@@ -275,88 +547,6 @@ void RangerNode::log_state_changes(const LinkSnapshot& s) {
 void RangerNode::publish_diagnostics() {
   diagnostics_->refresh();
   updater_.update();
-}
-
-bool RangerNode::on_clear_errors(ranger_msgs::ClearErrors::Request& req,
-                                 ranger_msgs::ClearErrors::Response& res) {
-  if (req.code > protocol::kMaxErrorClearCode) {
-    res.success = false;
-    res.message = "code " + std::to_string(req.code) + " is not an error-clearing code (valid 0.." +
-                  std::to_string(protocol::kMaxErrorClearCode) + ")";
-  } else if (const ranger::Status st = link_->clear_errors(req.code); !st) {
-    res.success = false;
-    res.message = st.error().message;
-  } else {
-    res.success = true;
-    res.message = "sent 0x441 code " + std::to_string(req.code) + ": clears " +
-                  protocol::error_clear_description(req.code);
-  }
-  res.error_word = link_->snapshot().controller.error_bits;
-  if (res.success) ROS_INFO("clear_errors: %s", res.message.c_str());
-  return true;
-}
-
-bool RangerNode::on_set_ultrasonic(ranger_msgs::SetUltrasonic::Request& req,
-                                   ranger_msgs::SetUltrasonic::Response& res) {
-  if (const ranger::Status st = link_->set_ultrasonic(req.enable); !st) {
-    res.success = false;
-    res.message = st.error().message;
-    return true;
-  }
-  // Wait (on this service thread only) until the chassis confirms via 0x45A or the controller
-  // gives up; the controller resends meanwhile.
-  const auto deadline = std::chrono::steady_clock::now() + confirmation_budget(params_.controller);
-  while (ros::ok()) {
-    const auto c = link_->snapshot().controller;
-    if (c.ultrasonic_enabled && *c.ultrasonic_enabled == req.enable && !c.ultrasonic_requested) {
-      res.success = true;
-      res.enabled = req.enable;
-      res.message = std::string("ultrasonic avoidance ") + (req.enable ? "enabled" : "disabled") +
-                    " (confirmed by the chassis)";
-      return true;
-    }
-    if (c.ultrasonic_failed || std::chrono::steady_clock::now() > deadline) {
-      res.success = false;
-      res.enabled = c.ultrasonic_enabled.value_or(false);
-      res.message = "the chassis did not confirm the ultrasonic setting (0x45A)";
-      return true;
-    }
-    ros::WallDuration(0.01).sleep();
-  }
-  res.success = false;
-  res.message = "shutting down";
-  return true;
-}
-
-bool RangerNode::on_set_motion_mode(ranger_msgs::SetMotionMode::Request& req,
-                                    ranger_msgs::SetMotionMode::Response& res) {
-  using Req = ranger_msgs::SetMotionMode::Request;
-  std::optional<protocol::MotionMode> mode;
-  switch (req.mode) {
-    case Req::ACKERMANN:
-      mode = protocol::MotionMode::kAckermann;
-      break;
-    case Req::OBLIQUE:
-      mode = protocol::MotionMode::kOblique;
-      break;
-    case Req::SPIN:
-      mode = protocol::MotionMode::kSpin;
-      break;
-    case Req::AUTOMATIC:
-      break;
-    default:
-      res.success = false;
-      res.message = "mode " + std::to_string(req.mode) +
-                    " unknown: use 0 (Ackermann), 1 (oblique), 2 (spin) or 255 (automatic)";
-      return true;
-  }
-  link_->request_motion_mode(mode);
-  res.success = true;
-  res.message = mode ? "motion mode pinned to " + std::string(protocol::to_string(*mode)) +
-                           " (the switch happens at standstill)"
-                     : "automatic motion-mode selection";
-  ROS_INFO("set_motion_mode: %s", res.message.c_str());
-  return true;
 }
 
 }  // namespace ranger_base

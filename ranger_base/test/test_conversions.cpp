@@ -7,6 +7,7 @@
 #include <set>
 
 #include <ranger_can/control/geometry.hpp>
+#include <ranger_can/wire/codec.hpp>
 #include <ranger_can/wire/protocol.hpp>
 
 #include "ranger_base/conversions.hpp"
@@ -75,7 +76,9 @@ TEST(NamedBits, BmsStatusBytesMapToTheirOwnFields) {
 // ---- system state ----------------------------------------------------------------------------
 
 TEST(SystemState, CarriesModesRawWordAndActiveNames) {
-  ranger::ControllerState st;
+  ranger::DriverSnapshot snap;
+  ranger::ControllerState& st = snap.controller;
+  ranger::ChassisFeedback& fb = snap.feedback;
   st.link = ranger::LinkState::kConnected;
   ranger::SystemStatus status;
   status.control_mode = protocol::ControlMode::kRemote;
@@ -83,17 +86,17 @@ TEST(SystemState, CarriesModesRawWordAndActiveNames) {
   status.vehicle_status = protocol::VehicleStatus::kEmergencyStop;
   status.vehicle_status_raw = 1;
   status.battery_voltage = 51.2;
-  st.feedback.system_status = ranger::Stamped<ranger::SystemStatus>{status, 1s, 1s};
+  fb.system_status = ranger::Stamped<ranger::SystemStatus>{status, 1s, 1s};
   ranger::MotionModeFeedback mode;
   mode.mode = protocol::MotionMode::kSpin;
   mode.mode_raw = 2;
   mode.switching = true;
-  st.feedback.motion_mode = ranger::Stamped<ranger::MotionModeFeedback>{mode, 1s, 1s};
+  fb.motion_mode = ranger::Stamped<ranger::MotionModeFeedback>{mode, 1s, 1s};
   const auto& bits = protocol::system_error_bits();
   st.error_bits = (1u << bits.front().index) | (1u << bits.back().index);
   st.refusal = ranger::MotionRefusal::kRemote;
 
-  const auto msg = to_system_state(st, ros::Time(10.0));
+  const auto msg = to_system_state(snap, ros::Time(10.0));
   EXPECT_TRUE(msg.link_up);
   EXPECT_EQ(msg.control_mode, ranger_msgs::SystemState::CONTROL_MODE_REMOTE);
   EXPECT_EQ(msg.vehicle_status, ranger_msgs::SystemState::VEHICLE_STATUS_EMERGENCY_STOP);
@@ -103,15 +106,78 @@ TEST(SystemState, CarriesModesRawWordAndActiveNames) {
   EXPECT_EQ(msg.error_word, st.error_bits);
   ASSERT_EQ(msg.active_errors.size(), 2u);
   EXPECT_EQ(msg.motion_inhibited_reason, "remote");
+  EXPECT_NE(msg.motion_inhibited_detail.find("remote control"), std::string::npos);
   EXPECT_EQ(msg.control_mode_name,
             std::string(protocol::to_string(protocol::ControlMode::kRemote)));
 }
 
 TEST(SystemState, UnknownBeforeTheFirstFrame) {
-  const auto msg = to_system_state(ranger::ControllerState{}, ros::Time(1.0));
+  const ranger::DriverSnapshot nothing_yet;
+  const auto msg = to_system_state(nothing_yet, ros::Time(1.0));
   EXPECT_FALSE(msg.link_up);
+  EXPECT_FALSE(msg.motion_known);
   EXPECT_EQ(msg.control_mode_name, "unknown");
   EXPECT_EQ(msg.motion_mode_name, "unknown");
+}
+
+TEST(SystemState, ReArmNamesTheLatchedCausesAndWhatToDo) {
+  ranger::DriverSnapshot snap;
+  auto& c = snap.controller;
+  c.link = ranger::LinkState::kConnected;
+  c.refusal = ranger::MotionRefusal::kRearmRequired;
+  c.latched_causes = 0u | ranger::StopCause::kEstop;
+  const auto msg = to_system_state(snap, ros::Time(1.0));
+  EXPECT_TRUE(msg.rearm_required);
+  EXPECT_EQ(msg.motion_inhibited_reason, "rearm_required");
+  EXPECT_EQ(msg.latched_causes, std::vector<std::string>{"emergency_stop"});
+  EXPECT_TRUE(msg.active_causes.empty());
+  EXPECT_NE(msg.motion_inhibited_detail.find("after emergency_stop"), std::string::npos)
+      << msg.motion_inhibited_detail;
+  EXPECT_NE(msg.motion_inhibited_detail.find("resume"), std::string::npos);
+
+  c.latched_causes = c.latched_causes | ranger::StopCause::kRemote;
+  c.active_causes = 0u | ranger::StopCause::kEstop;
+  EXPECT_EQ(to_system_state(snap, ros::Time(1.0)).latched_causes,
+            (std::vector<std::string>{"remote", "emergency_stop"}));
+  EXPECT_EQ(to_system_state(snap, ros::Time(1.0)).active_causes,
+            std::vector<std::string>{"emergency_stop"});
+}
+
+TEST(SystemState, ReclaimBlockedSteerFirstAndBelowMinimumAreSaid) {
+  ranger::ControllerState c;
+  c.link = ranger::LinkState::kConnected;
+  c.refusal = ranger::MotionRefusal::kStandby;
+  c.reclaim_blocked = true;
+  EXPECT_EQ(describe_refusal(c), "remote control had the chassis: call resume to take CAN control");
+  c.reclaim_blocked = false;
+  c.refusal = ranger::MotionRefusal::kBelowMinimum;
+  EXPECT_NE(describe_refusal(c).find("below_minimum"), std::string::npos);
+  c.refusal = ranger::MotionRefusal::kNone;
+  EXPECT_EQ(describe_refusal(c), "");
+  c.steer_first_factor = 0.25;
+  EXPECT_NE(describe_refusal(c).find("steering first"), std::string::npos);
+  EXPECT_NE(describe_refusal(c).find("25 %"), std::string::npos) << describe_refusal(c);
+  ranger::DriverSnapshot snap;
+  snap.controller = c;
+  EXPECT_FLOAT_EQ(to_system_state(snap, ros::Time(1.0)).steer_first_factor, 0.25f);
+}
+
+// ---- cmd_vel_out -------------------------------------------------------------------------------
+
+TEST(CmdVelOut, OnlyMotionCommandsCarryATwistAndTheShutdownStopIsZero) {
+  ranger::SentEvent motion;
+  motion.sent.message = ranger::MotionCommand{};
+  motion.sent.achieved = {0.3, 0.0, 0.1};
+  ASSERT_TRUE(achieved_twist(motion));
+  EXPECT_DOUBLE_EQ(achieved_twist(motion)->vx, 0.3);
+  ranger::SentEvent stop;
+  stop.sent.message = ranger::MotionCommand{};
+  stop.sent.shutdown = true;
+  ASSERT_TRUE(achieved_twist(stop));
+  EXPECT_DOUBLE_EQ(achieved_twist(stop)->vx, 0.0);
+  ranger::SentEvent other;
+  other.sent.message = ranger::ControlModeCommand{protocol::ControlMode::kCan};
+  EXPECT_FALSE(achieved_twist(other));
 }
 
 // ---- odometry ---------------------------------------------------------------------------------
@@ -126,8 +192,12 @@ TEST(Odometry, PoseTwistFramesAndCovariance) {
   o.pose = {1.0, -2.0, 0.75};
   o.twist = {0.5, 0.1, -0.2};
   o.pose_variance = {0.5, 0.6, 0.7};
+  o.stamp = std::chrono::seconds(1700000000) + 250ms;  // the frames' time (bus clock)
 
-  const auto msg = to_odometry(o, p, ros::Time(5.0));
+  const auto msg = to_odometry(o, p);
+  // Stamped with the frames that produced it, not with the time of publication.
+  EXPECT_EQ(msg.header.stamp.sec, 1700000000u);
+  EXPECT_EQ(msg.header.stamp.nsec, 250000000u);
   EXPECT_EQ(msg.header.frame_id, "r1/odom");
   EXPECT_EQ(msg.child_frame_id, "r1/base_link");
   EXPECT_DOUBLE_EQ(msg.pose.pose.position.x, 1.0);
@@ -156,7 +226,7 @@ TEST(Odometry, PoseTwistFramesAndCovariance) {
 }
 
 TEST(JointState, NamesComeFromTheSharedGeometryHeader) {
-  WheelJoints j;
+  ranger::WheelJoints j;
   j.steering_position = {0.1, 0.2, 0.3, 0.4};
   j.wheel_position = {1, 2, 3, 4};
   j.wheel_velocity = {5, 6, 7, 8};
@@ -174,6 +244,14 @@ TEST(JointState, NamesComeFromTheSharedGeometryHeader) {
   }
 }
 
+TEST(JointState, StampedWithTheNewestWheelFrame) {
+  ranger::ChassisFeedback fb;
+  EXPECT_EQ(joints_stamp(fb), ranger::Timestamp{0});
+  fb.steering_angles = ranger::Stamped<ranger::SteeringAnglesFeedback>{{}, 5s, 7s};
+  fb.wheel_speeds = ranger::Stamped<ranger::WheelSpeedsFeedback>{{}, 5s, 8s};
+  EXPECT_EQ(joints_stamp(fb), ranger::Timestamp{8s});  // the frame stamps, not arrival times
+}
+
 // ---- battery ----------------------------------------------------------------------------------
 
 ranger::Stamped<ranger::BmsData> bms(int battery, double soc, double voltage, ranger::Timestamp t) {
@@ -187,44 +265,52 @@ ranger::Stamped<ranger::BmsData> bms(int battery, double soc, double voltage, ra
 }
 
 TEST(Battery, PercentageIsAFractionAndSlotsReportPresence) {
-  ranger::ControllerState st;
-  st.feedback.bms[0] = bms(0, 87.0, 52.1, 10s);
-  st.feedback.bms[2] = bms(2, 80.0, 52.0, 10s);
-  st.feedback.bms[3] = bms(3, 80.0, 51.0, 1s);  // stale: removed long ago
-  const auto msg = to_battery_state(st, 10s + 100ms, ros::Time(3.0));
+  ranger::ChassisFeedback fb;
+  fb.bms[0] = bms(0, 87.0, 52.1, 10s);
+  fb.bms[2] = bms(2, 80.0, 52.0, 10s);
+  fb.bms[3] = bms(3, 80.0, 51.0, 1s);  // stale: removed long ago
+  const auto msg = to_battery_state(fb, 10s + 100ms, ros::Time(3.0));
   EXPECT_TRUE(msg.present);
   EXPECT_NEAR(msg.percentage, 0.87, 1e-6);
   EXPECT_NEAR(msg.voltage, 52.1, 1e-4);
   EXPECT_NEAR(msg.current, -3.0, 1e-6);
   EXPECT_EQ(msg.power_supply_status, sensor_msgs::BatteryState::POWER_SUPPLY_STATUS_DISCHARGING);
+  // The RANGER's pack is LiFePO4 (user manual), whatever the BMS says.
+  EXPECT_EQ(msg.power_supply_technology, sensor_msgs::BatteryState::POWER_SUPPLY_TECHNOLOGY_LIFE);
+  EXPECT_DOUBLE_EQ(msg.header.stamp.toSec(), 10.0);  // the BMS frame's own time
   ASSERT_EQ(msg.cell_voltage.size(), 4u);
   EXPECT_TRUE(std::isnan(msg.cell_voltage[0]));  // slot 1 never reported
   EXPECT_NEAR(msg.cell_voltage[1], 52.0, 1e-4);  // slot 2
   EXPECT_TRUE(std::isnan(msg.cell_voltage[2]));  // slot 3 stale
   EXPECT_TRUE(std::isnan(msg.cell_voltage[3]));
 
-  const auto array = to_bms_state(st.feedback, TimeMapper(ros::Time(3.0), 10s + 100ms), 10s + 100ms,
-                                  ros::Time(3.0));
+  const auto array = to_bms_state(fb, 10s + 100ms, ros::Time(3.0));
   ASSERT_EQ(array.batteries.size(), 5u);
   EXPECT_TRUE(array.batteries[0].present);
   EXPECT_FALSE(array.batteries[1].present);
   EXPECT_TRUE(array.batteries[2].present);
   EXPECT_FALSE(array.batteries[3].present);
-  EXPECT_NEAR(array.batteries[2].header.stamp.toSec(), 2.9, 1e-6);
+  EXPECT_NEAR(array.batteries[2].header.stamp.toSec(), 10.0, 1e-6);
 }
 
 TEST(Battery, PercentageStaysInZeroToOne) {
-  ranger::ControllerState st;
-  st.feedback.bms[0] = bms(0, 250.0, 52.1, 1s);
-  EXPECT_FLOAT_EQ(to_battery_state(st, 1s, ros::Time(1.0)).percentage, 1.0f);
+  ranger::ChassisFeedback fb;
+  fb.bms[0] = bms(0, 250.0, 52.1, 1s);
+  EXPECT_FLOAT_EQ(to_battery_state(fb, 1s, ros::Time(1.0)).percentage, 1.0f);
+}
+
+TEST(Battery, TheManualsPackDesign) {
+  EXPECT_DOUBLE_EQ(pack_design().nominal_voltage, 48.0);
+  EXPECT_DOUBLE_EQ(pack_design().normal_min_voltage, 46.0);
+  EXPECT_DOUBLE_EQ(pack_design().normal_max_voltage, 50.0);
 }
 
 TEST(Battery, WithoutBmsTheStatusVoltageIsUsedAndPercentageUnknown) {
-  ranger::ControllerState st;
+  ranger::ChassisFeedback fb;
   ranger::SystemStatus status;
   status.battery_voltage = 49.5;
-  st.feedback.system_status = ranger::Stamped<ranger::SystemStatus>{status, 1s, 1s};
-  const auto msg = to_battery_state(st, 1s, ros::Time(1.0));
+  fb.system_status = ranger::Stamped<ranger::SystemStatus>{status, 1s, 1s};
+  const auto msg = to_battery_state(fb, 1s, ros::Time(1.0));
   EXPECT_NEAR(msg.voltage, 49.5, 1e-4);
   EXPECT_TRUE(std::isnan(msg.percentage));
 }
@@ -232,8 +318,8 @@ TEST(Battery, WithoutBmsTheStatusVoltageIsUsedAndPercentageUnknown) {
 // ---- ultrasonic -------------------------------------------------------------------------------
 
 TEST(Ultrasonic, RangeFollowsRep117) {
-  UltrasonicRangeParameters p;
-  p.max_range = 4.0;
+  NodeParameters p;
+  p.ultrasonic.max_range = 4.0;
   const auto ok = to_range(3, 1234, p, ros::Time(1.0));
   EXPECT_EQ(ok.header.frame_id, "ultrasonic_3_link");
   EXPECT_EQ(ok.radiation_type, sensor_msgs::Range::ULTRASOUND);
@@ -242,18 +328,37 @@ TEST(Ultrasonic, RangeFollowsRep117) {
   EXPECT_TRUE(std::isinf(to_range(1, 5000, p, ros::Time(1.0)).range));
 }
 
+TEST(Ultrasonic, FramesArePrefixedLikeEveryOtherFrame) {
+  NodeParameters p;
+  p.frame_prefix = "robot1/";
+  EXPECT_EQ(to_range(1, 500, p, ros::Time(1.0)).header.frame_id, "robot1/ultrasonic_1_link");
+}
+
+// Whatever raw value the library does not call "ok" (an error code, and "no reading" for 0 once
+// the library names it so) is NaN; the node follows the library's name, not a raw comparison.
+TEST(Ultrasonic, EveryValueTheLibraryDoesNotCallOkIsNaN) {
+  NodeParameters p;
+  for (int raw = -5; raw <= 5; ++raw) {
+    const auto r = static_cast<std::int16_t>(raw);
+    const bool ok = protocol::ultrasonic_status_name(r) == "ok";
+    EXPECT_EQ(std::isnan(to_range(1, r, p, ros::Time(1.0)).range), !ok) << raw;
+    EXPECT_EQ(std::isnan(ultrasonic_range_m(r)), !ok) << raw;
+  }
+}
+
 TEST(Ultrasonic, StateListsSensorsInOrderWithStatusNames) {
-  ranger::ControllerState st;
+  ranger::DriverSnapshot snap;
+  ranger::ControllerState& st = snap.controller;
   ranger::UltrasonicFeedback back;
   back.first_sensor = 5;
   back.raw = {100, -1, -2, 300};
   ranger::UltrasonicFeedback front;
   front.first_sensor = 1;
   front.raw = {1000, 2000, 3000, 4000};
-  st.feedback.ultrasonic[1] = ranger::Stamped<ranger::UltrasonicFeedback>{back, 1s, 1s};
-  st.feedback.ultrasonic[0] = ranger::Stamped<ranger::UltrasonicFeedback>{front, 1s, 1s};
+  snap.feedback.ultrasonic[1] = ranger::Stamped<ranger::UltrasonicFeedback>{back, 1s, 1s};
+  snap.feedback.ultrasonic[0] = ranger::Stamped<ranger::UltrasonicFeedback>{front, 1s, 1s};
   st.ultrasonic_enabled = true;
-  const auto msg = to_ultrasonic_state(st, ros::Time(1.0));
+  const auto msg = to_ultrasonic_state(snap, ros::Time(1.0));
   EXPECT_TRUE(msg.avoidance_known);
   EXPECT_TRUE(msg.avoidance_enabled);
   ASSERT_EQ(msg.sensors.size(), 8u);
@@ -272,8 +377,8 @@ TEST(Actuators, EightMotorsWithTheirJoints) {
   ranger::MotorLowSpeedFeedback low;
   low.motor = 6;
   low.driver_status = 0x40;  // bit 6: driver disabled
-  fb.motor_low_speed[5] = ranger::Stamped<ranger::MotorLowSpeedFeedback>{low, 2s, 2s};
-  const auto msg = to_actuator_state(fb, TimeMapper(ros::Time(100.0), 3s), ros::Time(100.0));
+  fb.motor_low_speed[5] = ranger::Stamped<ranger::MotorLowSpeedFeedback>{low, 2s, 99s};
+  const auto msg = to_actuator_state(fb, ros::Time(100.0));
   ASSERT_EQ(msg.actuators.size(), 8u);
   EXPECT_EQ(msg.actuators[0].joint_name, ranger::kWheelJointNames[0]);
   EXPECT_EQ(msg.actuators[5].joint_name, ranger::kSteeringJointNames[1]);
@@ -283,10 +388,9 @@ TEST(Actuators, EightMotorsWithTheirJoints) {
   EXPECT_TRUE(msg.actuators[0].high_speed_stamp.isZero());
 }
 
-TEST(TimeMapper, MapsLinkTimeToRosTime) {
-  const TimeMapper m(ros::Time(1000.0), 50s);
-  EXPECT_NEAR(m.to_ros(49500ms).toSec(), 999.5, 1e-9);
-  EXPECT_TRUE(m.to_ros(ranger::Timestamp{0}).isZero());
+TEST(Time, BusStampsAreRosTime) {
+  EXPECT_NEAR(to_ros_time(std::chrono::seconds(1700000000) + 500ms).toSec(), 1700000000.5, 1e-6);
+  EXPECT_TRUE(to_ros_time(ranger::Timestamp{0}).isZero());
 }
 
 TEST(CmdVel, PlanarComponentsOnly) {

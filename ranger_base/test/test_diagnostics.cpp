@@ -14,11 +14,10 @@ using diagnostic_updater::DiagnosticStatusWrapper;
 using namespace std::chrono_literals;
 namespace protocol = ranger::protocol;
 
-LinkSnapshot healthy() {
-  LinkSnapshot s;
-  s.port_name = "can0";
+DriverSnapshot healthy() {
+  DriverSnapshot s;
+  s.bus_name = "can0";
   s.bus_open = true;
-  s.has_controller = true;
   s.controller.link = ranger::LinkState::kConnected;
   s.controller.control_mode = protocol::ControlMode::kCan;
   s.controller.refusal = ranger::MotionRefusal::kNone;
@@ -33,8 +32,8 @@ std::string value(const DiagnosticStatusWrapper& d, const std::string& key) {
 }
 
 TEST(Diagnostics, MissingAdapterIsAnErrorNamingThePort) {
-  LinkSnapshot s;
-  s.port_name = "can0";
+  DriverSnapshot s;
+  s.bus_name = "can0";
   s.bus_error = "can0: no such interface";
   DiagnosticStatusWrapper d;
   diagnose_link(s, d);
@@ -72,6 +71,44 @@ TEST(Diagnostics, RemoteControlIsAWarning) {
   EXPECT_EQ(value(d, "Control mode"), "remote");
 }
 
+TEST(Diagnostics, ReArmRequiredIsAWarningNamingTheCause) {
+  auto s = healthy();
+  s.controller.refusal = ranger::MotionRefusal::kRearmRequired;
+  s.controller.latched_causes = 0u | ranger::StopCause::kEstop;
+  DiagnosticStatusWrapper d;
+  diagnose_control(s, d);
+  EXPECT_EQ(d.level, DiagnosticStatus::WARN);
+  EXPECT_NE(d.message.find("rearm_required after emergency_stop"), std::string::npos) << d.message;
+  EXPECT_EQ(value(d, "Re-arm required"), "yes");
+  EXPECT_EQ(value(d, "Latched stop causes"), "emergency_stop");
+}
+
+TEST(Diagnostics, ReclaimBlockedAfterRemoteSaysToCallResume) {
+  auto s = healthy();
+  s.controller.control_mode = protocol::ControlMode::kStandby;
+  s.controller.refusal = ranger::MotionRefusal::kStandby;
+  s.controller.reclaim_blocked = true;
+  DiagnosticStatusWrapper d;
+  diagnose_control(s, d);
+  EXPECT_EQ(d.level, DiagnosticStatus::WARN);
+  EXPECT_EQ(d.message, "remote control had the chassis: call resume to take CAN control");
+}
+
+TEST(Diagnostics, SteerFirstAndBelowMinimumAreShown) {
+  auto s = healthy();
+  s.controller.steer_first_factor = 0.5;
+  DiagnosticStatusWrapper steering;
+  diagnose_control(s, steering);
+  EXPECT_EQ(steering.level, DiagnosticStatus::OK);
+  EXPECT_NE(steering.message.find("steering first"), std::string::npos) << steering.message;
+  s.controller.steer_first_factor = 1.0;
+  s.controller.refusal = ranger::MotionRefusal::kBelowMinimum;
+  DiagnosticStatusWrapper below;
+  diagnose_control(s, below);
+  EXPECT_EQ(below.level, DiagnosticStatus::WARN);
+  EXPECT_NE(below.message.find("below_minimum"), std::string::npos) << below.message;
+}
+
 TEST(Diagnostics, IdleAfterCmdVelTimeoutIsOk) {
   auto s = healthy();
   s.controller.refusal = ranger::MotionRefusal::kCmdTimeout;
@@ -87,7 +124,7 @@ TEST(Diagnostics, FaultsAreListedByNameAndStoppingOnesAreErrors) {
   diagnose_errors(s, warn);
   EXPECT_EQ(warn.level, DiagnosticStatus::WARN);
   EXPECT_EQ(value(warn, "motor_driver_1_communication_fault"), "active");
-  s.controller.estop = true;
+  s.controller.active_causes = 0u | ranger::StopCause::kEstop;
   s.controller.faults.push_back("emergency_stop");
   DiagnosticStatusWrapper error;
   diagnose_errors(s, error);
@@ -101,31 +138,36 @@ TEST(Diagnostics, LowBatteryIsAnError) {
   auto s = healthy();
   ranger::BmsData d;
   d.soc = 8.0;
-  s.controller.feedback.bms[0] = ranger::Stamped<ranger::BmsData>{d, 1s, 1s};
-  s.controller.low_battery = true;
+  s.feedback.bms[0] = ranger::Stamped<ranger::BmsData>{d, 1s, 1s};
+  s.controller.active_causes = 0u | ranger::StopCause::kLowBattery;
   DiagnosticStatusWrapper out;
   diagnose_battery(s, out);
   EXPECT_EQ(out.level, DiagnosticStatus::ERROR);
 }
 
-TEST(Diagnostics, FrameRatesFromCountsOverTheLinkClock) {
+TEST(Diagnostics, FrameRatesPerIdFromTheSnapshotAndRejectsWarn) {
   FrameRateMonitor monitor;
   auto s = healthy();
-  s.now = ranger::Timestamp(10s);
-  s.frames_by_id[protocol::kSystemStatusId] = 100;
-  DiagnosticStatusWrapper first;
-  monitor.diagnose(s, first);
-  s.now = ranger::Timestamp(12s);
-  s.frames_by_id[protocol::kSystemStatusId] = 200;  // 50 Hz
-  DiagnosticStatusWrapper second;
-  monitor.diagnose(s, second);
-  EXPECT_EQ(second.level, DiagnosticStatus::OK) << second.message;
-  EXPECT_EQ(std::stod(value(second, "0x211 system_status (Hz)")), 50.0);
-  s.now = ranger::Timestamp(14s);
-  s.frames_by_id[protocol::kSystemStatusId] = 210;  // 5 Hz: frames lost
-  DiagnosticStatusWrapper third;
-  monitor.diagnose(s, third);
-  EXPECT_EQ(third.level, DiagnosticStatus::WARN);
+  // 50 Hz of 0x211 over the stats' window, as the driver records them.
+  for (int i = 0; i < 100; ++i) {
+    s.frames.record(protocol::kSystemStatusId, ranger::Timestamp(10s) + i * 20ms, true, 0);
+  }
+  s.now = ranger::Timestamp(10s) + 2s;
+  DiagnosticStatusWrapper ok;
+  monitor.diagnose(s, ok);
+  EXPECT_EQ(ok.level, DiagnosticStatus::OK) << ok.message;
+  EXPECT_NEAR(std::stod(value(ok, "0x211 system_status (Hz)")), 50.0, 5.0);
+  // A padded frame is counted and shown; a rejected one turns the status to WARN once.
+  s.frames.record(protocol::kMotionFeedbackId, s.now, true, 2);
+  s.frames.record(protocol::kMotionFeedbackId, s.now, false, 0);
+  DiagnosticStatusWrapper rejected;
+  monitor.diagnose(s, rejected);
+  EXPECT_EQ(rejected.level, DiagnosticStatus::WARN) << rejected.message;
+  EXPECT_EQ(value(rejected, "0x221 longer than its layout"), "1");
+  EXPECT_EQ(value(rejected, "0x221 rejected"), "1");
+  DiagnosticStatusWrapper later;
+  monitor.diagnose(s, later);
+  EXPECT_EQ(later.level, DiagnosticStatus::OK) << later.message;  // nothing new rejected
 }
 
 }  // namespace

@@ -5,8 +5,6 @@
 #include <sstream>
 #include <string>
 
-#include <ranger_can/wire/interpretation.hpp>
-
 #include "ranger_base/parameters.hpp"
 
 namespace ranger_base {
@@ -37,19 +35,105 @@ TEST(Parameters, DefaultsMatchTheLibraryAndTheIssue) {
   EXPECT_EQ(p->port_name, "can0");
   EXPECT_EQ(p->odom_frame, "odom");
   EXPECT_EQ(p->base_frame, "base_link");
+  EXPECT_EQ(p->frame_prefix, "");
   EXPECT_TRUE(p->publish_odom_tf);
   EXPECT_DOUBLE_EQ(p->publish_rate, 50.0);
-  EXPECT_EQ(p->controller.cmd_timeout, 500ms);
-  EXPECT_TRUE(p->controller.auto_command_mode);
-  EXPECT_EQ(p->odometry.source, ranger::OdometrySource::kWheels);
-  const ranger::VehicleGeometry defaults;
-  EXPECT_DOUBLE_EQ(p->controller.geometry.wheelbase, defaults.wheelbase);
-  EXPECT_DOUBLE_EQ(p->odometry.geometry.track, defaults.track);
-  EXPECT_DOUBLE_EQ(p->sim.geometry.wheel_radius, defaults.wheel_radius);
+  EXPECT_EQ(p->driver.odometry.source, ranger::OdometrySource::kWheels);
   EXPECT_FALSE(p->is_sim());
   // The vendor node's complaint: zero covariance. Ours is never zero on the planar axes.
   EXPECT_GT(p->pose_covariance_diagonal[0], 0.0);
   EXPECT_GT(p->twist_covariance_diagonal[5], 0.0);
+}
+
+// Every node default that has a library counterpart is the library's: the node and
+// `ranger_can scenario` behave alike.
+TEST(Parameters, EveryDefaultIsTheLibrarysOwn) {
+  MapParameterSource source;
+  auto p = load_parameters(source);
+  ASSERT_TRUE(p.ok()) << p.error().message;
+  const ranger::DriverConfig d;
+  const auto& c = p->driver.controller;
+  EXPECT_EQ(p->driver.reconnect_interval, d.reconnect_interval);
+  EXPECT_EQ(p->driver.request_answer_timeout, d.request_answer_timeout);
+  EXPECT_EQ(c.cmd_timeout, d.controller.cmd_timeout);
+  EXPECT_EQ(c.auto_command_mode, d.controller.auto_command_mode);
+  EXPECT_EQ(c.auto_reclaim_after_remote, d.controller.auto_reclaim_after_remote);
+  EXPECT_FALSE(c.auto_reclaim_after_remote);
+  EXPECT_EQ(c.link_timeout, d.controller.link_timeout);
+  EXPECT_EQ(c.min_command_interval, d.controller.min_command_interval);
+  EXPECT_EQ(c.mode_switch_timeout, d.controller.mode_switch_timeout);
+  EXPECT_EQ(c.mode_switch_max_attempts, d.controller.mode_switch_max_attempts);
+  EXPECT_DOUBLE_EQ(c.standstill_speed, d.controller.standstill_speed);
+  EXPECT_DOUBLE_EQ(c.steer_first_threshold, d.controller.steer_first_threshold);
+  EXPECT_DOUBLE_EQ(c.low_battery_soc, d.controller.low_battery_soc);
+  EXPECT_DOUBLE_EQ(c.geometry.wheelbase, d.controller.geometry.wheelbase);
+  EXPECT_DOUBLE_EQ(c.geometry.track, d.controller.geometry.track);
+  EXPECT_DOUBLE_EQ(c.geometry.wheel_radius, d.controller.geometry.wheel_radius);
+  EXPECT_DOUBLE_EQ(p->driver.odometry.geometry.track, d.odometry.geometry.track);
+  EXPECT_DOUBLE_EQ(p->sim.chassis.geometry.wheel_radius, d.controller.geometry.wheel_radius);
+  EXPECT_DOUBLE_EQ(c.limits.max_linear_speed, d.controller.limits.max_linear_speed);
+  EXPECT_DOUBLE_EQ(c.limits.max_speed_at_large_steering,
+                   d.controller.limits.max_speed_at_large_steering);
+  EXPECT_DOUBLE_EQ(c.limits.max_ackermann_steering, d.controller.limits.max_ackermann_steering);
+  EXPECT_DOUBLE_EQ(c.limits.max_oblique_steering, d.controller.limits.max_oblique_steering);
+  EXPECT_DOUBLE_EQ(c.limits.max_spin_wheel_speed, d.controller.limits.max_spin_wheel_speed);
+  for (const auto* axis : {&c.limit_vx, &c.limit_vy, &c.limit_wz}) {
+    const ranger::SpeedLimits l;
+    EXPECT_EQ(axis->has_velocity_limits, l.has_velocity_limits);
+    EXPECT_EQ(axis->has_acceleration_limits, l.has_acceleration_limits);
+    EXPECT_DOUBLE_EQ(axis->max_velocity, l.max_velocity);
+    EXPECT_DOUBLE_EQ(axis->max_acceleration, l.max_acceleration);
+  }
+  const auto& m = c.mode_selection;
+  const auto& dm = d.controller.mode_selection;
+  EXPECT_DOUBLE_EQ(m.lateral_enter, dm.lateral_enter);
+  EXPECT_DOUBLE_EQ(m.lateral_exit, dm.lateral_exit);
+  EXPECT_DOUBLE_EQ(m.linear_enter, dm.linear_enter);
+  EXPECT_DOUBLE_EQ(m.linear_exit, dm.linear_exit);
+  EXPECT_DOUBLE_EQ(m.rotation_enter, dm.rotation_enter);
+  EXPECT_DOUBLE_EQ(m.rotation_exit, dm.rotation_exit);
+  EXPECT_DOUBLE_EQ(m.min_linear_speed, dm.min_linear_speed);
+  EXPECT_DOUBLE_EQ(m.min_yaw_rate, dm.min_yaw_rate);
+  EXPECT_EQ(m.confirm_time, dm.confirm_time);
+  EXPECT_EQ(m.min_dwell, dm.min_dwell);
+  EXPECT_DOUBLE_EQ(m.oblique_side_band, dm.oblique_side_band);
+  const auto& o = p->driver.odometry;
+  EXPECT_EQ(o.source, d.odometry.source);
+  EXPECT_EQ(o.wheel_data_timeout, d.odometry.wheel_data_timeout);
+  EXPECT_DOUBLE_EQ(o.pose_variance_per_meter, d.odometry.pose_variance_per_meter);
+  EXPECT_DOUBLE_EQ(o.yaw_variance_per_radian, d.odometry.yaw_variance_per_radian);
+  EXPECT_DOUBLE_EQ(o.yaw_variance_per_meter, d.odometry.yaw_variance_per_meter);
+  EXPECT_DOUBLE_EQ(p->twist_covariance_diagonal[0], d.odometry.twist_variance_linear);
+  EXPECT_DOUBLE_EQ(p->twist_covariance_diagonal[5], d.odometry.twist_variance_angular);
+  const ranger::sim::VirtualChassisConfig v;
+  EXPECT_DOUBLE_EQ(p->sim.chassis.initial_soc, v.initial_soc);
+  EXPECT_EQ(p->sim.chassis.mode_switch_duration, v.mode_switch_duration);
+  EXPECT_EQ(p->sim.chassis.boot_in_remote_mode, v.boot_in_remote_mode);
+  EXPECT_EQ(p->sim.chassis.ultrasonic, v.ultrasonic);
+  EXPECT_EQ(p->sim.boot_error_bits, 0u);
+}
+
+TEST(Parameters, PortNamesAreWhatTheBusFactoryAccepts) {
+  for (const char* ok : {"can0", "vcan0", "sim", "sim:manual", "replay:/tmp/drive.log"}) {
+    MapParameterSource source;
+    source.values["port_name"] = ok;
+    auto p = load_parameters(source);
+    EXPECT_TRUE(p.ok()) << ok << ": " << p.error().message;
+  }
+  MapParameterSource sim;
+  sim.values["port_name"] = "sim:manual";
+  EXPECT_TRUE(load_parameters(sim)->is_sim());
+  MapParameterSource unknown_variant;
+  unknown_variant.values["port_name"] = "sim:warp";
+  const std::string message = load_error(unknown_variant);
+  EXPECT_NE(message.find("~port_name"), std::string::npos) << message;
+  EXPECT_NE(message.find("manual"), std::string::npos) << message;  // names the valid variants
+}
+
+TEST(Parameters, HardwareIdNamesTheRobot) {
+  EXPECT_EQ(hardware_id("/robot1", "sim"), "ranger:/robot1:sim");
+  EXPECT_NE(hardware_id("/robot1", "sim"), hardware_id("/robot2", "sim"));
+  EXPECT_EQ(hardware_id("/", "can0"), "ranger:/:can0");
 }
 
 TEST(Parameters, ValuesAreReadIntoTheLibraryConfigs) {
@@ -63,6 +147,10 @@ TEST(Parameters, ValuesAreReadIntoTheLibraryConfigs) {
   source.values["publish_rate"] = 20;  // an int is a valid number
   source.values["linear/x/has_velocity_limits"] = true;
   source.values["linear/x/max_velocity"] = 0.8;
+  source.values["auto_reclaim_after_remote"] = true;
+  source.values["steer_first_threshold"] = 0.2;
+  source.values["mode_selection/min_linear_speed"] = 0.005;
+  source.values["frame_prefix"] = "robot1/";
   source.values["sim/errors"] = [] {
     XmlRpcValue v;
     v[0] = "motor_driver_1_communication_fault";
@@ -70,18 +158,23 @@ TEST(Parameters, ValuesAreReadIntoTheLibraryConfigs) {
   }();
   auto p = load_parameters(source);
   ASSERT_TRUE(p.ok()) << p.error().message;
+  const auto& c = p->driver.controller;
   EXPECT_TRUE(p->is_sim());
-  EXPECT_EQ(p->controller.cmd_timeout, 250ms);
-  EXPECT_DOUBLE_EQ(p->controller.geometry.wheelbase, 1.0);
-  EXPECT_DOUBLE_EQ(p->odometry.geometry.wheelbase, 1.0);
-  EXPECT_DOUBLE_EQ(p->sim.geometry.track, 0.6);
-  EXPECT_EQ(p->odometry.source, ranger::OdometrySource::kMotion);
-  EXPECT_FALSE(p->controller.auto_command_mode);
+  EXPECT_EQ(c.cmd_timeout, 250ms);
+  EXPECT_DOUBLE_EQ(c.geometry.wheelbase, 1.0);
+  EXPECT_DOUBLE_EQ(p->driver.odometry.geometry.wheelbase, 1.0);
+  EXPECT_DOUBLE_EQ(p->sim.chassis.geometry.track, 0.6);
+  EXPECT_EQ(p->driver.odometry.source, ranger::OdometrySource::kMotion);
+  EXPECT_FALSE(c.auto_command_mode);
   EXPECT_DOUBLE_EQ(p->publish_rate, 20.0);
-  EXPECT_TRUE(p->controller.limit_vx.has_velocity_limits);
-  EXPECT_DOUBLE_EQ(p->controller.limit_vx.max_velocity, 0.8);
-  EXPECT_DOUBLE_EQ(p->controller.limit_vx.min_velocity, -0.8);  // ros_controllers' default
-  EXPECT_NE(p->sim_error_bits, 0u);
+  EXPECT_TRUE(c.limit_vx.has_velocity_limits);
+  EXPECT_DOUBLE_EQ(c.limit_vx.max_velocity, 0.8);
+  EXPECT_DOUBLE_EQ(c.limit_vx.min_velocity, -0.8);  // ros_controllers' default
+  EXPECT_TRUE(c.auto_reclaim_after_remote);
+  EXPECT_DOUBLE_EQ(c.steer_first_threshold, 0.2);
+  EXPECT_DOUBLE_EQ(c.mode_selection.min_linear_speed, 0.005);
+  EXPECT_EQ(p->frame_prefix, "robot1/");
+  EXPECT_NE(p->sim.boot_error_bits, 0u);
 }
 
 struct BadValue {
@@ -111,12 +204,15 @@ INSTANTIATE_TEST_SUITE_P(
                                "[0.02, 60] s"},
                       BadValue{"wheelbase", -0.89, "(0, 10] m"},
                       BadValue{"track", 0.0, "(0, 10] m"},
-                      BadValue{"max_linear_speed", 3.0, "(0, 2.6] m/s"},
+                      BadValue{"max_linear_speed", 3.0, "not in (0, 2.6"},
                       BadValue{"max_ackermann_steering", 1.0, "40 deg"},
                       BadValue{"max_spin_wheel_speed", 1.5, "(0, 1] m/s"},
                       BadValue{"odometry_source", "gps", "\"wheels\" or \"motion\""},
                       BadValue{"port_name", "", "CAN interface name"},
                       BadValue{"port_name", "a/b", "CAN interface name"},
+                      BadValue{"port_name", "replay:", "replay:FILE"},
+                      BadValue{"steer_first_threshold", 2.0, "[0, 1.5708] rad"},
+                      BadValue{"frame_prefix", "/robot1/", "no leading '/'"},
                       BadValue{"odom_frame", "/odom", "no leading '/'"},
                       BadValue{"base_frame", "odom", "must differ from odom_frame"},
                       BadValue{"publish_odom_tf", 1, "expected true or false"},

@@ -1,5 +1,10 @@
 // Conversions between libranger_can's types and ROS messages. Pure functions: no protocol
-// knowledge (bit positions, signs, units all come from libranger_can), no I/O, unit-tested.
+// knowledge (names, units and signs come from libranger_can), no I/O, unit-tested.
+//
+// Time: every stamp the driver hands over is either the bus clock (CanFrame::stamp: the kernel's
+// CLOCK_REALTIME receive time for SocketCAN, the node's SystemClock for `sim` and `replay:FILE`),
+// which is ROS time as it is, or the driver's monotonic clock (DriverSnapshot::now, Stamped::
+// received), which is only compared with itself (freshness).
 #pragma once
 
 #include <geometry_msgs/TransformStamped.h>
@@ -18,33 +23,19 @@
 #include <array>
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <string_view>
 
-#include <ranger_can/control/controller.hpp>
-#include <ranger_can/control/odometry.hpp>
+#include <ranger_can/control/driver.hpp>
 #include <ranger_can/sim/virtual_chassis.hpp>
 
 #include "ranger_base/parameters.hpp"
-#include "ranger_base/wheel_joints.hpp"
 
 namespace ranger_base {
 
-// Maps the link's monotonic clock to ROS time, from one pair of readings taken together.
-class TimeMapper {
- public:
-  TimeMapper(const ros::Time& ros_now, ranger::Timestamp link_now)
-      : ros_now_(ros_now), link_now_(link_now) {}
-  // Zero (ros::Time()) for a zero timestamp, i.e. "never".
-  ros::Time to_ros(ranger::Timestamp t) const;
-
- private:
-  ros::Time ros_now_;
-  ranger::Timestamp link_now_;
-};
-
-// Feedback older than this many nominal periods counts as absent (e.g. an unfitted battery).
-inline constexpr int kStalePeriods = 3;
+// A bus-clock timestamp (nanoseconds since the Unix epoch) as ROS time; zero stays zero ("never").
+ros::Time to_ros_time(ranger::Timestamp bus_stamp);
 
 // ---- cmd_vel ----------------------------------------------------------------------------------
 // The planar part of a Twist (linear.x, linear.y, angular.z) as a REP-103 body twist. The other
@@ -54,43 +45,67 @@ ranger::BodyTwist to_body_twist(const geometry_msgs::Twist& twist);
 bool has_non_planar_components(const geometry_msgs::Twist& twist);
 geometry_msgs::TwistStamped to_twist_stamped(const ranger::BodyTwist& twist, const ros::Time& stamp,
                                              const std::string& frame_id);
+// What cmd_vel_out publishes for a frame the driver sent: the twist a motion command realises
+// (zero for a stop, the shutdown's included); nullopt for every other kind of frame.
+std::optional<ranger::BodyTwist> achieved_twist(const ranger::SentEvent& event);
 
 // ---- odometry, TF, joints ---------------------------------------------------------------------
 // Pose covariance = diag(pose_covariance_diagonal) + the odometry's growing x/y/yaw variance;
-// twist covariance = diag(twist_covariance_diagonal).
-nav_msgs::Odometry to_odometry(const ranger::OdometryState& odometry, const NodeParameters& params,
-                               const ros::Time& stamp);
+// twist covariance = diag(twist_covariance_diagonal). Stamped with the odometry's own stamp (the
+// frames that produced it).
+nav_msgs::Odometry to_odometry(const ranger::OdometryState& odometry, const NodeParameters& params);
 geometry_msgs::TransformStamped to_transform(const nav_msgs::Odometry& odometry);
-sensor_msgs::JointState to_joint_state(const WheelJoints& joints, const ros::Time& stamp);
+// The time of the newest per-wheel frame behind `feedback`'s joints (zero: none yet).
+ranger::Timestamp joints_stamp(const ranger::ChassisFeedback& feedback);
+sensor_msgs::JointState to_joint_state(const ranger::WheelJoints& joints, const ros::Time& stamp);
 // The virtual chassis's ground truth, as an Odometry in the odom frame (zero covariance: exact).
 nav_msgs::Odometry to_ground_truth(const ranger::sim::ChassisSnapshot& sim,
                                    const NodeParameters& params, const ros::Time& stamp);
 
 // ---- chassis state ----------------------------------------------------------------------------
-ranger_msgs::SystemState to_system_state(const ranger::ControllerState& state,
+// Why motion is refused, and what to do about it, in words (system_state's
+// motion_inhibited_detail, diagnostics, the log); "" while the chassis is driven as asked.
+std::string describe_refusal(const ranger::ControllerState& state);
+// The stop causes of a set by name ("emergency_stop", "remote", ...), in the library's order.
+std::vector<std::string> cause_names(ranger::StopCauses causes);
+
+ranger_msgs::SystemState to_system_state(const ranger::DriverSnapshot& snapshot,
                                          const ros::Time& stamp);
-// Sets every SystemErrors field from the 0x211 error word, through libranger_can's bit names.
+// Sets every SystemErrors field from the chassis's error word, through libranger_can's bit names.
 void fill_system_errors(std::uint32_t error_word, ranger_msgs::SystemErrors& out);
 ranger_msgs::DriverStatus to_driver_status(std::uint8_t status);
 ranger_msgs::BmsFlags to_bms_flags(std::uint8_t status1, std::uint8_t status2);
 
 ranger_msgs::ActuatorStateArray to_actuator_state(const ranger::ChassisFeedback& feedback,
-                                                  const TimeMapper& time, const ros::Time& stamp);
+                                                  const ros::Time& stamp);
+// `now`: the driver's clock (DriverSnapshot::now), for the present flags.
 ranger_msgs::BmsStateArray to_bms_state(const ranger::ChassisFeedback& feedback,
-                                        const TimeMapper& time, ranger::Timestamp link_now,
-                                        const ros::Time& stamp);
-// The whole pack (BMS 0x361/0x362, or 0x211's voltage until the BMS reports). percentage in 0..1;
-// cell_voltage / cell_temperature carry one entry per battery slot 1..4, NaN for an empty slot
-// (ranger_msgs/BmsStateArray has the per-slot details and present flags).
-sensor_msgs::BatteryState to_battery_state(const ranger::ControllerState& state,
-                                           ranger::Timestamp link_now, const ros::Time& stamp);
-ranger_msgs::UltrasonicState to_ultrasonic_state(const ranger::ControllerState& state,
+                                        ranger::Timestamp now, const ros::Time& stamp);
+
+// The RANGER's battery pack per its user manual (LiFePO4, 48 V nominal, 46-50 V normal). The
+// library's control layer has no names for these yet: this is the one place the node keeps them.
+struct PackDesign {
+  double nominal_voltage;     // V
+  double normal_min_voltage;  // V
+  double normal_max_voltage;  // V
+};
+const PackDesign& pack_design();
+
+// The whole pack (the BMS reports, or the system status's voltage until it does). percentage in
+// 0..1; technology LiFePO4; cell_voltage / cell_temperature carry one entry per battery slot 1..4,
+// NaN for an empty slot (ranger_msgs/BmsStateArray has the per-slot details and present flags).
+sensor_msgs::BatteryState to_battery_state(const ranger::ChassisFeedback& feedback,
+                                           ranger::Timestamp now, const ros::Time& stamp);
+ranger_msgs::UltrasonicState to_ultrasonic_state(const ranger::DriverSnapshot& snapshot,
                                                  const ros::Time& stamp);
-// One sensor (1..8) as sensor_msgs/Range in frame ultrasonic_<sensor>_link (ranger_description).
-// range = raw / 1000 m; NaN for an error code; +inf beyond max_range (REP-117).
-sensor_msgs::Range to_range(int sensor, std::int16_t raw, const UltrasonicRangeParameters& params,
+// One sensor (1..8) as sensor_msgs/Range in frame <frame_prefix>ultrasonic_<sensor>_link
+// (ranger_description). range in m; NaN for every raw value the library does not call "ok"
+// (no reading, an error code); +inf beyond max_range (REP-117).
+sensor_msgs::Range to_range(int sensor, std::int16_t raw, const NodeParameters& params,
                             const ros::Time& stamp);
-std::string ultrasonic_frame_id(int sensor);
+std::string ultrasonic_frame_id(const std::string& frame_prefix, int sensor);
+// The distance a raw ultrasonic value stands for, in m; NaN unless the library calls it "ok".
+float ultrasonic_range_m(std::int16_t raw);
 
 // ---- named-bit tables (message field <- libranger_can bit name); tests check they are complete --
 using SystemErrorField = std::uint8_t ranger_msgs::SystemErrors::*;

@@ -1,16 +1,18 @@
 // /diagnostics for the chassis, through diagnostic_updater: one status per concern (CAN link,
-// control mode, errors, battery, frame rates), each computed from a LinkSnapshot so the same
-// rules are unit-tested without ROS plumbing. ranger_bringup's aggregator config groups them.
+// control mode, errors, battery, frame rates), each computed from a ranger::DriverSnapshot so the
+// same rules are unit-tested without ROS plumbing. ranger_bringup's aggregator config groups them.
 #pragma once
 
 #include <diagnostic_updater/DiagnosticStatusWrapper.h>
 #include <diagnostic_updater/diagnostic_updater.h>
 
 #include <cstdint>
+#include <functional>
 #include <map>
+#include <memory>
 #include <optional>
 
-#include "ranger_base/chassis_link.hpp"
+#include <ranger_can/control/driver.hpp>
 
 namespace ranger_base {
 
@@ -21,32 +23,36 @@ inline constexpr const char* kDiagErrors = "Chassis errors";
 inline constexpr const char* kDiagBattery = "Battery";
 inline constexpr const char* kDiagFrameRates = "Frame rates";
 
-void diagnose_link(const LinkSnapshot& s, diagnostic_updater::DiagnosticStatusWrapper& out);
-void diagnose_control(const LinkSnapshot& s, diagnostic_updater::DiagnosticStatusWrapper& out);
-void diagnose_errors(const LinkSnapshot& s, diagnostic_updater::DiagnosticStatusWrapper& out);
-void diagnose_battery(const LinkSnapshot& s, diagnostic_updater::DiagnosticStatusWrapper& out);
+using diagnostic_updater::DiagnosticStatusWrapper;
+using ranger::DriverSnapshot;
 
-// Frame rates per ID since the previous call (the first call only records the counts).
+void diagnose_link(const DriverSnapshot& s, DiagnosticStatusWrapper& out);
+void diagnose_control(const DriverSnapshot& s, DiagnosticStatusWrapper& out);
+void diagnose_errors(const DriverSnapshot& s, DiagnosticStatusWrapper& out);
+void diagnose_battery(const DriverSnapshot& s, DiagnosticStatusWrapper& out);
+
+// Received frames per ID: the snapshot's rates (FrameStats, over its window), the rejected and
+// padded counts; WARN while frames are being rejected (since the previous call).
 class FrameRateMonitor {
  public:
-  void diagnose(const LinkSnapshot& s, diagnostic_updater::DiagnosticStatusWrapper& out);
+  void diagnose(const DriverSnapshot& s, DiagnosticStatusWrapper& out);
 
  private:
-  std::optional<ranger::Timestamp> previous_time_;
-  std::map<std::uint32_t, std::uint64_t> previous_counts_;
+  std::map<std::uint32_t, std::uint64_t> previous_rejected_;
 };
 
 // Registers the tasks on `updater`. Call refresh() before each updater.update(): every task of a
 // round reports from the same snapshot.
 class ChassisDiagnostics {
  public:
-  ChassisDiagnostics(diagnostic_updater::Updater& updater, const ChassisLink& link);
+  using SnapshotSource = std::function<std::shared_ptr<const DriverSnapshot>()>;
+  ChassisDiagnostics(diagnostic_updater::Updater& updater, SnapshotSource source);
   void refresh();
 
  private:
-  const ChassisLink& link_;
+  SnapshotSource source_;
   FrameRateMonitor rates_;
-  LinkSnapshot current_;
+  std::shared_ptr<const DriverSnapshot> current_;
 };
 
 }  // namespace ranger_base

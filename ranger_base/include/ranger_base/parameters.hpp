@@ -17,10 +17,9 @@
 #include <string>
 #include <vector>
 
-#include <ranger_can/control/controller.hpp>
-#include <ranger_can/control/odometry.hpp>
+#include <ranger_can/control/driver.hpp>
 #include <ranger_can/result.hpp>
-#include <ranger_can/sim/virtual_chassis.hpp>
+#include <ranger_can/sim/sim_bus_source.hpp>
 
 namespace ros {
 class NodeHandle;
@@ -28,38 +27,48 @@ class NodeHandle;
 
 namespace ranger_base {
 
-// The port name that selects the in-process virtual chassis instead of a CAN interface.
-inline constexpr const char* kSimPortName = "sim";
-
 struct UltrasonicRangeParameters {
   double field_of_view = 0.52;  // rad, sensor_msgs/Range field_of_view
   double min_range = 0.05;      // m
   double max_range = 5.0;       // m
 };
 
+// Every default below that has a library counterpart is read from the library's own structs
+// (ranger::DriverConfig{}, ControllerConfig{}, OdometryConfig{}, sim::VirtualChassisConfig{}), so
+// the node and `ranger_can scenario` behave alike.
 struct NodeParameters {
+  // The bus (ranger::sim::open_bus_source): a SocketCAN interface, sim[:VARIANT] or replay:FILE.
   std::string port_name = "can0";
   std::string odom_frame = "odom";
   std::string base_frame = "base_link";
+  // Prefix of the frames the node names itself (ultrasonic_<n>_link), e.g. "robot1/": the launch
+  // files give odom_frame and base_frame with the same prefix.
+  std::string frame_prefix;
   bool publish_odom_tf = true;
   double publish_rate = 50.0;        // Hz: odom, TF, joint_states
   double state_publish_rate = 10.0;  // Hz: ranger_msgs states, battery, ultrasonic
-  bool publish_cmd = false;          // cmd_vel_out: the twist each 0x111 realises
-  std::chrono::nanoseconds reconnect_interval = std::chrono::seconds(1);
+  bool publish_cmd = false;          // cmd_vel_out: the twist each motion command realises
 
   // x, y, z, roll, pitch, yaw. The pose entries are a floor to which the odometry's growing
-  // x/y/yaw variance is added; the twist entries are published as they are.
+  // x/y/yaw variance is added; the twist entries are published as they are (the planar ones
+  // default to the library's twist variances).
   std::array<double, 6> pose_covariance_diagonal{1e-4, 1e-4, 1e6, 1e6, 1e6, 1e-3};
-  std::array<double, 6> twist_covariance_diagonal{1e-3, 1e-3, 1e6, 1e6, 1e6, 2e-3};
+  std::array<double, 6> twist_covariance_diagonal{ranger::OdometryConfig{}.twist_variance_linear,
+                                                  ranger::OdometryConfig{}.twist_variance_linear,
+                                                  1e6,
+                                                  1e6,
+                                                  1e6,
+                                                  ranger::OdometryConfig{}.twist_variance_angular};
 
   UltrasonicRangeParameters ultrasonic;
 
-  ranger::ControllerConfig controller;    // geometry, limits, cmd_vel_timeout, ...
-  ranger::OdometryConfig odometry;        // geometry (same), source, covariance growth
-  ranger::sim::VirtualChassisConfig sim;  // port_name = sim only
-  std::uint32_t sim_error_bits = 0;       // 0x211 error bits the virtual chassis boots with
+  // controller (geometry, limits, cmd_vel_timeout, ...), odometry (the same geometry, source,
+  // covariance growth), reconnect_interval, request_answer_timeout.
+  ranger::DriverConfig driver;
+  // The virtual chassis (port_name sim[:VARIANT] only): its configuration and boot faults.
+  ranger::sim::SimSourceOptions sim;
 
-  bool is_sim() const { return port_name == kSimPortName; }
+  bool is_sim() const;
 };
 
 // Where parameter values come from: the node's private namespace, or a map in tests.
@@ -96,6 +105,10 @@ class MapParameterSource final : public ParameterSource {
 // Reads and checks every parameter. On failure the Error's message lists every problem, one per
 // line, each naming the parameter, the value found and the valid range.
 ranger::Result<NodeParameters> load_parameters(const ParameterSource& source);
+
+// The diagnostics' hardware_id: "ranger:<namespace>:<port_name>", e.g. "ranger:/robot1:sim", so
+// that robots on one master are told apart.
+std::string hardware_id(const std::string& ns, const std::string& port_name);
 
 // Every parameter name load_parameters() reads (for the README check and unknown-name warnings).
 const std::vector<std::string>& known_parameter_names();

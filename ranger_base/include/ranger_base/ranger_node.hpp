@@ -1,13 +1,16 @@
-// ranger_base_node's ROS side: subscriptions, publications, services and diagnostics around a
-// ChassisLink. All topic and service names are relative (the node works under a namespace);
-// only /tf and /diagnostics are global, by their own conventions.
+// ranger_base_node's ROS side around libranger_can's driver runtime (ranger::Driver): parameters
+// become a DriverConfig, snapshots become messages and diagnostics, ROS callbacks post to the
+// driver's mailbox. The node knows no frame: the driver owns the bus, the controller, the
+// odometry and the joint tracker on a thread of its own.
 //
-// Threads: the CAN thread lives in ChassisLink. Publishing runs on one thread of its own that
-// sleeps until the next publication is due (odometry/TF/joints at publish_rate, states at
-// state_publish_rate, diagnostics): one wake-up per publication, no timer-to-spinner hand-off.
-// Two callback queues are each spun by one thread: cmd_vel (never queued behind anything) and
-// the services (which may wait for the chassis to confirm). Every callback and publication reads
-// the link through snapshot() or posts to it; none touches the bus.
+// All topic and service names are relative (the node works under a namespace); only /tf and
+// /diagnostics are global, by their own conventions.
+//
+// Threads besides the driver's: one publishing thread that sleeps until the next publication is
+// due (odometry/TF/joints at publish_rate, states at state_publish_rate, diagnostics), and two
+// callback queues each spun by one thread: cmd_vel (never queued behind anything) and the
+// services (which wait for the chassis's answer). cmd_vel_out is published from the driver's
+// sent-frame observer. None of them touches the bus.
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
@@ -17,18 +20,24 @@
 #include <ranger_msgs/SetUltrasonic.h>
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
+#include <std_msgs/String.h>
+#include <std_srvs/Trigger.h>
 #include <tf2_ros/transform_broadcaster.h>
 
 #include <array>
+#include <atomic>
 #include <condition_variable>
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <thread>
 
 #include <ranger_can/clock.hpp>
+#include <ranger_can/control/driver.hpp>
+#include <ranger_can/result.hpp>
+#include <ranger_can/sim/sim_bus_source.hpp>
 
-#include "ranger_base/chassis_link.hpp"
 #include "ranger_base/diagnostics.hpp"
 #include "ranger_base/parameters.hpp"
 
@@ -36,47 +45,67 @@ namespace ranger_base {
 
 class RangerNode {
  public:
+  // Opens the bus source params.port_name names (a SocketCAN interface, sim[:VARIANT] or
+  // replay:FILE; a missing interface is no error: the driver retries it) and builds the driver.
   // `nh`: the node's namespace (topics), `private_nh`: its parameters.
-  RangerNode(const ros::NodeHandle& nh, const ros::NodeHandle& private_nh, NodeParameters params);
+  static ranger::Result<std::unique_ptr<RangerNode>> create(const ros::NodeHandle& nh,
+                                                            const ros::NodeHandle& private_nh,
+                                                            NodeParameters params);
   ~RangerNode();  // shutdown()
+  RangerNode(const RangerNode&) = delete;
+  RangerNode& operator=(const RangerNode&) = delete;
 
-  // Starts the CAN thread, the publishing thread and the spinners.
+  // Starts the driver thread, the publishing thread and the spinners.
   void start();
-  // Stops the chassis (zero 0x111) and the CAN thread, then the ROS side. Idempotent.
+  // Stops the chassis (the driver's zero motion command, logged and published on cmd_vel_out),
+  // the driver thread, then the ROS side. Idempotent; returns promptly (services in progress stop
+  // waiting).
   void shutdown();
 
-  ChassisLink& link() { return *link_; }
-
  private:
+  RangerNode(const ros::NodeHandle& nh, const ros::NodeHandle& private_nh, NodeParameters params,
+             std::shared_ptr<ranger::BusSource> source);
+
   void on_cmd_vel(const geometry_msgs::Twist::ConstPtr& msg);
-  void publish_loop();
-  void publish_motion();  // odom, TF, joint_states, sim/ground_truth
-  void publish_states();  // ranger_msgs states, battery, ultrasonic
-  void publish_diagnostics();
-  void on_motion_command(const MotionCommandEvent& event);  // CAN thread
+  void on_sim_inject(const std_msgs::String::ConstPtr& msg);
+  void on_sent(const ranger::SentEvent& event);  // driver thread
+  bool on_resume(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
   bool on_clear_errors(ranger_msgs::ClearErrors::Request& req,
                        ranger_msgs::ClearErrors::Response& res);
   bool on_set_ultrasonic(ranger_msgs::SetUltrasonic::Request& req,
                          ranger_msgs::SetUltrasonic::Response& res);
   bool on_set_motion_mode(ranger_msgs::SetMotionMode::Request& req,
                           ranger_msgs::SetMotionMode::Response& res);
-  void log_state_changes(const LinkSnapshot& s);
+  // The outcome of request `id` once answered or failed, after `timeout`, or at shutdown.
+  ranger::RequestOutcome wait_for(std::uint64_t id, std::chrono::nanoseconds timeout);
+
+  void publish_loop();
+  void publish_motion();  // odom, TF, joint_states, sim/ground_truth
+  void publish_states();  // ranger_msgs states, battery, ultrasonic
+  void publish_diagnostics();
+  void log_state_changes(const ranger::DriverSnapshot& s);
 
   ros::NodeHandle nh_;
   ros::NodeHandle private_nh_;
   ros::CallbackQueue cmd_queue_, service_queue_;
   ros::NodeHandle cmd_nh_, service_nh_;  // nh_ with those queues
   const NodeParameters params_;
-  ranger::SteadyClock clock_;
-  std::unique_ptr<ChassisLink> link_;
 
-  ros::Subscriber cmd_vel_sub_;
+  // The driver runs on a monotonic clock (timeouts, keep-alive); the bus source on
+  // CLOCK_REALTIME, as SocketCAN stamps frames: the virtual chassis and a replayed log stamp their
+  // frames with it too, so every frame time is ROS time (ranger_node.cpp: driver_clock(),
+  // bus_clock()).
+  std::shared_ptr<ranger::BusSource> source_;
+  std::shared_ptr<ranger::sim::SimBusSource> sim_;  // port_name sim[:VARIANT] only
+  std::unique_ptr<ranger::Driver> driver_;
+
+  ros::Subscriber cmd_vel_sub_, sim_inject_sub_;
   ros::Publisher odom_pub_, joint_state_pub_, system_state_pub_, actuator_state_pub_,
       bms_state_pub_, battery_state_pub_, ultrasonic_state_pub_, cmd_vel_out_pub_,
       ground_truth_pub_;
   std::array<ros::Publisher, 8> range_pubs_;
   tf2_ros::TransformBroadcaster tf_broadcaster_;
-  ros::ServiceServer clear_errors_srv_, set_ultrasonic_srv_, set_motion_mode_srv_;
+  ros::ServiceServer resume_srv_, clear_errors_srv_, set_ultrasonic_srv_, set_motion_mode_srv_;
 
   diagnostic_updater::Updater updater_;
   std::unique_ptr<ChassisDiagnostics> diagnostics_;
@@ -88,11 +117,20 @@ class RangerNode {
   std::condition_variable publisher_wake_;
   bool publisher_stop_ = false;  // guarded by publisher_mutex_
 
+  std::atomic<bool> stopping_{false};   // services stop waiting
+  std::atomic<bool> stop_sent_{false};  // the driver's shutdown stop was observed
+
+  // Publishing thread only.
+  ranger::Timestamp last_odom_stamp_{0}, last_joints_stamp_{0};
+  std::array<ranger::Timestamp, 2> last_ultrasonic_stamp_{};
   // For logging transitions once instead of every cycle (publishing thread only).
   std::optional<ranger::MotionRefusal> last_refusal_;
   std::optional<ranger::LinkState> last_link_;
+  bool last_bus_open_ = false;
   std::string last_bus_error_;
   std::uint32_t last_error_bits_ = 0;
+  ranger::Timestamp waiting_since_{0}, next_waiting_log_{0};
+  std::set<std::uint32_t> padded_ids_reported_;
   bool shut_down_ = false;
 };
 
