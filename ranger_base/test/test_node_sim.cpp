@@ -1,10 +1,12 @@
 // ranger_base_node end to end against its in-process virtual chassis (port_name:=sim), through
-// ROS only: cmd_vel in; system_state, odom, sim/ground_truth, cmd_vel_out (every 0x111 the node
-// sent, stamped with its send time), services out. Launched by node_sim.test (and, filtered to
-// the Faults suite, by node_sim_faults.test).
+// ROS only: cmd_vel and sim/inject (faults for the virtual chassis) in; system_state, odom,
+// sim/ground_truth, cmd_vel_out (every motion command the node sent, stamped with its send time),
+// /rosout, services out. Launched by node_sim.test (and, filtered to the Faults suite, by
+// node_sim_faults.test).
 //
-// Waits are bounded only to fail a broken build instead of hanging; timing is asserted on the
-// node's own stamps and on message order, never on how long the test took.
+// Nothing sleeps to synchronise: every wait is on an observable condition (a message, a state),
+// bounded only to fail a broken build instead of hanging; timing is asserted on the node's own
+// stamps and on message order, never on how long the test took.
 #include <geometry_msgs/Twist.h>
 #include <geometry_msgs/TwistStamped.h>
 #include <gtest/gtest.h>
@@ -16,14 +18,22 @@
 #include <ranger_msgs/UltrasonicState.h>
 #include <ros/ros.h>
 #include <rosgraph_msgs/Log.h>
+#include <sensor_msgs/JointState.h>
+#include <sensor_msgs/Range.h>
+#include <std_msgs/String.h>
+#include <std_srvs/Trigger.h>
 #include <tf2/utils.h>
 
+#include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <deque>
 #include <functional>
 #include <limits>
 #include <mutex>
 #include <optional>
+#include <string>
+#include <vector>
 
 namespace {
 
@@ -64,10 +74,25 @@ class NodeSim : public ::testing::Test {
   static void SetUpTestSuite() {
     nh_ = std::make_unique<ros::NodeHandle>();
     auto& nh = *nh_;
-    subs_.push_back(subscribe<SystemState>(nh, "system_state", 10,
-                                           [](const SystemState::ConstPtr& m) { state_.set(*m); }));
-    subs_.push_back(subscribe<nav_msgs::Odometry>(
-        nh, "odom", 10, [](const nav_msgs::Odometry::ConstPtr& m) { odom_.set(*m); }));
+    subs_.push_back(
+        subscribe<SystemState>(nh, "system_state", 10, [](const SystemState::ConstPtr& m) {
+          state_.set(*m);
+          std::lock_guard<std::mutex> lock(commands_mutex_);
+          states_.push_back(*m);  // every one: the suite runs for minutes at 10 Hz
+        }));
+    subs_.push_back(
+        subscribe<nav_msgs::Odometry>(nh, "odom", 10, [](const nav_msgs::Odometry::ConstPtr& m) {
+          // Each estimate once, stamped with its frames' time: stamps only ever increase.
+          const auto previous = odom_.get();
+          if (previous && m->header.stamp <= previous->header.stamp) ++odom_stamp_regressions_;
+          odom_.set(*m);
+          ++odom_count_;
+        }));
+    subs_.push_back(subscribe<sensor_msgs::JointState>(
+        nh, "joint_states", 10, [](const sensor_msgs::JointState::ConstPtr&) { ++joints_count_; }));
+    subs_.push_back(subscribe<sensor_msgs::Range>(
+        nh, "ultrasonic/range_1", 10,
+        [](const sensor_msgs::Range::ConstPtr& m) { range_.set(*m); }));
     subs_.push_back(subscribe<nav_msgs::Odometry>(
         nh, "sim/ground_truth", 10, [](const nav_msgs::Odometry::ConstPtr& m) { truth_.set(*m); }));
     subs_.push_back(subscribe<ranger_msgs::UltrasonicState>(
@@ -86,6 +111,7 @@ class NodeSim : public ::testing::Test {
           logs_.push_back(*m);
         }));
     cmd_pub_ = nh.advertise<geometry_msgs::Twist>("cmd_vel", 100);
+    inject_pub_ = nh.advertise<std_msgs::String>("sim/inject", 10);
     spinner_ = std::make_unique<ros::AsyncSpinner>(2);
     spinner_->start();
   }
@@ -97,6 +123,7 @@ class NodeSim : public ::testing::Test {
     spinner_.reset();
     subs_.clear();
     cmd_pub_.shutdown();
+    inject_pub_.shutdown();
     nh_.reset();
   }
 
@@ -104,7 +131,8 @@ class NodeSim : public ::testing::Test {
     ASSERT_TRUE(wait_for([] {
       const auto s = state_.get();
       return s && s->link_up && s->control_mode == SystemState::CONTROL_MODE_CAN &&
-             cmd_pub_.getNumSubscribers() > 0 && truth_.get() && odom_.get();
+             cmd_pub_.getNumSubscribers() > 0 && inject_pub_.getNumSubscribers() > 0 &&
+             truth_.get() && odom_.get();
     })) << "the node never reached CAN command mode";
     stop_and_settle();
   }
@@ -135,6 +163,58 @@ class NodeSim : public ::testing::Test {
       if (wait_for(condition, 0.05)) return true;
     }
     return false;
+  }
+
+  // The newest cmd_vel_out stamp (zero before the first).
+  static ros::Time newest_command() {
+    std::lock_guard<std::mutex> lock(commands_mutex_);
+    return commands_.empty() ? ros::Time() : commands_.back().header.stamp;
+  }
+
+  // Publishes `cmd` `n` times, each time waiting until the node has sent a motion command after
+  // it: a teleop kept alive at the node's own pace, observed on cmd_vel_out.
+  static bool drive_for(const geometry_msgs::Twist& cmd, int n) {
+    for (int i = 0; i < n; ++i) {
+      const ros::Time before = newest_command();
+      cmd_pub_.publish(cmd);
+      if (!wait_for([&] { return newest_command() > before; }, 5.0)) return false;
+    }
+    return true;
+  }
+
+  // Waits until the node logged `text` (at `level` or above) on /rosout after `since`.
+  static bool logged(const std::string& text, const ros::Time& since,
+                     std::uint8_t level = rosgraph_msgs::Log::DEBUG, double limit_s = 20.0) {
+    return wait_for(
+        [&] {
+          std::lock_guard<std::mutex> lock(commands_mutex_);
+          for (const auto& l : logs_) {
+            if (l.header.stamp >= since && l.level >= level &&
+                l.msg.find(text) != std::string::npos) {
+              return true;
+            }
+          }
+          return false;
+        },
+        limit_s);
+  }
+
+  static void inject(const std::string& line) {
+    std_msgs::String msg;
+    msg.data = line;
+    inject_pub_.publish(msg);
+  }
+
+  static std_srvs::Trigger::Response call_resume() {
+    ros::ServiceClient client = nh_->serviceClient<std_srvs::Trigger>("resume");
+    EXPECT_TRUE(client.waitForExistence(ros::Duration(10.0)));
+    std_srvs::Trigger srv;
+    EXPECT_TRUE(client.call(srv));
+    return srv.response;
+  }
+
+  static bool contains(const std::vector<std::string>& v, const std::string& x) {
+    return std::find(v.begin(), v.end(), x) != v.end();
   }
 
   static double speed(const nav_msgs::Odometry& o) {
@@ -179,25 +259,32 @@ class NodeSim : public ::testing::Test {
 
   static std::unique_ptr<ros::NodeHandle> nh_;
   static std::vector<ros::Subscriber> subs_;
-  static ros::Publisher cmd_pub_;
+  static ros::Publisher cmd_pub_, inject_pub_;
   static std::unique_ptr<ros::AsyncSpinner> spinner_;
   static Latest<SystemState> state_;
   static Latest<nav_msgs::Odometry> odom_, truth_;
   static Latest<ranger_msgs::UltrasonicState> ultrasonic_;
+  static Latest<sensor_msgs::Range> range_;
+  static std::atomic<int> odom_count_, joints_count_, odom_stamp_regressions_;
   static std::mutex commands_mutex_;
   static std::deque<geometry_msgs::TwistStamped> commands_;
+  static std::deque<SystemState> states_;
   static std::vector<rosgraph_msgs::Log> logs_;
 };
 
 std::unique_ptr<ros::NodeHandle> NodeSim::nh_;
 std::vector<ros::Subscriber> NodeSim::subs_;
-ros::Publisher NodeSim::cmd_pub_;
+ros::Publisher NodeSim::cmd_pub_, NodeSim::inject_pub_;
 std::unique_ptr<ros::AsyncSpinner> NodeSim::spinner_;
 Latest<SystemState> NodeSim::state_;
 Latest<nav_msgs::Odometry> NodeSim::odom_, NodeSim::truth_;
 Latest<ranger_msgs::UltrasonicState> NodeSim::ultrasonic_;
+Latest<sensor_msgs::Range> NodeSim::range_;
+std::atomic<int> NodeSim::odom_count_{0}, NodeSim::joints_count_{0},
+    NodeSim::odom_stamp_regressions_{0};
 std::mutex NodeSim::commands_mutex_;
 std::deque<geometry_msgs::TwistStamped> NodeSim::commands_;
+std::deque<SystemState> NodeSim::states_;
 std::vector<rosgraph_msgs::Log> NodeSim::logs_;
 
 double yaw_of(const nav_msgs::Odometry& o) {
@@ -264,10 +351,7 @@ TEST_F(NodeSim, PureRotationSpinsInPlace) {
 TEST_F(NodeSim, CmdVelStoppingGivesAZeroCommandWithinTheTimeout) {
   ASSERT_TRUE(
       drive_until(twist(0.4, 0.0, 0.0), [] { return truth_.get()->twist.twist.linear.x > 0.3; }));
-  for (int i = 0; i < 5; ++i) {  // keep driving a little: the command is fresh
-    cmd_pub_.publish(twist(0.4, 0.0, 0.0));
-    ros::WallDuration(0.05).sleep();
-  }
+  ASSERT_TRUE(drive_for(twist(0.4, 0.0, 0.0), 5));  // keep driving a little: the command is fresh
   const ros::Time last_publish = ros::Time::now();
   cmd_pub_.publish(twist(0.4, 0.0, 0.0));
   // Then silence. The first zero 0x111 after the last cmd_vel must be stamped (by the node, when
@@ -316,18 +400,28 @@ TEST_F(NodeSim, NonFiniteCommandsAreRefusedStopTheChassisAndAreLoggedThrottled) 
     }
     ASSERT_TRUE(wait_for([] { return speed(*truth_.get()) < 1e-3; }));
   }
-  // A flood of NaN: the refusal is logged at most once per second.
+  // A flood of NaN over more than a second: the refusal is logged at most once per second. Each
+  // NaN is published once the node has sent a motion command since the previous one.
   const ros::Time flood_start = ros::Time::now();
-  for (int i = 0; i < 400; ++i) {
+  while ((ros::Time::now() - flood_start).toSec() < 1.5) {
+    const ros::Time before = newest_command();
     cmd_pub_.publish(twist(nan, 0, 0));
-    ros::WallDuration(0.0025).sleep();
+    ASSERT_TRUE(wait_for([&] { return newest_command() > before; }, 5.0));
   }
-  ros::WallDuration(0.5).sleep();  // let /rosout arrive
   const double flood_s = (ros::Time::now() - flood_start).toSec();
+  // A log line the node writes after the flood: once it is here, so is every earlier one (one
+  // publisher, one ordered connection).
+  const ros::Time marker = ros::Time::now();
+  ros::ServiceClient modes = nh_->serviceClient<ranger_msgs::SetMotionMode>("set_motion_mode");
+  ranger_msgs::SetMotionMode automatic;
+  automatic.request.mode = ranger_msgs::SetMotionMode::Request::AUTOMATIC;
+  ASSERT_TRUE(modes.call(automatic));
+  ASSERT_TRUE(logged("set_motion_mode", marker));
   std::lock_guard<std::mutex> lock(commands_mutex_);
   int refusals = 0;
   for (const auto& l : logs_) {
-    if (l.header.stamp >= flood_start && l.msg.find("cmd_vel refused") != std::string::npos) {
+    if (l.header.stamp >= flood_start && l.header.stamp < marker &&
+        l.msg.find("cmd_vel refused") != std::string::npos) {
       ++refusals;
     }
   }
@@ -339,10 +433,7 @@ TEST_F(NodeSim, HugeCommandsAreClampedToTheLimits) {
   ASSERT_TRUE(
       drive_until(twist(1e9, 0, 0), [] { return truth_.get()->twist.twist.linear.x > 0.9; }));
   const ros::Time t = ros::Time::now();
-  for (int i = 0; i < 20; ++i) {
-    cmd_pub_.publish(twist(1e9, 0, 0));
-    ros::WallDuration(0.05).sleep();
-  }
+  ASSERT_TRUE(drive_for(twist(1e9, 0, 0), 20));
   const auto commands = commands_since(t);
   ASSERT_FALSE(commands.empty());
   for (const auto& c : commands)
@@ -356,7 +447,8 @@ TEST_F(NodeSim, AFloodOfCommandsIsRateBoundedAndTheNodeStaysResponsive) {
   for (int i = 0; i < 3000; ++i)
     cmd_pub_.publish(twist(0.1 + 0.0001 * (i % 100), 0, 0));
   const ros::Time end = ros::Time::now();
-  ros::WallDuration(0.2).sleep();
+  // Commands arrive in order: once one stamped after the flood is here, the flood's all are.
+  ASSERT_TRUE(wait_for([&] { return newest_command() > end; }));
   const auto commands = commands_since(start);
   // Whatever arrives, changed commands go out at most every min_command_interval, plus the
   // 20 ms keep-alive: the bus load stays bounded.
@@ -379,6 +471,7 @@ TEST_F(NodeSim, UltrasonicServiceReachesTheChassis) {
   for (const bool enable : {true, false}) {
     ranger_msgs::SetUltrasonic srv;
     srv.request.enable = enable;
+    srv.request.disable = !enable;
     ASSERT_TRUE(client.call(srv));
     EXPECT_TRUE(srv.response.success) << srv.response.message;
     EXPECT_EQ(srv.response.enabled, enable);
@@ -390,9 +483,27 @@ TEST_F(NodeSim, UltrasonicServiceReachesTheChassis) {
   const auto u = ultrasonic_.get();
   ASSERT_EQ(u->sensors.size(), 8u);
   EXPECT_EQ(u->sensors[0].status, "ok");
+  ASSERT_TRUE(wait_for([] { return range_.get().has_value(); }));
+  EXPECT_EQ(range_.get()->header.frame_id, "ultrasonic_1_link");  // no frame_prefix here
+  EXPECT_NEAR(range_.get()->range, 3.0, 1e-3);                    // sim/ultrasonic_range
 }
 
-TEST_F(NodeSim, ClearErrorsRefusesAnUnknownCode) {
+TEST_F(NodeSim, UltrasonicServiceRefusesEmptyAndContradictoryRequests) {
+  ros::ServiceClient client = nh_->serviceClient<ranger_msgs::SetUltrasonic>("set_ultrasonic");
+  ASSERT_TRUE(client.waitForExistence(ros::Duration(10.0)));
+  for (const bool both : {false, true}) {
+    ranger_msgs::SetUltrasonic srv;
+    srv.request.enable = both;
+    srv.request.disable = both;
+    ASSERT_TRUE(client.call(srv));
+    EXPECT_FALSE(srv.response.success);
+    EXPECT_NE(srv.response.message.find(both ? "contradictory" : "empty"), std::string::npos)
+        << srv.response.message;
+    EXPECT_NE(srv.response.message.find("nothing sent"), std::string::npos);
+  }
+}
+
+TEST_F(NodeSim, ClearErrorsRefusesAnUnknownCodeAndAnswersWithTheChassisErrorWord) {
   ros::ServiceClient client = nh_->serviceClient<ranger_msgs::ClearErrors>("clear_errors");
   ASSERT_TRUE(client.waitForExistence(ros::Duration(10.0)));
   ranger_msgs::ClearErrors srv;
@@ -403,6 +514,10 @@ TEST_F(NodeSim, ClearErrorsRefusesAnUnknownCode) {
   srv.request.code = ranger_msgs::ClearErrors::Request::ALL_NON_CRITICAL;
   ASSERT_TRUE(client.call(srv));
   EXPECT_TRUE(srv.response.success) << srv.response.message;
+  EXPECT_EQ(srv.response.error_word, 0u);
+  EXPECT_NE(srv.response.message.find("the chassis answered with error word 0x00000000"),
+            std::string::npos)
+      << srv.response.message;
 }
 
 TEST_F(NodeSim, MotionModeCanBePinnedAndReleased) {
@@ -431,6 +546,204 @@ TEST_F(NodeSim, MotionModeCanBePinnedAndReleased) {
   stop_and_settle();
 }
 
+// ---- safety through ROS (issue 13): the re-arm latch, resume, sim/inject ------------------------
+
+class Safety : public NodeSim {
+ protected:
+  // Undoes a fault injection however the test ends, so the next test starts from a normal
+  // chassis.
+  struct Injected {
+    std::vector<std::string> undo;
+    ~Injected() {
+      for (const auto& line : undo)
+        inject(line);
+    }
+  };
+
+  // Publishes `cmd` `n` times, each time waiting for the node's next system_state: a teleop kept
+  // alive while the node sends no motion command at all (standby).
+  static bool drive_for_states(const geometry_msgs::Twist& cmd, int n) {
+    for (int i = 0; i < n; ++i) {
+      std::size_t seen = 0;
+      {
+        std::lock_guard<std::mutex> lock(commands_mutex_);
+        seen = states_.size();
+      }
+      cmd_pub_.publish(cmd);
+      if (!wait_for(
+              [&] {
+                std::lock_guard<std::mutex> lock(commands_mutex_);
+                return states_.size() > seen;
+              },
+              5.0)) {
+        return false;
+      }
+    }
+    return true;
+  }
+};
+
+TEST_F(Safety, EmergencyStopLatchesUntilResume) {
+  ASSERT_TRUE(
+      drive_until(twist(0.4, 0, 0), [] { return truth_.get()->twist.twist.linear.x > 0.3; }));
+  const Injected undo{{"estop off"}};
+  const ros::Time pressed = ros::Time::now();
+  inject("estop on");
+  // Still commanding: the chassis stops, and the node says why.
+  ASSERT_TRUE(drive_until(twist(0.4, 0, 0), [] {
+    const auto s = state_.get();
+    return s->motion_inhibited_reason == "estop" && speed(*truth_.get()) < 1e-3;
+  }));
+  EXPECT_TRUE(logged("sim/inject \"estop on\" applied", pressed));
+
+  // resume while the e-stop is pressed: refused, naming it; nothing changes.
+  const auto refused = call_resume();
+  EXPECT_FALSE(refused.success);
+  EXPECT_NE(refused.message.find("emergency_stop"), std::string::npos) << refused.message;
+  EXPECT_EQ(state_.get()->motion_inhibited_reason, "estop");
+
+  // Released: the e-stop is gone, but cmd_vel alone never restarts the chassis.
+  inject("estop off");
+  ASSERT_TRUE(drive_until(twist(0.4, 0, 0), [] {
+    const auto s = state_.get();
+    return s->vehicle_status == SystemState::VEHICLE_STATUS_NORMAL && s->rearm_required &&
+           s->motion_inhibited_reason == "rearm_required";
+  }));
+  const ros::Time released = ros::Time::now();
+  ASSERT_TRUE(drive_for(twist(0.4, 0, 0), 25));
+  for (const auto& c : commands_since(released))
+    EXPECT_TRUE(is_zero(c)) << "a motion command went out before resume";
+  EXPECT_LT(speed(*truth_.get()), 1e-3);
+  const auto held = *state_.get();
+  EXPECT_TRUE(held.rearm_required);
+  EXPECT_TRUE(contains(held.latched_causes, "emergency_stop"));
+  EXPECT_TRUE(held.active_causes.empty());
+  EXPECT_NE(held.motion_inhibited_detail.find("after emergency_stop"), std::string::npos)
+      << held.motion_inhibited_detail;
+  EXPECT_TRUE(logged("rearm_required after emergency_stop", pressed, rosgraph_msgs::Log::WARN));
+
+  // resume: the chassis drives again on the same cmd_vel.
+  const auto resumed = call_resume();
+  EXPECT_TRUE(resumed.success) << resumed.message;
+  EXPECT_TRUE(
+      drive_until(twist(0.4, 0, 0), [] { return truth_.get()->twist.twist.linear.x > 0.3; }));
+  EXPECT_FALSE(state_.get()->rearm_required);
+  stop_and_settle();
+}
+
+TEST_F(Safety, RemoteControlIsFinalUntilResume) {
+  ASSERT_TRUE(
+      drive_until(twist(0.3, 0, 0), [] { return truth_.get()->twist.twist.linear.x > 0.2; }));
+  // However it ends: the remote takes over and hands back to CAN command mode.
+  const Injected undo{{"remote on", "remote can"}};
+  inject("remote on");
+  ASSERT_TRUE(drive_until(twist(0.3, 0, 0), [] {
+    const auto s = state_.get();
+    return s->control_mode == SystemState::CONTROL_MODE_REMOTE && speed(*truth_.get()) < 1e-3;
+  }));
+  // The remote is switched off: the chassis falls back to standby, and the node does not take
+  // CAN control back by itself, however long cmd_vel keeps coming.
+  inject("remote off");
+  ASSERT_TRUE(drive_until(twist(0.3, 0, 0), [] {
+    const auto s = state_.get();
+    return s->control_mode == SystemState::CONTROL_MODE_STANDBY && s->reclaim_blocked;
+  }));
+  ASSERT_TRUE(drive_for_states(twist(0.3, 0, 0), 15));
+  EXPECT_EQ(state_.get()->control_mode, SystemState::CONTROL_MODE_STANDBY);
+  EXPECT_LT(speed(*truth_.get()), 1e-3);
+  // A zero cmd_vel re-arms the latch, but only resume asks for CAN control again.
+  cmd_pub_.publish(twist(0, 0, 0));
+  ASSERT_TRUE(wait_for([] {
+    const auto s = state_.get();
+    return !s->rearm_required && s->reclaim_blocked;
+  }));
+  EXPECT_EQ(state_.get()->motion_inhibited_detail,
+            "remote control had the chassis: call resume to take CAN control");
+  const auto resumed = call_resume();
+  EXPECT_TRUE(resumed.success) << resumed.message;
+  ASSERT_TRUE(wait_for([] {
+    const auto s = state_.get();
+    return s->control_mode == SystemState::CONTROL_MODE_CAN && !s->reclaim_blocked;
+  }));
+  EXPECT_TRUE(
+      drive_until(twist(0.3, 0, 0), [] { return truth_.get()->twist.twist.linear.x > 0.2; }));
+  stop_and_settle();
+}
+
+TEST_F(Safety, SimInjectRefusesUnknownAndMalformedCommandsByName) {
+  const ros::Time t = ros::Time::now();
+  inject("warp 9");
+  ASSERT_TRUE(logged("sim/inject \"warp 9\" not applied", t, rosgraph_msgs::Log::WARN));
+  inject("estop maybe");
+  ASSERT_TRUE(logged("sim/inject \"estop maybe\" not applied", t, rosgraph_msgs::Log::WARN));
+  {
+    std::lock_guard<std::mutex> lock(commands_mutex_);
+    for (const auto& l : logs_) {
+      if (l.header.stamp >= t && l.msg.find("not applied") != std::string::npos) {
+        // The valid commands are named.
+        EXPECT_NE(l.msg.find("estop"), std::string::npos) << l.msg;
+        EXPECT_NE(l.msg.find("remote"), std::string::npos) << l.msg;
+      }
+    }
+  }
+  // Nothing was injected: a valid command after them is the first one applied, and the chassis
+  // still drives.
+  inject("ultrasonic all 2500");
+  ASSERT_TRUE(logged("sim/inject \"ultrasonic all 2500\" applied", t));
+  const Injected undo{{"ultrasonic all 3000"}};
+  EXPECT_EQ(state_.get()->vehicle_status, SystemState::VEHICLE_STATUS_NORMAL);
+  EXPECT_TRUE(wait_for([] { return range_.get() && std::abs(range_.get()->range - 2.5) < 1e-3; }));
+  EXPECT_TRUE(
+      drive_until(twist(0.3, 0, 0), [] { return truth_.get()->twist.twist.linear.x > 0.2; }));
+  stop_and_settle();
+}
+
+TEST_F(Safety, OdometryOnlyWhileTheChassisIsHeardAndItResumesFromTheLastPose) {
+  ASSERT_TRUE(drive_until(twist(0.4, 0, 0), [] { return speed(*odom_.get()) > 0.3; }));
+  stop_and_settle();
+  ASSERT_TRUE(wait_for([] { return speed(*odom_.get()) < 1e-3; }));
+  const auto before = *odom_.get();
+  const ros::Time t = ros::Time::now();
+  inject("silent 1.5");
+  ASSERT_TRUE(wait_for([] {
+    const auto s = state_.get();
+    return !s->link_up && !s->motion_known;
+  }));
+  EXPECT_TRUE(logged("went silent", t, rosgraph_msgs::Log::WARN));
+  // While the chassis is not heard, nothing is estimated, so nothing is published: count over
+  // the next system_state messages (10 Hz) that still say so.
+  const int odoms = odom_count_, joints = joints_count_;
+  std::size_t seen = 0;
+  {
+    std::lock_guard<std::mutex> lock(commands_mutex_);
+    seen = states_.size();
+  }
+  ASSERT_TRUE(wait_for([&] {
+    std::lock_guard<std::mutex> lock(commands_mutex_);
+    return states_.size() >= seen + 4;
+  }));
+  {
+    std::lock_guard<std::mutex> lock(commands_mutex_);
+    for (std::size_t i = seen; i < seen + 4; ++i)
+      ASSERT_FALSE(states_[i].motion_known);  // the silence lasted
+  }
+  EXPECT_EQ(odom_count_, odoms);
+  EXPECT_EQ(joints_count_, joints);
+  // Heard again: odometry comes back where it was (the chassis did not move), not from zero.
+  ASSERT_TRUE(wait_for([] { return state_.get()->link_up && state_.get()->motion_known; }));
+  ASSERT_TRUE(wait_for([&] { return odom_count_ > odoms; }));
+  const auto after = *odom_.get();
+  EXPECT_NEAR(after.pose.pose.position.x, before.pose.pose.position.x, 0.01);
+  EXPECT_NEAR(after.pose.pose.position.y, before.pose.pose.position.y, 0.01);
+  EXPECT_GT(std::abs(after.pose.pose.position.x), 0.1);  // really the old pose
+  EXPECT_GT(after.header.stamp, before.header.stamp);
+  EXPECT_TRUE(logged("chassis heard again", t));
+  EXPECT_EQ(odom_stamp_regressions_, 0);
+  // The link loss latched: a zero cmd_vel (stop_and_settle in SetUp) or resume re-arms.
+  EXPECT_TRUE(wait_for([] { return state_.get()->rearm_required; }));
+  EXPECT_TRUE(contains(state_.get()->latched_causes, "link_lost"));
+}
+
 // ---- node_sim_faults.test: the virtual chassis boots with motor driver 1's communication fault.
 
 class Faults : public NodeSim {
@@ -444,14 +757,11 @@ class Faults : public NodeSim {
   }
 };
 
-TEST_F(Faults, ClearErrorsReachesTheChassisAndMotionResumes) {
+TEST_F(Faults, ClearErrorsAnswersThenTheLatchHoldsUntilResume) {
   ASSERT_TRUE(wait_for([] { return state_.get()->errors.motor_driver_1_communication_fault; }));
   EXPECT_EQ(state_.get()->motion_inhibited_reason, "critical_error");
   // The fault stops the chassis: commands do not move it.
-  for (int i = 0; i < 10; ++i) {
-    cmd_pub_.publish(twist(0.4, 0, 0));
-    ros::WallDuration(0.05).sleep();
-  }
+  ASSERT_TRUE(drive_for(twist(0.4, 0, 0), 10));
   EXPECT_LT(speed(*truth_.get()), 1e-3);
 
   ros::ServiceClient client = nh_->serviceClient<ranger_msgs::ClearErrors>("clear_errors");
@@ -459,10 +769,25 @@ TEST_F(Faults, ClearErrorsReachesTheChassisAndMotionResumes) {
   ranger_msgs::ClearErrors srv;
   srv.request.code = ranger_msgs::ClearErrors::Request::MOTOR1_COMMUNICATION;
   ASSERT_TRUE(client.call(srv));
+  // The answer is the chassis's error word after it received the request: cleared.
   EXPECT_TRUE(srv.response.success) << srv.response.message;
+  EXPECT_EQ(srv.response.error_word, 0u) << srv.response.message;
   ASSERT_TRUE(wait_for([] { return state_.get()->error_word == 0; }));
+  // The error is gone, but the stop it caused latched: cmd_vel alone does not move the chassis.
+  ASSERT_TRUE(wait_for([] {
+    const auto s = state_.get();
+    return s->rearm_required && s->motion_inhibited_reason == "rearm_required";
+  }));
+  EXPECT_TRUE(contains(state_.get()->latched_causes, "critical_error"));
+  ASSERT_TRUE(drive_for(twist(0.4, 0, 0), 10));
+  EXPECT_LT(speed(*truth_.get()), 1e-3);
+  EXPECT_TRUE(state_.get()->rearm_required);
+  // resume re-arms.
+  const auto resumed = call_resume();
+  EXPECT_TRUE(resumed.success) << resumed.message;
   EXPECT_TRUE(
       drive_until(twist(0.4, 0, 0), [] { return truth_.get()->twist.twist.linear.x > 0.3; }));
+  EXPECT_FALSE(state_.get()->rearm_required);
   stop_and_settle();
 }
 
