@@ -457,6 +457,43 @@ def drive_one_robot(session, cmd, match):
     session.probe(process, conditions)
 
 
+# What the virtual robot's system_state shows after a sim/inject line a README uses.
+INJECTED_STATE = {
+    "estop on": [("vehicle_status", 1), ("motion_inhibited_reason", "estop")],
+    "estop off": [("vehicle_status", 0), ("rearm_required", True)],
+}
+
+
+def inject_fault(session, cmd, match):
+    """`rostopic pub -1 .../sim/inject std_msgs/String "data: 'LINE'"` against a virtual robot
+    started before: exits 0, and the robot's system_state then shows what LINE does."""
+    ns = match.group("ns").strip("/")
+    assert ns in session.robots, f"no virtual robot '{ns}' started before `{cmd.text}`"
+    line = match.group("line")
+    assert line in INJECTED_STATE, (
+        f"`{cmd.text}`: say in INJECTED_STATE what '{line}' shows in system_state")
+    run_ok(session, cmd, match)
+    topic = f"/{ns}/system_state" if ns else "/system_state"
+    session.probe(session.running[-1], [
+        {"topic": topic, "type": "ranger_msgs/SystemState", "field": f, "equals": v}
+        for f, v in INJECTED_STATE[line]])
+
+
+def call_resume(session, cmd, match):
+    """`rosservice call .../resume` against a virtual robot: answers success, and the robot is
+    re-armed (system_state.rearm_required false)."""
+    ns = match.group("ns").strip("/")
+    assert ns in session.robots, f"no virtual robot '{ns}' started before `{cmd.text}`"
+
+    def check(out):
+        assert "success: True" in out, out
+    run_ok(session, cmd, match, check=check)
+    topic = f"/{ns}/system_state" if ns else "/system_state"
+    session.probe(session.running[-1], [
+        {"topic": topic, "type": "ranger_msgs/SystemState", "field": "rearm_required",
+         "equals": False}])
+
+
 def run_ok(session, cmd, match, timeout=120, check=None):
     rc, out = session.run(cmd.text, timeout=timeout)
     assert rc == 0, f"`{cmd.text}` exited {rc}:\n{out[-3000:]}"
@@ -573,6 +610,11 @@ RULES = [
          "runs until the node is up (in CAN command mode with _port_name:=sim)"),
     Rule(r"rostopic pub -r \S+ (?P<ns>/\S+)/cmd_vel geometry_msgs/Twist .*", drive_one_robot,
          "runs until that robot moves; every other virtual robot must stay put"),
+    Rule(r"rostopic pub -1 (?P<ns>(/[^/\s]+)*)/sim/inject std_msgs/String "
+         r"\"data: '(?P<line>[^']*)'\"", inject_fault,
+         "runs against the virtual robot started before; its system_state then shows the fault"),
+    Rule(r"rosservice call (?P<ns>(/[^/\s]+)*)/resume", call_resume,
+         "runs against the virtual robot started before: success, and it is re-armed"),
     Rule(r"ranger_can (?P<rest>.*)", ranger_can, "runs; exit status 0"),
     Rule(r"source install/setup\.bash", run_ok, "runs; exit status 0"),
     Rule(r"cmake -S \. -B build/lib && cmake --build build/lib && ctest --test-dir build/lib "

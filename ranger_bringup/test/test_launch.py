@@ -93,6 +93,7 @@ def test_minimal_on_can0_by_default():
     assert p["/ranger_base_node/port_name"] == "can0"
     assert p["/ranger_base_node/odom_frame"] == "odom"
     assert p["/ranger_base_node/base_frame"] == "base_footprint"  # the URDF's root
+    assert p["/ranger_base_node/frame_prefix"] == ""
     assert p["/ranger_base_node/publish_odom_tf"] is True
     assert p["/diagnostic_aggregator/analyzers/ranger/path"] == "RANGER"
     assert p["/diagnostic_aggregator/analyzers/ranger/expected"] == [
@@ -139,6 +140,7 @@ def test_namespace_moves_nodes_params_and_frames():
     p = params("ranger_minimal.launch", "namespace:=r1")
     assert p["/r1/ranger_base_node/odom_frame"] == "r1/odom"
     assert p["/r1/ranger_base_node/base_frame"] == "r1/base_footprint"
+    assert p["/r1/ranger_base_node/frame_prefix"] == "r1/"
     assert p["/r1/robot_state_publisher/tf_prefix"] == "r1"
     assert "/r1/robot_description" in p and "/robot_description" not in p
 
@@ -210,6 +212,7 @@ def test_two_simulated_robots_share_one_aggregator():
         assert p[f"/{robot}/ranger_base_node/port_name"] == "sim"
         assert p[f"/{robot}/ranger_base_node/odom_frame"] == f"{robot}/odom"
         assert p[f"/{robot}/ranger_base_node/base_frame"] == f"{robot}/base_footprint"
+        assert p[f"/{robot}/ranger_base_node/frame_prefix"] == f"{robot}/"
         assert p[f"/{robot}/robot_state_publisher/tf_prefix"] == robot
         assert analyzer_of(p, robot)["path"] == robot
     assert "/robot_description" not in p

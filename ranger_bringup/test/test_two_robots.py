@@ -2,20 +2,9 @@
 diagnostics aggregator): each is driven by its own cmd_vel (one moves, the other stays put), each
 has its own frames, and one aggregated diagnostics view shows both.
 
-The tests marked xfail(strict=True) are what the node itself must still provide (issue 16, phase
-2); they fail the suite as soon as the node provides it, so that the mark is removed then:
-* hardware_id: each robot's diagnostics name their robot, e.g. "ranger:robot1/sim" (today
-  "ranger:" + port_name, the same for every simulated robot); derived from the node's namespace,
-  or a `~hardware_id` parameter the launch file passes.
-* ultrasonic frames: Range.header.frame_id carries the same prefix as odom_frame/base_frame
-  ("robot1/ultrasonic_1_link"; today "ultrasonic_1_link"). ranger_minimal.launch computes the
-  prefix (arg frame_prefix); the node needs a parameter for it (e.g. `~frame_prefix`), which the
-  launch file passes once the node accepts it (today an unknown private parameter is warned
-  about, so the launch file does not pass it yet).
-Beyond this file, the node's part of issue 16 (phase 2): INFO (not WARN) while waiting for a
-chassis never heard; the CAN open error naming the interface and bringup_can2usb.bash; exit
-within 0.3 s of Ctrl-C / rosnode kill after the stop was sent and logged; clear_errors answering
-with the chassis's error word after it answered; set_ultrasonic refusing an empty request."""
+Each robot's diagnostics carry a hardware_id of their own ("ranger:/robot1:sim": the node's
+namespace and port), and its ultrasonic Range frames the same prefix as odom_frame/base_frame
+("robot1/ultrasonic_1_link": the launch file passes its frame_prefix to the node)."""
 
 import math
 import os
@@ -137,15 +126,14 @@ def test_one_aggregated_view_shows_both_robots(fleet):
     fleet.launch.wait_until(lambda: wanted <= names(), timeout=30)
 
 
-@pytest.mark.xfail(strict=True, reason="phase 2: the node's hardware_id names its robot")
 def test_each_robot_reports_its_own_hardware_id(fleet):
     assert wait_for(lambda: all(f"{r}/ranger_base_node: CAN link" in fleet.raw.get()
                                 for r in ROBOTS), timeout=30)
     ids = fleet.raw.get()
     assert ids["robot1/ranger_base_node: CAN link"] != ids["robot2/ranger_base_node: CAN link"]
+    assert ids["robot1/ranger_base_node: CAN link"] == "ranger:/robot1:sim"
 
 
-@pytest.mark.xfail(strict=True, reason="phase 2: the node prefixes the ultrasonic frames too")
 def test_ultrasonic_frames_are_prefixed_like_every_other_frame(fleet):
     assert wait_for(lambda: all(fleet.range[r].get() for r in ROBOTS), timeout=30)
     for r in ROBOTS:
