@@ -1,5 +1,6 @@
 // `ranger_can decode`: golden output on the bundled sample log, the JSON contract, and garbage in
-// (random bytes, huge lines, empty input) without a crash and with numbered errors on stderr.
+// (random bytes, huge lines, empty input) without a crash and with numbered errors on stderr;
+// padded frames decode and say so.
 #include <gtest/gtest.h>
 
 #include <cctype>
@@ -192,12 +193,13 @@ TEST(CliDecode, SampleLogShowsEveryPartOfTheContract) {
   // One line per input frame.
   EXPECT_EQ(lines_of(out).size(), lines_of(read_file(kSampleLog)).size());
   EXPECT_TRUE(has(R"("t":1700000000.030050,"iface":"can0","id":273,"name":"motion_command")"));
-  EXPECT_TRUE(has(R"("linear_speed":0.15,"spin_speed":0.0,"steering_angle":0.17453292519943295)"));
+  EXPECT_TRUE(has(R"("linear_speed":0.15,"yaw_rate":0.0,"spin_speed":0.0,)"
+                  R"("steering_angle":0.17453292519943295)"));
   EXPECT_TRUE(has(R"("vehicle_status":0,"vehicle_status_name":"normal","control_mode":1)"));
   EXPECT_TRUE(
       has(R"("battery_voltage":51.2,"error_bits":512,"errors":["host_communication_lost"])"));
   EXPECT_TRUE(has(R"("name":"motion_feedback","dlc":8,"data":"00980000000003E8","speed":0.152,)"
-                  R"("steering_angle":0.17453292519943295})"));
+                  R"("yaw_rate":0.0,"lateral_speed":0.0,"steering_angle":0.17453292519943295})"));
   EXPECT_TRUE(has(R"("name":"steering_angles")"));
   EXPECT_TRUE(has(R"("angles":[0.19320794819577225,-0.19320794819577225,)"));
   EXPECT_TRUE(has(R"("speeds":[0.136,0.136,0.168,0.168])"));
@@ -207,7 +209,8 @@ TEST(CliDecode, SampleLogShowsEveryPartOfTheContract) {
                   R"("temperature":25.3)"));
   EXPECT_TRUE(has(R"("id":1793,"name":"unknown","dlc":1,"data":"05","error":)"));
   EXPECT_TRUE(has(R"("name":"motion_feedback","dlc":4,"data":"00960000",)"
-                  R"("error":"0x221 (motion_feedback): DLC 4, expected 8")"));
+                  R"("error":"0x221 (motion_feedback): DLC 4, expected 8 or more")"));
+  EXPECT_EQ(out.find("extra_bytes"), std::string::npos) << "no padded frame in the sample";
 }
 
 TEST(CliDecode, RealExecutableMatchesTheGolden) {
@@ -230,7 +233,7 @@ TEST(CliDecode, MalformedLinesAreNumberedAndDecodingGoesOn) {
       "(1.000000) can0 111#0096000000000000\n"
       "this is not candump\n"
       "\n"
-      "(1.020000) can0 221#00960000000000\n"  // 7 bytes: a parsed frame with a bad DLC
+      "(1.020000) can0 221#00960000000000\n"  // 7 bytes: a parsed frame, too short
       "(1.040000) can0 221#0G\n"
       "  can0  291   [2]  00 01\n";
   const Outcome r = run({"--json"}, input);
@@ -238,7 +241,7 @@ TEST(CliDecode, MalformedLinesAreNumberedAndDecodingGoesOn) {
   const auto out = lines_of(r.out);
   ASSERT_EQ(out.size(), 3u);
   EXPECT_NE(out[0].find("\"motion_command\""), std::string::npos);
-  EXPECT_NE(out[1].find("\"error\":\"0x221 (motion_feedback): DLC 7, expected 8\""),
+  EXPECT_NE(out[1].find("\"error\":\"0x221 (motion_feedback): DLC 7, expected 8 or more\""),
             std::string::npos);
   EXPECT_NE(out[2].find("\"t\":0.000000"), std::string::npos);  // no timestamp in that format
   EXPECT_NE(out[2].find("\"switching\":true"), std::string::npos);

@@ -118,10 +118,8 @@ void VirtualChassis::step(Timestamp now) {
     } else {
       const auto ids = protocol::all_ids();
       f.id = ids[garbage_rng_() % ids.size()];
-      const int expected = protocol::expected_dlc(f.id);
-      do {
-        f.dlc = static_cast<std::uint8_t>(garbage_rng_() % 9);
-      } while (f.dlc == expected);
+      // Shorter than its layout (a longer frame is valid: its extra bytes are ignored).
+      f.dlc = static_cast<std::uint8_t>(garbage_rng_() % protocol::layout_dlc(f.id));
     }
     for (int i = 0; i < f.dlc; ++i)
       f.data[i] = static_cast<std::uint8_t>(garbage_rng_());
