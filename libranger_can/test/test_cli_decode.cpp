@@ -16,6 +16,7 @@
 #include "cli_commands.hpp"
 #include "cli_input.hpp"
 #include "cli_json.hpp"
+#include "ranger_can/wire/protocol.hpp"
 #include "support/cli_run.hpp"
 
 namespace ranger::cli {
@@ -224,6 +225,177 @@ TEST(CliDecode, RealExecutableMatchesTheGolden) {
     out.append(buf, n);
   EXPECT_EQ(pclose(pipe), 0);
   EXPECT_EQ(out, read_file(kGoldenJson));
+}
+
+// ---- The bundled logs of both revisions, padded and unpadded ----------------------------------
+// (written by test_cli_odom.cpp's generator: one drive, encoded under each profile)
+
+const std::string kPaddedLog = std::string(RANGER_DATA_DIR) + "/sample_padded.log";
+const std::string kAgxLog = std::string(RANGER_DATA_DIR) + "/sample_agx_v2.log";
+const std::string kAgxUnpaddedLog = std::string(RANGER_DATA_DIR) + "/sample_agx_v2_unpadded.log";
+
+// The value of `"key":` in a JSON line, as text up to the next ',' or '}' ("" when absent).
+std::string json_value(const std::string& line, const std::string& key) {
+  const std::string k = "\"" + key + "\":";
+  const auto at = line.find(k);
+  if (at == std::string::npos) return "";
+  const auto start = at + k.size();
+  return line.substr(start, line.find_first_of(",}", start) - start);
+}
+
+TEST(CliDecode, PaddedLogDecodesEveryFrameAndCountsTheIgnoredBytes) {
+  const Outcome r = run({kPaddedLog, "--json"});
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  expect_all_valid_json(r.out);
+  const auto lines = lines_of(r.out);
+  EXPECT_EQ(lines.size(), lines_of(read_file(kPaddedLog)).size());
+  std::size_t padded = 0;
+  for (const auto& line : lines) {
+    EXPECT_EQ(line.find("\"error\""), std::string::npos) << line;
+    EXPECT_EQ(json_value(line, "dlc"), "8") << line;
+    const int id = std::stoi(json_value(line, "id"));
+    const int extra = 8 - protocol::layout_dlc(static_cast<std::uint32_t>(id));
+    if (extra > 0) {
+      EXPECT_EQ(json_value(line, "extra_bytes"), std::to_string(extra)) << line;
+      ++padded;
+    } else {
+      EXPECT_EQ(line.find("extra_bytes"), std::string::npos) << line;
+    }
+  }
+  EXPECT_GT(padded, 150u);  // every 0x291 (6 bytes), and the one-byte commands
+  EXPECT_NE(r.out.find(R"("name":"motion_mode","dlc":8,"data":"0000000000000000","extra_bytes":6,)"
+                       R"("mode":0,"mode_name":"ackermann","switching":false)"),
+            std::string::npos);
+  // Text: the same frames, each padded one saying so.
+  const Outcome text = run({kPaddedLog});
+  ASSERT_EQ(text.rc, 0);
+  EXPECT_NE(text.out.find("motion_mode                  mode=0 (ackermann) switching=no  "
+                          "[+6 bytes ignored]\n"),
+            std::string::npos);
+  EXPECT_NE(text.out.find("control_mode_command         mode=1 (can)  [+7 bytes ignored]\n"),
+            std::string::npos);
+  EXPECT_EQ(text.out.find(" error: "), std::string::npos);
+}
+
+TEST(CliDecode, AgxV2LogTourUnderItsProfile) {
+  const Outcome r = run({kAgxLog, "--protocol", "agx_v2"});
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  const auto lines = lines_of(r.out);
+  const std::vector<std::string> tour = {
+      "1700000000.000000 can0 421 control_mode_command         mode=1 (can)  [+7 bytes ignored]",
+      "1700000000.010000 can0 4A1 version                      request  [+7 bytes ignored]",
+      "1700000000.020000 can0 4A1 version                      text=\"V2.3.1\"",
+      "1700000000.030000 can0 121 light_command                enable=yes front=on/0 "
+      "rear=breathing/0 counter=0",
+      "1700000000.040000 can0 231 light_state                  enable=yes front=on/0 "
+      "rear=breathing/0 counter=1",
+      "1700000000.050000 can0 241 remote_control               swa=up swb=up swc=middle swd=down "
+      "right_h=0 right_v=0 left_v=12 left_h=0 var_a=0 counter=7",
+      "1700000000.060000 can0 311 odometer                     left=12345 right=12400 (raw)",
+      "1700000000.070000 can0 211 system_status                vehicle=normal control=can "
+      "battery=51.2 V errors=0x0200 [host_communication_lost] counter=200",
+      "1700000000.080000 can0 261 motor_low_speed              motor=1 voltage=51.0 V driver=33 "
+      "degC motor=29 degC status=none",
+      "1700000000.090000 can0 361 bms                          battery=pack soc=87% soh=98% "
+      "voltage=51.20 V current=-2.4 A temperature=25.3 degC",
+      "1700000000.100000 can0 362 bms_alarm                    battery=pack alarms=none "
+      "warnings=none  [+4 bytes ignored]",
+      "1700000000.110000 can0 141 motion_mode_command          mode=0 (ackermann)  [+7 bytes "
+      "ignored]",
+      "1700000000.120000 can0 111 motion_command               linear=0.500 m/s yaw_rate=0.000 "
+      "rad/s spin=0.000 m/s steering=0.00 deg",
+  };
+  ASSERT_GT(lines.size(), tour.size());
+  for (std::size_t i = 0; i < tour.size(); ++i)
+    EXPECT_EQ(lines[i], tour[i]);
+  EXPECT_EQ(r.out.find(" error: "), std::string::npos);
+}
+
+TEST(CliDecode, AgxV2LogCounterIsNoFault) {
+  const Outcome r = run({kAgxLog, "--json", "--protocol", "agx_v2"});
+  ASSERT_EQ(r.rc, 0) << r.err;
+  expect_all_valid_json(r.out);
+  std::size_t statuses = 0, faults = 0;
+  for (const auto& line : lines_of(r.out)) {
+    EXPECT_EQ(line.find("\"error\""), std::string::npos) << line;
+    if (json_value(line, "name") != "\"system_status\"") continue;
+    ++statuses;
+    EXPECT_FALSE(json_value(line, "counter").empty()) << line;
+    EXPECT_EQ(json_value(line, "critical"), "false") << line;
+    if (json_value(line, "error_bits") != "0") ++faults;
+  }
+  EXPECT_GT(statuses, 170u);
+  EXPECT_EQ(faults, 1u) << "only the tour's host_communication_lost";
+  // Units: 0.1 V BMS, wheel angles in mrad (left positive) read back in rad (right positive).
+  EXPECT_NE(r.out.find(R"("voltage":51.2,"current":-2.4)"), std::string::npos);
+}
+
+TEST(CliDecode, AgxV2LogUnderTheManualShowsWhyTheProfileMatters) {
+  const Outcome r = run({kAgxLog, "--json"});
+  ASSERT_EQ(r.rc, 0) << r.err;
+  std::size_t phantom = 0;
+  for (const auto& line : lines_of(r.out)) {
+    if (json_value(line, "name") == "\"system_status\"" && json_value(line, "error_bits") != "0") {
+      ++phantom;  // the counter in byte 7, read as the low byte of a 32-bit error word
+    }
+  }
+  EXPECT_GT(phantom, 100u);
+  EXPECT_NE(r.out.find(R"("voltage":5.12,)"), std::string::npos) << "0.1 V read as 0.01 V";
+  EXPECT_EQ(r.out.find(R"("voltage":51.2,)"), std::string::npos);
+}
+
+TEST(CliDecode, AgxV2LogPaddedAndUnpaddedDecodeAlike) {
+  const auto padded = lines_of(run({kAgxLog, "--json", "--protocol", "agx_v2"}).out);
+  const auto unpadded = lines_of(run({kAgxUnpaddedLog, "--json", "--protocol", "agx_v2"}).out);
+  ASSERT_EQ(padded.size(), unpadded.size());
+  // Equal after the frame part (dlc, data, extra_bytes): the same messages.
+  auto message_part = [](const std::string& line) {
+    const auto data = line.find("\"data\":");
+    const auto after = line.find(',', line.find('"', data + 8) + 1);
+    std::string rest = line.substr(after);
+    const auto extra = rest.find(",\"extra_bytes\":");
+    if (extra != std::string::npos) rest.erase(extra, rest.find(',', extra + 1) - extra);
+    return line.substr(0, line.find("\"dlc\":")) + rest;
+  };
+  for (std::size_t i = 0; i < padded.size(); ++i) {
+    EXPECT_EQ(message_part(padded[i]), message_part(unpadded[i])) << padded[i];
+    EXPECT_EQ(unpadded[i].find("extra_bytes"), std::string::npos) << unpadded[i];
+  }
+}
+
+TEST(CliDecode, ProtocolOptions) {
+  const Outcome help = run({"--help"});
+  EXPECT_NE(help.out.find("--protocol manual|agx_v2"), std::string::npos) << help.out;
+  EXPECT_NE(help.out.find("--set NAME=VALUE"), std::string::npos);
+  EXPECT_NE(help.out.find("steering_unit_271=centideg|millirad"), std::string::npos);
+  const Outcome bad = run({kAgxLog, "--protocol", "vendor"});
+  EXPECT_EQ(bad.rc, 2);
+  EXPECT_EQ(bad.out, "");
+  EXPECT_NE(bad.err.find("--protocol: 'vendor' is not one of manual, agx_v2"), std::string::npos)
+      << bad.err;
+  const Outcome value = run({kAgxLog, "--set", "error_word=agx32"});
+  EXPECT_EQ(value.rc, 2);
+  EXPECT_NE(value.err.find("protocol setting error_word = 'agx32' is invalid (valid: "
+                           "manual32|agx16)"),
+            std::string::npos)
+      << value.err;
+  const Outcome name = run({kAgxLog, "--set", "counter=yes"});
+  EXPECT_EQ(name.rc, 2);
+  EXPECT_NE(name.err.find("unknown protocol setting 'counter' (valid: steering_unit_111, "),
+            std::string::npos)
+      << name.err;
+  // One setting on top of the manual: the 16-bit word alone removes the phantom faults.
+  const Outcome word =
+      run({kAgxLog, "--json", "--set", "error_word=agx16", "--set", "bms_voltage_scale=0.1"});
+  ASSERT_EQ(word.rc, 0) << word.err;
+  EXPECT_NE(word.out.find(R"("voltage":51.2,)"), std::string::npos);
+  EXPECT_NE(word.out.find(R"("errors":[],"critical":false,"counter":1})"), std::string::npos);
+  // Later --set wins.
+  const Outcome twice =
+      run({kAgxLog, "--json", "--set", "bms_voltage_scale=0.1", "--set", "bms_voltage_scale=0.01"});
+  EXPECT_NE(twice.out.find(R"("voltage":5.12,)"), std::string::npos);
 }
 
 // ---- Bad input --------------------------------------------------------------------------------
