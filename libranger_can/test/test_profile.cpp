@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <fstream>
 #include <ostream>
 #include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -286,6 +288,51 @@ TEST(ProfileNames, EnumerationsAsTheSettingsSpellThem) {
   EXPECT_EQ(to_string(DriverStatusBit6::kDisabled), "disabled");
   EXPECT_EQ(to_string(DriverStatusBit6::kEnabled), "enabled");
   EXPECT_EQ(to_string(static_cast<ModeNumbering>(9)), "unknown");
+}
+
+// ---- docs/PROTOCOL_INTERPRETATIONS.md lists every setting as the code has it -------------------
+
+// The cells of a Markdown table row ("| a | b \\| c |" -> {"a", "b | c"}), trimmed.
+std::vector<std::string> cells(const std::string& row) {
+  std::vector<std::string> out;
+  std::string cell;
+  for (std::size_t i = 1; i < row.size(); ++i) {
+    if (row[i] == '\\' && i + 1 < row.size() && row[i + 1] == '|') {
+      cell += '|';
+      ++i;
+    } else if (row[i] == '|') {
+      const auto b = cell.find_first_not_of(' '), e = cell.find_last_not_of(' ');
+      out.push_back(b == std::string::npos ? "" : cell.substr(b, e - b + 1));
+      cell.clear();
+    } else {
+      cell += row[i];
+    }
+  }
+  return out;
+}
+
+TEST(ProfileDocs, TheSettingsTableMatchesTheCode) {
+  std::ifstream in(std::string(RANGER_SOURCE_DIR) + "/../docs/PROTOCOL_INTERPRETATIONS.md");
+  ASSERT_TRUE(in.good());
+  std::vector<std::string> rows;
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("| `", 0) == 0) rows.push_back(line);
+  }
+  for (const auto& s : profile_settings()) {
+    SCOPED_TRACE(std::string(s.name));
+    const std::string key = "| `" + std::string(s.name) + "` |";
+    const auto row = std::find_if(rows.begin(), rows.end(),
+                                  [&](const std::string& r) { return r.rfind(key, 0) == 0; });
+    ASSERT_NE(row, rows.end()) << "no row for the setting";
+    const auto c = cells(*row);
+    ASSERT_GE(c.size(), 7u) << *row;
+    for (const auto& v : s.values)
+      EXPECT_NE(c[2].find("`" + std::string(v) + "`"), std::string::npos) << c[2];
+    EXPECT_EQ(c[3], "`" + *get_setting(preset("manual"), s.name) + "`");
+    EXPECT_EQ(c[4], "`" + *get_setting(preset("agx_v2"), s.name) + "`");
+    EXPECT_EQ(c[5], "see models");
+    EXPECT_FALSE(c[6].empty()) << "evidence";
+  }
 }
 
 }  // namespace
