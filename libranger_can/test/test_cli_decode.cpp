@@ -527,6 +527,18 @@ TEST(CliDecode, StrangeInterfaceNamesStayValidJson) {
   EXPECT_NE(r.out.find(R"("iface":"a\"b\\\u0001\u00ff")"), std::string::npos) << r.out;
 }
 
+TEST(CliDecode, UltrasonicZeroIsNoReading) {
+  const std::string line = "(1.0) can0 342#0000FFFF04B00000\n";
+  const Outcome text = run({}, line);
+  EXPECT_NE(text.out.find("s1=no_reading s2=offline s3=1200 mm s4=no_reading"), std::string::npos)
+      << text.out;
+  const Outcome json = run({"--json"}, line);
+  EXPECT_NE(json.out.find(R"("raw":[0,-1,1200,0],"status":["no_reading","offline","ok",)"
+                          R"("no_reading"])"),
+            std::string::npos)
+      << json.out;
+}
+
 TEST(CliDecode, ExtremeValuesAndErrorFrames) {
   const Outcome r = run({"--json"},
                         "(1.0) can0 281#7FFF800000000001\n"

@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "ranger_can/wire/interpretation.hpp"
 #include "ranger_can/wire/protocol.hpp"
 
 namespace ranger::cli {
@@ -284,7 +285,7 @@ struct TextFields {
   void operator()(const UltrasonicFeedback& m) const {
     for (int i = 0; i < 4; ++i) {
       if (i > 0) out += ' ';
-      if (m.raw[i] >= 0) {
+      if (interpretation::ultrasonic_distance_m(m.raw[i])) {  // 0 is no reading, not 0 mm
         appendf(out, "s%d=%d mm", m.first_sensor + i, m.raw[i]);
       } else {
         appendf(out, "s%d=%s", m.first_sensor + i, proto::ultrasonic_status_name(m.raw[i]).data());
