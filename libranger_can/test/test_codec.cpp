@@ -9,7 +9,9 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <limits>
+#include <new>
 #include <random>
 #include <string>
 #include <vector>
@@ -18,6 +20,22 @@
 #include "ranger_can/wire/interpretation.hpp"
 #include "ranger_can/wire/profile.hpp"
 #include "ranger_can/wire/protocol.hpp"
+
+// Counts the global allocations of this test program (for CodecDecode.DoesNotAllocateOnSuccess).
+namespace {
+std::size_t g_allocations = 0;
+}  // namespace
+void* operator new(std::size_t n) {
+  ++g_allocations;
+  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept {
+  std::free(p);
+}
+void operator delete(void* p, std::size_t) noexcept {
+  std::free(p);
+}
 
 namespace ranger {
 namespace {
@@ -709,6 +727,26 @@ TEST(CodecDecode, LongerFramesDecodeTheirLeadingBytes) {
       }
     }
   }
+}
+
+TEST(CodecDecode, DoesNotAllocateOnSuccess) {
+  std::vector<CanFrame> frames;
+  for (std::uint32_t id : proto::all_ids()) {
+    CanFrame f;
+    f.id = id;
+    f.dlc = 8;  // padded: every layout, read from its leading bytes
+    f.data = {0x01, 0x00, 0x00, 0x01, 0x00, 0x01, 0x00, 0x02};
+    frames.push_back(f);
+  }
+  const ProtocolProfile profiles_[] = {manual_profile(), agx_v2()};
+  std::size_t decoded = 0;
+  const std::size_t before = g_allocations;
+  for (const ProtocolProfile& p : profiles_) {
+    for (const CanFrame& f : frames)
+      decoded += decode(f, p).ok() ? 1 : 0;
+  }
+  EXPECT_EQ(g_allocations - before, 0u);
+  EXPECT_EQ(decoded, 2 * frames.size());
 }
 
 TEST(CodecDecode, PaddedSampleFrames) {

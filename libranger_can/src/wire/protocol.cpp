@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <initializer_list>
+#include <iterator>
 #include <string>
 
 namespace ranger::protocol {
@@ -149,30 +150,51 @@ std::string_view frame_name(std::uint32_t id) {
 
 // ---- Motion modes -------------------------------------------------------------------------------
 
-std::vector<MotionMode> motion_modes(ModeNumbering numbering) {
+namespace {
+
+// Each numbering's modes in wire order (index = wire value). Plain arrays: the codec maps modes on
+// every 0x141 and 0x291 without allocating.
+constexpr MotionMode kManualModes[] = {MotionMode::kAckermann, MotionMode::kOblique,
+                                       MotionMode::kSpin};
+constexpr MotionMode kAgxV2Modes[] = {MotionMode::kAckermann, MotionMode::kOblique,
+                                      MotionMode::kSpin, MotionMode::kPark, MotionMode::kSideSlip};
+constexpr MotionMode kMiniV1Modes[] = {MotionMode::kAckermann, MotionMode::kOblique,
+                                       MotionMode::kSpin, MotionMode::kSideSlip};
+
+struct ModeTable {
+  const MotionMode* modes;
+  std::size_t count;
+};
+
+ModeTable mode_table(ModeNumbering numbering) {
   switch (numbering) {
     case ModeNumbering::kManual:
-      return {MotionMode::kAckermann, MotionMode::kOblique, MotionMode::kSpin};
+      return {kManualModes, std::size(kManualModes)};
     case ModeNumbering::kAgxV2:
-      return {MotionMode::kAckermann, MotionMode::kOblique, MotionMode::kSpin, MotionMode::kPark,
-              MotionMode::kSideSlip};
+      return {kAgxV2Modes, std::size(kAgxV2Modes)};
     case ModeNumbering::kMiniV1:
-      return {MotionMode::kAckermann, MotionMode::kOblique, MotionMode::kSpin,
-              MotionMode::kSideSlip};
+      return {kMiniV1Modes, std::size(kMiniV1Modes)};
   }
-  return {};
+  return {nullptr, 0};
+}
+
+}  // namespace
+
+std::vector<MotionMode> motion_modes(ModeNumbering numbering) {
+  const ModeTable t = mode_table(numbering);
+  return std::vector<MotionMode>(t.modes, t.modes + t.count);
 }
 
 std::optional<MotionMode> motion_mode_from_wire(std::uint8_t raw, ModeNumbering numbering) {
-  const std::vector<MotionMode> modes = motion_modes(numbering);  // index = wire value
-  if (raw < modes.size()) return modes[raw];
+  const ModeTable t = mode_table(numbering);
+  if (raw < t.count) return t.modes[raw];
   return std::nullopt;
 }
 
 std::optional<std::uint8_t> motion_mode_to_wire(MotionMode mode, ModeNumbering numbering) {
-  const std::vector<MotionMode> modes = motion_modes(numbering);
-  for (std::size_t i = 0; i < modes.size(); ++i) {
-    if (modes[i] == mode) return static_cast<std::uint8_t>(i);
+  const ModeTable t = mode_table(numbering);
+  for (std::size_t i = 0; i < t.count; ++i) {
+    if (t.modes[i] == mode) return static_cast<std::uint8_t>(i);
   }
   return std::nullopt;
 }
