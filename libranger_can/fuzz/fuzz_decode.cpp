@@ -1,17 +1,23 @@
 // Fuzzes the frame decoder with arbitrary identifiers, DLCs (0..15: a corrupt DLC nibble must
-// not be trusted), bytes and error flags.
+// not be trusted), bytes, error flags and protocol profiles (every setting's value drawn from the
+// input, so both revisions and every mix of them are reached).
 //
 // Properties (each a FUZZ_CHECK):
 //  * decode() never crashes and refuses what it cannot read with the documented error codes:
-//    kInvalidArgument for error frames, kUnknownId exactly for IDs outside the protocol, kBadDlc
-//    for a DLC other than the protocol's; every error has a message;
-//  * no byte past `dlc` is read: the same frame with different bytes beyond its DLC decodes to
-//    the same message (compared through its encoding) or the same error;
-//  * encode(decode(x)) reproduces x byte for byte, up to exactly what the protocol cannot carry
-//    back: reserved bytes are sent as zero, a boolean byte as 0x01, 0x111 fields saturate to their
-//    valid range, BMS SOC/SOH to 100 %; only command frames with values a host may not send
-//    (0x141 mode > 2, 0x421 mode other than standby/CAN, 0x441 code > 0x10) fail to re-encode;
-//  * the protocol tables (names, bit names) answer for any value.
+//    kInvalidArgument for error frames, kUnknownId exactly for IDs outside both revisions,
+//    kBadDlc exactly for a DLC shorter than the ID's layout or above 8, kOutOfRange only for a
+//    0x221/0x271 steering angle beyond interpretation::kMaxPlausibleSteeringRad; every error has a
+//    message;
+//  * a longer frame decodes from its leading bytes (issue 14): no byte past the layout is read,
+//    so the same frame with other bytes past its layout, or cut to its layout, decodes to the
+//    same message (compared through its encoding) or the same error; no byte past `dlc` either;
+//  * encode(decode(x)) under the same profile (with tx_dlc 0) reproduces x's layout bytes, up to
+//    exactly what the protocol cannot carry back: reserved bytes are sent as zero, a boolean byte
+//    as 0x01, 0x111 fields saturate to their valid range, BMS SOC/SOH to 100 %; only command
+//    frames with values a host may not send (a 0x141 mode the numbering lacks, a 0x421 mode other
+//    than standby/CAN, a 0x441 code > 0x10, a 0x121 light mode > 3) fail to re-encode; with
+//    tx_dlc 8 the same bytes come back zero-padded to 8;
+//  * the protocol tables (names, bit names of both layouts, faults) answer for any value.
 #include <algorithm>
 #include <cstdint>
 #include <string>
@@ -19,6 +25,8 @@
 
 #include "fuzz_input.hpp"
 #include "ranger_can/wire/codec.hpp"
+#include "ranger_can/wire/interpretation.hpp"
+#include "ranger_can/wire/profile.hpp"
 #include "ranger_can/wire/protocol.hpp"
 
 namespace {
@@ -26,6 +34,7 @@ namespace {
 namespace protocol = ranger::protocol;
 using ranger::CanFrame;
 using ranger::Errc;
+using ranger::ProtocolProfile;
 
 std::uint16_t get_u16(const CanFrame& f, int at) {
   return static_cast<std::uint16_t>(f.data[at] << 8 | f.data[at + 1]);
@@ -49,17 +58,36 @@ bool is_bms_data(std::uint32_t id) {
          (id - protocol::kBmsBaseId) % 2 == 0;
 }
 
-// What encode(decode(f)) must produce for a valid frame `f` (see the header comment).
-CanFrame canonical(CanFrame f) {
+// A profile with every setting drawn from the input.
+ProtocolProfile consume_profile(FuzzedDataProvider& in) {
+  ProtocolProfile p;
+  for (const auto& s : ranger::profile_settings()) {
+    const auto i = in.ConsumeIntegralInRange<std::size_t>(0, s.values.size() - 1);
+    FUZZ_CHECK(ranger::set_setting(p, s.name, s.values[i]).ok());
+  }
+  FUZZ_CHECK(p.validate().ok());
+  return p;
+}
+
+// `f` cut to its layout (the bytes a decoder reads): a 0x4A1 answer is all text.
+CanFrame cut_to_layout(CanFrame f) {
+  if (f.id == protocol::kVersionId && !protocol::is_version_request(f)) return f;
+  const int layout = protocol::layout_dlc(f.id);
+  f.dlc = static_cast<std::uint8_t>(layout);
+  for (std::size_t i = static_cast<std::size_t>(layout); i < CanFrame::kMaxDlc; ++i)
+    f.data[i] = 0;
+  return f;
+}
+
+// What encode(decode(f)) must produce under `p` with tx_dlc 0, for a valid frame `f` cut to its
+// layout (see the header comment).
+CanFrame canonical(CanFrame f, const ProtocolProfile& p) {
   switch (f.id) {
     case protocol::kMotionCommandId:
-      f.data[2] = f.data[3] = 0;
       saturate_i16_field(f, 0, 2600);  // interpretation::kMaxLinearSpeedMps
-      saturate_i16_field(f, 4, 1000);
-      saturate_i16_field(f, 6, 9000);
-      break;
-    case protocol::kMotionFeedbackId:
-      f.data[2] = f.data[3] = f.data[4] = f.data[5] = 0;
+      if (p.spin_field == ranger::SpinField::kWheelSpeed) saturate_i16_field(f, 4, 1000);
+      saturate_i16_field(f, 6,
+                         p.steering_unit_111 == ranger::AngleUnit::kMilliradian ? 1571 : 9000);
       break;
     case protocol::kUltrasonicSettingId:
     case protocol::kUltrasonicSettingFeedbackId:
@@ -67,6 +95,20 @@ CanFrame canonical(CanFrame f) {
       break;
     case protocol::kMotionModeFeedbackId:
       f.data[1] = f.data[1] != 0;
+      break;
+    case protocol::kLightCommandId:
+    case protocol::kLightStateId:
+      f.data[0] = f.data[0] != 0;
+      f.data[5] = f.data[6] = 0;
+      break;
+    case protocol::kRemoteControlStateId:
+      f.data[6] = 0;
+      break;
+    case protocol::kSystemStatusId:
+      if (p.error_word == ranger::ErrorWordLayout::kAgxV2_16) f.data[6] = 0;
+      break;
+    case protocol::kVersionId:
+      if (protocol::is_version_request(f)) f.dlc = 1;
       break;
     default:
       if (is_low_speed(f.id)) f.data[6] = f.data[7] = 0;
@@ -80,14 +122,16 @@ CanFrame canonical(CanFrame f) {
 }
 
 // Commands whose decoded value a host may not send: the only frames that may fail to re-encode.
-bool unsendable_command(const CanFrame& f) {
+bool unsendable_command(const CanFrame& f, const ProtocolProfile& p) {
   switch (f.id) {
     case protocol::kMotionModeCommandId:
-      return f.data[0] > 2;
+      return !protocol::motion_mode_from_wire(f.data[0], p.mode_numbering).has_value();
     case protocol::kControlModeCommandId:
       return f.data[0] != 0 && f.data[0] != 1;
     case protocol::kErrorClearCommandId:
       return f.data[0] > protocol::kMaxErrorClearCode;
+    case protocol::kLightCommandId:
+      return f.data[1] > 3 || f.data[3] > 3;
     default:
       return false;
   }
@@ -96,9 +140,17 @@ bool unsendable_command(const CanFrame& f) {
 void check_tables(FuzzedDataProvider& in, std::uint32_t id) {
   FUZZ_CHECK(!protocol::frame_name(id).empty());
   const auto word = in.ConsumeIntegral<std::uint32_t>();
-  for (const auto& name : protocol::error_bit_names(word))
-    FUZZ_CHECK(!name.empty());
-  (void)protocol::is_critical_error(word);
+  for (const auto layout :
+       {ranger::ErrorWordLayout::kManual32, ranger::ErrorWordLayout::kAgxV2_16}) {
+    for (const auto& name : protocol::error_bit_names(word, layout))
+      FUZZ_CHECK(!name.empty());
+    (void)protocol::is_critical_error(word, layout);
+    const int motor = in.ConsumeIntegralInRange<int>(-1, 10);
+    const auto fault =
+        static_cast<protocol::Fault>(in.ConsumeIntegralInRange<int>(0, protocol::kFaultCount - 1));
+    const std::uint32_t bit = protocol::fault_bit(fault, layout, motor);
+    FUZZ_CHECK((bit & (bit - 1)) == 0);
+  }
   const auto byte = in.ConsumeIntegral<std::uint8_t>();
   for (const auto& name : protocol::driver_status_names(byte))
     FUZZ_CHECK(!name.empty());
@@ -114,17 +166,20 @@ void check_tables(FuzzedDataProvider& in, std::uint32_t id) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static const std::vector<std::uint32_t> kIds = protocol::all_ids();
   FuzzedDataProvider in(data, size);
+  const ProtocolProfile profile = consume_profile(in);
+  ProtocolProfile unpadded = profile;
+  unpadded.tx_dlc = 0;
 
   CanFrame frame;
   // Mostly RANGER IDs so that every decoder is reached; otherwise any 32-bit value.
   frame.id = in.ConsumeIntegralInRange<int>(0, 3) != 0
                  ? kIds[in.ConsumeIntegralInRange<std::size_t>(0, kIds.size() - 1)]
                  : in.ConsumeIntegral<std::uint32_t>();
-  // The DLC the protocol wants three times in four; otherwise any nibble.
-  const int wanted = protocol::expected_dlc(frame.id);
-  frame.dlc = wanted >= 0 && in.ConsumeIntegralInRange<int>(0, 3) != 0
-                  ? static_cast<std::uint8_t>(wanted)
-                  : in.ConsumeIntegralInRange<std::uint8_t>(0, 15);
+  // The layout's length or 8 (padded) three times in four; otherwise any nibble.
+  const int layout = protocol::layout_dlc(frame.id);
+  const int pick = in.ConsumeIntegralInRange<int>(0, 3);
+  frame.dlc = layout >= 0 && pick != 0 ? static_cast<std::uint8_t>(pick == 1 ? 8 : layout)
+                                       : in.ConsumeIntegralInRange<std::uint8_t>(0, 15);
   frame.is_error = in.ConsumeIntegralInRange<int>(0, 31) == 0;
   const std::size_t valid = std::min<std::size_t>(frame.dlc, CanFrame::kMaxDlc);
   for (std::size_t i = 0; i < valid; ++i)
@@ -135,8 +190,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     dirty.data[i] = static_cast<std::uint8_t>(0xA5 ^ in.ConsumeIntegral<std::uint8_t>());
   }
 
-  const auto message = ranger::decode(frame);
-  const auto dirty_message = ranger::decode(dirty);
+  const auto message = ranger::decode(frame, profile);
+  const auto dirty_message = ranger::decode(dirty, profile);
   FUZZ_CHECK(message.ok() == dirty_message.ok());
   check_tables(in, frame.id);
 
@@ -149,36 +204,63 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       FUZZ_CHECK(code == Errc::kInvalidArgument);
     } else if (!protocol::is_known_id(frame.id)) {
       FUZZ_CHECK(code == Errc::kUnknownId);
+    } else if (code == Errc::kOutOfRange) {
+      FUZZ_CHECK(frame.id == protocol::kMotionFeedbackId ||
+                 frame.id == protocol::kSteeringAnglesId);
+      FUZZ_CHECK(frame.dlc >= layout && frame.dlc <= 8);
+      // The same content cut to its layout is just as impossible.
+      const auto cut = ranger::decode(cut_to_layout(frame), profile);
+      FUZZ_CHECK(!cut.ok() && cut.error().message == message.error().message);
     } else {
       FUZZ_CHECK(code == Errc::kBadDlc);
-      FUZZ_CHECK(frame.dlc != wanted);
+      FUZZ_CHECK(frame.dlc < layout || frame.dlc > 8);
     }
     return 0;
   }
 
   FUZZ_CHECK(!frame.is_error);
   FUZZ_CHECK(protocol::is_known_id(frame.id));
-  FUZZ_CHECK(frame.dlc == wanted);
+  FUZZ_CHECK(frame.dlc >= layout && frame.dlc <= 8);
   FUZZ_CHECK(ranger::id_of(*message) == frame.id);
 
-  const auto encoded = ranger::encode(*message);
-  const auto dirty_encoded = ranger::encode(*dirty_message);
+  // Extra bytes are ignored: the frame cut to its layout decodes to the same message.
+  const CanFrame cut = cut_to_layout(frame);
+  FUZZ_CHECK(protocol::extra_bytes(frame) == frame.dlc - cut.dlc);
+  const auto cut_message = ranger::decode(cut, profile);
+  FUZZ_CHECK(cut_message.ok());
+  FUZZ_CHECK(cut_message->index() == message->index());
+
+  const auto encoded = ranger::encode(*message, unpadded);
+  const auto dirty_encoded = ranger::encode(*dirty_message, unpadded);
+  const auto cut_encoded = ranger::encode(*cut_message, unpadded);
   FUZZ_CHECK(encoded.ok() == dirty_encoded.ok());
+  FUZZ_CHECK(encoded.ok() == cut_encoded.ok());
   if (!encoded.ok()) {
-    FUZZ_CHECK(unsendable_command(frame));
+    FUZZ_CHECK(unsendable_command(frame, profile));
     FUZZ_CHECK(encoded.error().code == Errc::kInvalidArgument);
     FUZZ_CHECK(!encoded.error().message.empty());
     return 0;
   }
-  FUZZ_CHECK(!unsendable_command(frame));
+  FUZZ_CHECK(!unsendable_command(frame, profile));
   FUZZ_CHECK(*encoded == *dirty_encoded);  // bytes past the DLC made no difference
+  FUZZ_CHECK(*encoded == *cut_encoded);    // nor did bytes past the layout
   FUZZ_CHECK(encoded->stamp.count() == 0);
-  FUZZ_CHECK(*encoded == canonical(frame));
+  FUZZ_CHECK(*encoded == canonical(cut, profile));
 
   // The canonical frame is a fixed point.
-  const auto again = ranger::decode(*encoded);
+  const auto again = ranger::decode(*encoded, profile);
   FUZZ_CHECK(again.ok());
-  const auto reencoded = ranger::encode(*again);
+  const auto reencoded = ranger::encode(*again, unpadded);
   FUZZ_CHECK(reencoded.ok() && *reencoded == *encoded);
+
+  // Padded (tx_dlc 8): the same bytes, zero-padded to 8, and they decode back.
+  ProtocolProfile padded = profile;
+  padded.tx_dlc = 8;
+  const auto eight = ranger::encode(*message, padded);
+  FUZZ_CHECK(eight.ok() && eight->dlc == 8);
+  for (std::size_t i = 0; i < CanFrame::kMaxDlc; ++i)
+    FUZZ_CHECK(eight->data[i] == (i < encoded->dlc ? encoded->data[i] : 0));
+  const auto back = ranger::decode(*eight, profile);
+  FUZZ_CHECK(back.ok() && back->index() == message->index());
   return 0;
 }

@@ -1,6 +1,7 @@
 // candump's text formats: both layouts, their variants, and whatever else a log file may hold.
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <random>
 #include <string>
 
@@ -170,6 +171,27 @@ TEST(CandumpLog, FormatThenParseRoundTrips) {
   err.dlc = 8;
   EXPECT_EQ(format_candump_line(err, "can0"), "(0.000000) can0 20000004#0000000000000000");
   EXPECT_EQ(parse_ok(format_candump_line(err, "can0")).frame, err);
+}
+
+TEST(CandumpLog, BundledLogsParseAndFormatBackLineByLine) {
+  // The logs of both revisions (padded to 8 and unpadded) and the original sample.
+  for (const char* name :
+       {"sample.log", "sample_padded.log", "sample_agx_v2.log", "sample_agx_v2_unpadded.log"}) {
+    std::ifstream in(std::string(RANGER_DATA_DIR) + "/" + name);
+    ASSERT_TRUE(in.good()) << name;
+    std::size_t lines = 0, eight = 0;
+    for (std::string line; std::getline(in, line);) {
+      ++lines;
+      const LogEntry e = parse_ok(line);
+      EXPECT_TRUE(e.has_timestamp) << name << ": " << line;
+      EXPECT_EQ(format_candump_line(e.frame, e.iface), line) << name;
+      eight += e.frame.dlc == 8;
+    }
+    EXPECT_GT(lines, 100u) << name;
+    if (std::string(name) == "sample_padded.log" || std::string(name) == "sample_agx_v2.log") {
+      EXPECT_EQ(eight, lines) << name << ": every frame padded to 8";
+    }
+  }
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 // `ranger_can decode`: golden output on the bundled sample log, the JSON contract, and garbage in
-// (random bytes, huge lines, empty input) without a crash and with numbered errors on stderr.
+// (random bytes, huge lines, empty input) without a crash and with numbered errors on stderr;
+// padded frames decode and say so.
 #include <gtest/gtest.h>
 
 #include <cctype>
@@ -15,6 +16,7 @@
 #include "cli_commands.hpp"
 #include "cli_input.hpp"
 #include "cli_json.hpp"
+#include "ranger_can/wire/protocol.hpp"
 #include "support/cli_run.hpp"
 
 namespace ranger::cli {
@@ -192,12 +194,13 @@ TEST(CliDecode, SampleLogShowsEveryPartOfTheContract) {
   // One line per input frame.
   EXPECT_EQ(lines_of(out).size(), lines_of(read_file(kSampleLog)).size());
   EXPECT_TRUE(has(R"("t":1700000000.030050,"iface":"can0","id":273,"name":"motion_command")"));
-  EXPECT_TRUE(has(R"("linear_speed":0.15,"spin_speed":0.0,"steering_angle":0.17453292519943295)"));
+  EXPECT_TRUE(has(R"("linear_speed":0.15,"yaw_rate":0.0,"spin_speed":0.0,)"
+                  R"("steering_angle":0.17453292519943295)"));
   EXPECT_TRUE(has(R"("vehicle_status":0,"vehicle_status_name":"normal","control_mode":1)"));
   EXPECT_TRUE(
       has(R"("battery_voltage":51.2,"error_bits":512,"errors":["host_communication_lost"])"));
   EXPECT_TRUE(has(R"("name":"motion_feedback","dlc":8,"data":"00980000000003E8","speed":0.152,)"
-                  R"("steering_angle":0.17453292519943295})"));
+                  R"("yaw_rate":0.0,"lateral_speed":0.0,"steering_angle":0.17453292519943295})"));
   EXPECT_TRUE(has(R"("name":"steering_angles")"));
   EXPECT_TRUE(has(R"("angles":[0.19320794819577225,-0.19320794819577225,)"));
   EXPECT_TRUE(has(R"("speeds":[0.136,0.136,0.168,0.168])"));
@@ -207,7 +210,8 @@ TEST(CliDecode, SampleLogShowsEveryPartOfTheContract) {
                   R"("temperature":25.3)"));
   EXPECT_TRUE(has(R"("id":1793,"name":"unknown","dlc":1,"data":"05","error":)"));
   EXPECT_TRUE(has(R"("name":"motion_feedback","dlc":4,"data":"00960000",)"
-                  R"("error":"0x221 (motion_feedback): DLC 4, expected 8")"));
+                  R"("error":"0x221 (motion_feedback): DLC 4, expected 8 or more")"));
+  EXPECT_EQ(out.find("extra_bytes"), std::string::npos) << "no padded frame in the sample";
 }
 
 TEST(CliDecode, RealExecutableMatchesTheGolden) {
@@ -223,6 +227,177 @@ TEST(CliDecode, RealExecutableMatchesTheGolden) {
   EXPECT_EQ(out, read_file(kGoldenJson));
 }
 
+// ---- The bundled logs of both revisions, padded and unpadded ----------------------------------
+// (written by test_cli_odom.cpp's generator: one drive, encoded under each profile)
+
+const std::string kPaddedLog = std::string(RANGER_DATA_DIR) + "/sample_padded.log";
+const std::string kAgxLog = std::string(RANGER_DATA_DIR) + "/sample_agx_v2.log";
+const std::string kAgxUnpaddedLog = std::string(RANGER_DATA_DIR) + "/sample_agx_v2_unpadded.log";
+
+// The value of `"key":` in a JSON line, as text up to the next ',' or '}' ("" when absent).
+std::string json_value(const std::string& line, const std::string& key) {
+  const std::string k = "\"" + key + "\":";
+  const auto at = line.find(k);
+  if (at == std::string::npos) return "";
+  const auto start = at + k.size();
+  return line.substr(start, line.find_first_of(",}", start) - start);
+}
+
+TEST(CliDecode, PaddedLogDecodesEveryFrameAndCountsTheIgnoredBytes) {
+  const Outcome r = run({kPaddedLog, "--json"});
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  expect_all_valid_json(r.out);
+  const auto lines = lines_of(r.out);
+  EXPECT_EQ(lines.size(), lines_of(read_file(kPaddedLog)).size());
+  std::size_t padded = 0;
+  for (const auto& line : lines) {
+    EXPECT_EQ(line.find("\"error\""), std::string::npos) << line;
+    EXPECT_EQ(json_value(line, "dlc"), "8") << line;
+    const int id = std::stoi(json_value(line, "id"));
+    const int extra = 8 - protocol::layout_dlc(static_cast<std::uint32_t>(id));
+    if (extra > 0) {
+      EXPECT_EQ(json_value(line, "extra_bytes"), std::to_string(extra)) << line;
+      ++padded;
+    } else {
+      EXPECT_EQ(line.find("extra_bytes"), std::string::npos) << line;
+    }
+  }
+  EXPECT_GT(padded, 150u);  // every 0x291 (6 bytes), and the one-byte commands
+  EXPECT_NE(r.out.find(R"("name":"motion_mode","dlc":8,"data":"0000000000000000","extra_bytes":6,)"
+                       R"("mode":0,"mode_name":"ackermann","switching":false)"),
+            std::string::npos);
+  // Text: the same frames, each padded one saying so.
+  const Outcome text = run({kPaddedLog});
+  ASSERT_EQ(text.rc, 0);
+  EXPECT_NE(text.out.find("motion_mode                  mode=0 (ackermann) switching=no  "
+                          "[+6 bytes ignored]\n"),
+            std::string::npos);
+  EXPECT_NE(text.out.find("control_mode_command         mode=1 (can)  [+7 bytes ignored]\n"),
+            std::string::npos);
+  EXPECT_EQ(text.out.find(" error: "), std::string::npos);
+}
+
+TEST(CliDecode, AgxV2LogTourUnderItsProfile) {
+  const Outcome r = run({kAgxLog, "--protocol", "agx_v2"});
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  const auto lines = lines_of(r.out);
+  const std::vector<std::string> tour = {
+      "1700000000.000000 can0 421 control_mode_command         mode=1 (can)  [+7 bytes ignored]",
+      "1700000000.010000 can0 4A1 version                      request  [+7 bytes ignored]",
+      "1700000000.020000 can0 4A1 version                      text=\"V2.3.1\"",
+      "1700000000.030000 can0 121 light_command                enable=yes front=on/0 "
+      "rear=breathing/0 counter=0",
+      "1700000000.040000 can0 231 light_state                  enable=yes front=on/0 "
+      "rear=breathing/0 counter=1",
+      "1700000000.050000 can0 241 remote_control               swa=up swb=up swc=middle swd=down "
+      "right_h=0 right_v=0 left_v=12 left_h=0 var_a=0 counter=7",
+      "1700000000.060000 can0 311 odometer                     left=12345 right=12400 (raw)",
+      "1700000000.070000 can0 211 system_status                vehicle=normal control=can "
+      "battery=51.2 V errors=0x0200 [host_communication_lost] counter=200",
+      "1700000000.080000 can0 261 motor_low_speed              motor=1 voltage=51.0 V driver=33 "
+      "degC motor=29 degC status=none",
+      "1700000000.090000 can0 361 bms                          battery=pack soc=87% soh=98% "
+      "voltage=51.20 V current=-2.4 A temperature=25.3 degC",
+      "1700000000.100000 can0 362 bms_alarm                    battery=pack alarms=none "
+      "warnings=none  [+4 bytes ignored]",
+      "1700000000.110000 can0 141 motion_mode_command          mode=0 (ackermann)  [+7 bytes "
+      "ignored]",
+      "1700000000.120000 can0 111 motion_command               linear=0.500 m/s yaw_rate=0.000 "
+      "rad/s spin=0.000 m/s steering=0.00 deg",
+  };
+  ASSERT_GT(lines.size(), tour.size());
+  for (std::size_t i = 0; i < tour.size(); ++i)
+    EXPECT_EQ(lines[i], tour[i]);
+  EXPECT_EQ(r.out.find(" error: "), std::string::npos);
+}
+
+TEST(CliDecode, AgxV2LogCounterIsNoFault) {
+  const Outcome r = run({kAgxLog, "--json", "--protocol", "agx_v2"});
+  ASSERT_EQ(r.rc, 0) << r.err;
+  expect_all_valid_json(r.out);
+  std::size_t statuses = 0, faults = 0;
+  for (const auto& line : lines_of(r.out)) {
+    EXPECT_EQ(line.find("\"error\""), std::string::npos) << line;
+    if (json_value(line, "name") != "\"system_status\"") continue;
+    ++statuses;
+    EXPECT_FALSE(json_value(line, "counter").empty()) << line;
+    EXPECT_EQ(json_value(line, "critical"), "false") << line;
+    if (json_value(line, "error_bits") != "0") ++faults;
+  }
+  EXPECT_GT(statuses, 170u);
+  EXPECT_EQ(faults, 1u) << "only the tour's host_communication_lost";
+  // Units: 0.1 V BMS, wheel angles in mrad (left positive) read back in rad (right positive).
+  EXPECT_NE(r.out.find(R"("voltage":51.2,"current":-2.4)"), std::string::npos);
+}
+
+TEST(CliDecode, AgxV2LogUnderTheManualShowsWhyTheProfileMatters) {
+  const Outcome r = run({kAgxLog, "--json"});
+  ASSERT_EQ(r.rc, 0) << r.err;
+  std::size_t phantom = 0;
+  for (const auto& line : lines_of(r.out)) {
+    if (json_value(line, "name") == "\"system_status\"" && json_value(line, "error_bits") != "0") {
+      ++phantom;  // the counter in byte 7, read as the low byte of a 32-bit error word
+    }
+  }
+  EXPECT_GT(phantom, 100u);
+  EXPECT_NE(r.out.find(R"("voltage":5.12,)"), std::string::npos) << "0.1 V read as 0.01 V";
+  EXPECT_EQ(r.out.find(R"("voltage":51.2,)"), std::string::npos);
+}
+
+TEST(CliDecode, AgxV2LogPaddedAndUnpaddedDecodeAlike) {
+  const auto padded = lines_of(run({kAgxLog, "--json", "--protocol", "agx_v2"}).out);
+  const auto unpadded = lines_of(run({kAgxUnpaddedLog, "--json", "--protocol", "agx_v2"}).out);
+  ASSERT_EQ(padded.size(), unpadded.size());
+  // Equal after the frame part (dlc, data, extra_bytes): the same messages.
+  auto message_part = [](const std::string& line) {
+    const auto data = line.find("\"data\":");
+    const auto after = line.find(',', line.find('"', data + 8) + 1);
+    std::string rest = line.substr(after);
+    const auto extra = rest.find(",\"extra_bytes\":");
+    if (extra != std::string::npos) rest.erase(extra, rest.find(',', extra + 1) - extra);
+    return line.substr(0, line.find("\"dlc\":")) + rest;
+  };
+  for (std::size_t i = 0; i < padded.size(); ++i) {
+    EXPECT_EQ(message_part(padded[i]), message_part(unpadded[i])) << padded[i];
+    EXPECT_EQ(unpadded[i].find("extra_bytes"), std::string::npos) << unpadded[i];
+  }
+}
+
+TEST(CliDecode, ProtocolOptions) {
+  const Outcome help = run({"--help"});
+  EXPECT_NE(help.out.find("--protocol manual|agx_v2"), std::string::npos) << help.out;
+  EXPECT_NE(help.out.find("--set NAME=VALUE"), std::string::npos);
+  EXPECT_NE(help.out.find("steering_unit_271=centideg|millirad"), std::string::npos);
+  const Outcome bad = run({kAgxLog, "--protocol", "vendor"});
+  EXPECT_EQ(bad.rc, 2);
+  EXPECT_EQ(bad.out, "");
+  EXPECT_NE(bad.err.find("--protocol: 'vendor' is not one of manual, agx_v2"), std::string::npos)
+      << bad.err;
+  const Outcome value = run({kAgxLog, "--set", "error_word=agx32"});
+  EXPECT_EQ(value.rc, 2);
+  EXPECT_NE(value.err.find("protocol setting error_word = 'agx32' is invalid (valid: "
+                           "manual32|agx16)"),
+            std::string::npos)
+      << value.err;
+  const Outcome name = run({kAgxLog, "--set", "counter=yes"});
+  EXPECT_EQ(name.rc, 2);
+  EXPECT_NE(name.err.find("unknown protocol setting 'counter' (valid: steering_unit_111, "),
+            std::string::npos)
+      << name.err;
+  // One setting on top of the manual: the 16-bit word alone removes the phantom faults.
+  const Outcome word =
+      run({kAgxLog, "--json", "--set", "error_word=agx16", "--set", "bms_voltage_scale=0.1"});
+  ASSERT_EQ(word.rc, 0) << word.err;
+  EXPECT_NE(word.out.find(R"("voltage":51.2,)"), std::string::npos);
+  EXPECT_NE(word.out.find(R"("errors":[],"critical":false,"counter":1})"), std::string::npos);
+  // Later --set wins.
+  const Outcome twice =
+      run({kAgxLog, "--json", "--set", "bms_voltage_scale=0.1", "--set", "bms_voltage_scale=0.01"});
+  EXPECT_NE(twice.out.find(R"("voltage":5.12,)"), std::string::npos);
+}
+
 // ---- Bad input --------------------------------------------------------------------------------
 
 TEST(CliDecode, MalformedLinesAreNumberedAndDecodingGoesOn) {
@@ -230,7 +405,7 @@ TEST(CliDecode, MalformedLinesAreNumberedAndDecodingGoesOn) {
       "(1.000000) can0 111#0096000000000000\n"
       "this is not candump\n"
       "\n"
-      "(1.020000) can0 221#00960000000000\n"  // 7 bytes: a parsed frame with a bad DLC
+      "(1.020000) can0 221#00960000000000\n"  // 7 bytes: a parsed frame, too short
       "(1.040000) can0 221#0G\n"
       "  can0  291   [2]  00 01\n";
   const Outcome r = run({"--json"}, input);
@@ -238,7 +413,7 @@ TEST(CliDecode, MalformedLinesAreNumberedAndDecodingGoesOn) {
   const auto out = lines_of(r.out);
   ASSERT_EQ(out.size(), 3u);
   EXPECT_NE(out[0].find("\"motion_command\""), std::string::npos);
-  EXPECT_NE(out[1].find("\"error\":\"0x221 (motion_feedback): DLC 7, expected 8\""),
+  EXPECT_NE(out[1].find("\"error\":\"0x221 (motion_feedback): DLC 7, expected 8 or more\""),
             std::string::npos);
   EXPECT_NE(out[2].find("\"t\":0.000000"), std::string::npos);  // no timestamp in that format
   EXPECT_NE(out[2].find("\"switching\":true"), std::string::npos);
@@ -350,6 +525,18 @@ TEST(CliDecode, StrangeInterfaceNamesStayValidJson) {
   EXPECT_EQ(r.rc, 0);
   expect_all_valid_json(r.out);
   EXPECT_NE(r.out.find(R"("iface":"a\"b\\\u0001\u00ff")"), std::string::npos) << r.out;
+}
+
+TEST(CliDecode, UltrasonicZeroIsNoReading) {
+  const std::string line = "(1.0) can0 342#0000FFFF04B00000\n";
+  const Outcome text = run({}, line);
+  EXPECT_NE(text.out.find("s1=no_reading s2=offline s3=1200 mm s4=no_reading"), std::string::npos)
+      << text.out;
+  const Outcome json = run({"--json"}, line);
+  EXPECT_NE(json.out.find(R"("raw":[0,-1,1200,0],"status":["no_reading","offline","ok",)"
+                          R"("no_reading"])"),
+            std::string::npos)
+      << json.out;
 }
 
 TEST(CliDecode, ExtremeValuesAndErrorFrames) {

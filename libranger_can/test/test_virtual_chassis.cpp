@@ -14,6 +14,7 @@
 #include "ranger_can/control/kinematics.hpp"
 #include "ranger_can/wire/protocol.hpp"
 #include "ranger_can/sim/virtual_chassis.hpp"
+#include "ranger_can/wire/vehicle_spec.hpp"
 #include "support/fake_bus.hpp"
 
 namespace ranger::sim {
@@ -104,7 +105,9 @@ TEST(VirtualChassis, BootsInStandbyAckermannAndReportsIt) {
   EXPECT_EQ(h.status().control_mode, ControlMode::kStandby);
   EXPECT_EQ(h.status().vehicle_status, protocol::VehicleStatus::kNormal);
   EXPECT_EQ(h.status().error_bits, 0u);
-  EXPECT_GT(h.status().battery_voltage, 40.0);
+  // The manual's LiFePO4 pack at the default 90 % SOC: inside its normal range, 46-50 V.
+  EXPECT_GE(h.status().battery_voltage, vehicle_spec::kBatteryNormalMinVoltage);
+  EXPECT_LE(h.status().battery_voltage, vehicle_spec::kBatteryNormalMaxVoltage);
   EXPECT_EQ(h.mode_feedback().mode, MotionMode::kAckermann);
   EXPECT_FALSE(h.mode_feedback().switching);
 }
@@ -503,12 +506,42 @@ TEST(VirtualChassis, MotorFramesArePlausible) {
     EXPECT_GT(m.position, 0);
   }
   const auto low = *h.last<MotorLowSpeedFeedback>(protocol::kMotorLowSpeedBaseId + 1);
-  EXPECT_GT(low.driver_voltage, 40.0);
+  EXPECT_GE(low.driver_voltage, vehicle_spec::kBatteryNormalMinVoltage - 1.0);  // under load
+  EXPECT_LE(low.driver_voltage, vehicle_spec::kBatteryNormalMaxVoltage);
   EXPECT_EQ(low.driver_status, 0u);
   EXPECT_GE(low.motor_temperature, 25.0);
 }
 
 // ---- battery ----------------------------------------------------------------------------------
+
+TEST(VirtualChassis, BatteryIsTheManualsLiFePO4Pack) {
+  // Open-circuit voltage: inside the manual's 46-50 V over the usable 10-90 % SOC, a flat
+  // plateau (3.2-3.3 V per cell), steep ends, rising with the charge; 48 V nominal.
+  double previous = 0.0;
+  for (double soc = 0.0; soc <= 100.0; soc += 0.5) {
+    const double v = sim::lifepo4_pack_open_circuit_voltage(soc);
+    EXPECT_GT(v, previous) << soc;
+    previous = v;
+    if (soc >= 10.0 && soc <= 90.0) {
+      EXPECT_GE(v, vehicle_spec::kBatteryNormalMinVoltage) << soc;
+      EXPECT_LE(v, vehicle_spec::kBatteryNormalMaxVoltage) << soc;
+    }
+  }
+  auto ocv = sim::lifepo4_pack_open_circuit_voltage;
+  EXPECT_LT(ocv(80) - ocv(20), 2.0) << "the plateau";
+  EXPECT_GT(ocv(10) - ocv(0), 3.0) << "the steep empty end";
+  EXPECT_GT(ocv(100) - ocv(95), 1.0) << "the steep full end";
+  EXPECT_NEAR(ocv(20), vehicle_spec::kBatteryNominalVoltage, 0.5);
+  EXPECT_EQ(ocv(-5), ocv(0));
+  EXPECT_EQ(ocv(150), ocv(100));
+  EXPECT_EQ(ocv(std::nan("")), ocv(0));
+  // What the chassis reports follows the curve: 0x211 and the BMS at 30 % SOC, at rest.
+  Harness h;
+  h.chassis.set_battery_soc(30.0);
+  h.advance(600ms);
+  EXPECT_NEAR(h.status().battery_voltage, ocv(30), 0.15);
+  EXPECT_NEAR(h.last<BmsData>(protocol::kBmsBaseId)->voltage, ocv(30), 0.15);
+}
 
 TEST(VirtualChassis, BatteryDrainsFasterUnderLoad) {
   Harness idle, driving;

@@ -1,13 +1,22 @@
 #!/usr/bin/python3
-"""Cross-checks libranger_can/dbc/ranger.dbc against the C++ codec.
+"""Cross-checks one of libranger_can/dbc/ranger_<revision>.dbc against the C++ codec.
 
-Random payloads (plus edge patterns) for every message in the DBC are written to a candump log,
-decoded by `ranger_can decode --json` and by cantools (installed from PyPI into a virtual
-environment this script creates, or reuses), and every signal is compared with the C++ field it
-describes. Also checked: the DBC and the codec know exactly the same IDs with the same DLCs, and
-every JSON field the codec prints for a frame is covered by some DBC signal.
+Payloads for every message in the DBC (edge patterns, random bytes, and random values inside
+each signal's range) are written to a candump log, decoded by `ranger_can decode --json
+--protocol REVISION` and by cantools (installed from PyPI into a virtual environment this script
+creates, or reuses), and every signal is compared with the C++ field it describes. Also checked:
+the DBC and the codec know the same IDs with the same lengths (a DBC length longer than the
+codec's layout shows as extra bytes, a shorter one as an error); every JSON field the codec prints
+for a frame is covered by some DBC signal (or is one the revision leaves reserved); a steering
+angle outside the DBC's stated range is refused by the codec as impossible content, one inside it
+is decoded.
 
-usage: check_dbc.py --cli PATH/ranger_can --dbc ranger.dbc --venv DIR --work DIR [--frames N]
+Then the planted-mistake self-check: the same comparison against copies of the DBC with one
+mistake planted each (a wrong scale, a flipped sign, two error bits swapped, a missing signal)
+must report disagreements; a check that misses one of them proves nothing.
+
+usage: check_dbc.py --cli PATH/ranger_can --dbc ranger_REV.dbc --protocol REV --venv DIR
+                    --work DIR [--other-dbc ranger_OTHER.dbc] [--frames N]
 Exit status 0 when everything agrees, 1 on any disagreement (each one printed), 2 on set-up errors.
 """
 import argparse
@@ -15,6 +24,7 @@ import json
 import math
 import os
 import random
+import re
 import subprocess
 import sys
 
@@ -25,6 +35,10 @@ def parse_args(argv):
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--cli", required=True, help="the ranger_can executable")
     p.add_argument("--dbc", required=True, help="the DBC file to check")
+    p.add_argument("--protocol", required=True, choices=["manual", "agx_v2"],
+                   help="the protocol revision the DBC describes (ranger_can --protocol)")
+    p.add_argument("--other-dbc", help="the other revision's DBC: its IDs that this DBC does not "
+                   "list are known to the codec under every profile and are not checked here")
     p.add_argument("--venv", required=True, help="virtual environment for cantools (created if absent)")
     p.add_argument("--work", required=True, help="directory for the generated log")
     p.add_argument("--frames", type=int, default=400, help="random payloads per message")
@@ -72,11 +86,17 @@ def same(key, index=None):
     return rule
 
 
-def degrees_of(key, index=None):
-    """DBC in degrees (the manual's 0.01 deg), C++ in radians; same sign convention."""
+# How a revision's steering angles relate to the codec's convention (rad, positive = right):
+# the manual's are positive right, agx_v2's positive left.
+STEERING_SIGN = {"manual": 1.0, "agx_v2": -1.0}
+
+
+def angle_of(key, unit, sign, index=None):
+    """DBC in degrees or radians with the revision's sign, C++ in radians, positive right."""
     def rule(v, o):
         c = o[key] if index is None else o[key][index]
-        return c, close(math.radians(v), c)
+        rad = math.radians(v) if unit == "deg" else v
+        return c, close(sign * rad, c)
     rule.keys = {key}
     return rule
 
@@ -88,11 +108,26 @@ def flag(key):
     return rule
 
 
-def bit_named(list_key, name):
+def bit_named(list_key, name, inverted=False):
+    """A 1-bit signal whose C++ side is a name in a list (present when the bit is set, or when it
+    is clear for an inverted bit)."""
     def rule(v, o):
         present = name in o[list_key]
-        return present, present == (v != 0)
+        return present, present == ((v != 0) != inverted)
     rule.keys = {list_key}
+    return rule
+
+
+def version_char(i):
+    """0x4A1: char_i of the DBC against the C++ text (trailing NUL bytes are padding), or the
+    request (byte 0 = 0x01, nothing else)."""
+    def rule(v, o):
+        if o.get("request"):
+            return "request", v == (1 if i == 0 else 0)
+        text = o.get("text", "")
+        c = ord(text[i]) if i < len(text) else 0
+        return c, c == v
+    rule.keys = {"text", "request"}
     return rule
 
 
@@ -100,19 +135,37 @@ WHEELS = ["front_right", "rear_right", "rear_left", "front_left"]
 # JSON fields that describe the frame rather than a signal, or are derived from other fields.
 META = {"t", "iface", "id", "name", "dlc", "data"}
 DERIVED = {"mode_name", "vehicle_status_name", "control_mode_name", "description", "critical",
-           "status", "error_bits", "driver_status", "alarm1", "alarm2", "warning1", "warning2"}
+           "status", "error_bits", "driver_status", "alarm1", "alarm2", "warning1", "warning2",
+           "front_mode_name", "rear_mode_name", "swa_name", "swb_name", "swc_name", "swd_name"}
 # Fields that are not carried by a signal but by the frame ID (checked separately).
 BY_ID = {"motor", "battery", "first_sensor"}
+# Fields the codec reads under every profile that a revision leaves reserved (and its DBC does
+# not describe): agx_v2's yaw rate and lateral speed in the manual's reserved bytes.
+RESERVED = {"manual": {"motion_command": {"yaw_rate"},
+                       "motion_feedback": {"yaw_rate", "lateral_speed"}},
+            "agx_v2": {}}
+# Signals whose DBC range is the plausible range: outside it the codec refuses the frame.
+PLAUSIBLE = {"MotionFeedback": {"steering_angle"},
+             "SteeringAngles": {f"angle_{w}" for w in WHEELS}}
+IMPOSSIBLE = "beyond any model's reach"
 
 
-def rules_for(message):
+def rules_for(message, revision):
     """(expected C++ frame name, {signal name: rule}, {C++ key: expected value from the ID})."""
     n = message.name
     sigs = [s.name for s in message.signals]
+    unit = {s.name: s.unit for s in message.signals}
+    sign = STEERING_SIGN[revision]
     if n == "MotionCommand":
-        return "motion_command", {"linear_speed": same("linear_speed"),
-                                  "spin_speed": same("spin_speed"),
-                                  "steering_angle": degrees_of("steering_angle")}, {}
+        rules = {"linear_speed": same("linear_speed"),
+                 "steering_angle": angle_of("steering_angle", unit.get("steering_angle"), sign)}
+        if "spin_speed" in sigs:
+            rules["spin_speed"] = same("spin_speed")
+        if "lateral_speed" in sigs:  # agx_v2's name for bytes 4-5 (the manual's spin speed)
+            rules["lateral_speed"] = same("spin_speed")
+        if "yaw_rate" in sigs:
+            rules["yaw_rate"] = same("yaw_rate")
+        return "motion_command", rules, {}
     if n in ("MotionModeCommand", "ControlModeCommand"):
         name = "motion_mode_command" if n == "MotionModeCommand" else "control_mode_command"
         return name, {"mode": same("mode")}, {}
@@ -125,13 +178,19 @@ def rules_for(message):
     if n == "SystemStatus":
         rules = {"vehicle_status": same("vehicle_status"), "control_mode": same("control_mode"),
                  "battery_voltage": same("battery_voltage")}
+        if "counter" in sigs:
+            rules["counter"] = same("counter")
         for s in message.signals:
             if s.length == 1:
                 rules[s.name] = bit_named("errors", s.name)
         return "system_status", rules, {}
     if n == "MotionFeedback":
-        return "motion_feedback", {"speed": same("speed"),
-                                   "steering_angle": degrees_of("steering_angle")}, {}
+        rules = {"speed": same("speed"),
+                 "steering_angle": angle_of("steering_angle", unit.get("steering_angle"), sign)}
+        for k in ("yaw_rate", "lateral_speed"):
+            if k in sigs:
+                rules[k] = same(k)
+        return "motion_feedback", rules, {}
     if n.startswith("MotorHighSpeed"):
         return "motor_high_speed", {"rpm": same("rpm"), "current": same("current"),
                                     "position": same("position")}, {"motor": int(n[-1])}
@@ -140,11 +199,13 @@ def rules_for(message):
                  "driver_temperature": same("driver_temperature"),
                  "motor_temperature": same("motor_temperature")}
         for s in message.signals:
-            if s.length == 1:
+            if s.name == "driver_enabled":  # agx_v2: the codec reports the manual's disabled bit
+                rules[s.name] = bit_named("driver_status_names", "driver_disabled", inverted=True)
+            elif s.length == 1:
                 rules[s.name] = bit_named("driver_status_names", s.name)
         return "motor_low_speed", rules, {"motor": int(n[-1])}
     if n == "SteeringAngles":
-        return "steering_angles", {f"angle_{w}": degrees_of("angles", i)
+        return "steering_angles", {f"angle_{w}": angle_of("angles", unit[f"angle_{w}"], sign, i)
                                    for i, w in enumerate(WHEELS)}, {}
     if n == "WheelSpeeds":
         return "wheel_speeds", {f"speed_{w}": same("speeds", i) for i, w in enumerate(WHEELS)}, {}
@@ -164,75 +225,91 @@ def rules_for(message):
             return "bms_alarm", rules, {"battery": battery}
         return "bms", {k: same(k) for k in ("soc", "soh", "voltage", "current", "temperature")}, \
             {"battery": battery}
+    if n in ("LightCommand", "LightState"):
+        rules = {"enable": flag("enable")}
+        rules.update({k: same(k) for k in ("front_mode", "front_custom", "rear_mode",
+                                           "rear_custom", "counter")})
+        return ("light_command" if n == "LightCommand" else "light_state"), rules, {}
+    if n == "RemoteControlState":
+        return "remote_control", {s: same(s) for s in sigs}, {}
+    if n == "Odometer":
+        return "odometer", {"left_wheel": same("left_wheel"),
+                            "right_wheel": same("right_wheel")}, {}
+    if n == "Version":
+        return "version", {f"char_{i}": version_char(i) for i in range(8)}, {}
     return None, {}, {}
 
 
-# ---- the check --------------------------------------------------------------------------------
+# ---- the frames -------------------------------------------------------------------------------
 
-def payloads(length, count, rng):
+def in_range_payload(m, rng):
+    """A payload whose every signal holds a random raw value inside the DBC's range."""
+    values = {}
+    for s in m.signals:
+        lo = math.ceil((s.minimum - s.offset) / s.scale - 1e-9)
+        hi = math.floor((s.maximum - s.offset) / s.scale + 1e-9)
+        values[s.name] = rng.randint(lo, hi) * s.scale + s.offset
+    return m.encode(values, scaling=True, strict=False)
+
+
+def payloads(m, count, rng):
+    length = m.length
     edge = [bytes([0x00] * length), bytes([0xFF] * length), bytes([0x80] + [0x00] * (length - 1)),
             bytes([0x7F] + [0xFF] * (length - 1)), bytes(([0x80, 0x00] * 4)[:length]),
             bytes(([0x7F, 0xFF] * 4)[:length]), bytes(([0x55, 0xAA] * 4)[:length])]
-    return edge + [bytes(rng.getrandbits(8) for _ in range(length)) for _ in range(count)]
+    raw = [bytes(rng.getrandbits(8) for _ in range(length)) for _ in range(count // 2)]
+    ranged = [bytes(in_range_payload(m, rng)) for _ in range(count - count // 2)]
+    return edge + raw + ranged
 
 
-def main():
-    args = parse_args(sys.argv[1:])
-    if not args.in_venv:
-        ensure_venv_and_reexec(args)
-    import cantools  # noqa: E402  (only inside the virtual environment)
+# ---- the comparison ---------------------------------------------------------------------------
 
-    db = cantools.database.load_file(args.dbc)  # strict: overlapping signals are refused
-    rng = random.Random(args.seed)
-    messages = sorted(db.messages, key=lambda m: m.frame_id)
-
-    frames = []  # (id, payload, message or None)
-    for m in messages:
-        for p in payloads(m.length, args.frames, rng):
-            frames.append((m.frame_id, p, m))
-    dbc_ids = {m.frame_id for m in messages}
-    for other in range(0x800):  # every other standard ID must be unknown to the codec as well
-        if other not in dbc_ids:
-            frames.append((other, bytes(rng.getrandbits(8) for _ in range(8)), None))
-
-    os.makedirs(args.work, exist_ok=True)
-    log_path = os.path.join(args.work, "dbc_check.log")
-    with open(log_path, "w") as f:
-        for i, (fid, p, _) in enumerate(frames):
-            f.write(f"({1700000000 + i // 1000}.{i % 1000:06d}) can0 {fid:03X}#{p.hex().upper()}\n")
-    r = subprocess.run([args.cli, "decode", "--json", log_path], capture_output=True, text=True)
-    if r.returncode != 0 or r.stderr:
-        die(f"'{args.cli} decode --json {log_path}' failed (exit {r.returncode}): {r.stderr}", 1)
-    lines = r.stdout.splitlines()
-    if len(lines) != len(frames):
-        die(f"{len(frames)} frames in, {len(lines)} JSON lines out", 1)
-
+def compare(db, frames, lines, revision):
+    """Every disagreement between `db` and the codec's JSON `lines` for `frames`."""
     problems = []
     comparisons = 0
     covered_signals = {}
-    for (fid, payload, m), line in zip(frames, lines):
+    refused = 0
+    by_id = {m.frame_id: m for m in db.messages}
+    for (fid, payload), line in zip(frames, lines):
         o = json.loads(line)
         where = f"ID 0x{fid:03X} data {payload.hex().upper()}"
         if o["id"] != fid:
             problems.append(f"{where}: JSON line is for ID {o['id']}")
             continue
+        m = by_id.get(fid)
         if m is None:
             if o["name"] != "unknown":
                 problems.append(f"{where}: not in the DBC, but the codec calls it '{o['name']}'")
             continue
+        if "extra_bytes" in o:
+            problems.append(f"{where} ({m.name}): the DBC's length {m.length} exceeds the codec's "
+                            f"layout by {o['extra_bytes']} byte(s)")
+            continue
+        decoded = m.decode(payload, decode_choices=False, scaling=True)
+        implausible = [s for s in sorted(PLAUSIBLE.get(m.name, ()))
+                       if s in decoded and not (m.get_signal_by_name(s).minimum - 1e-9
+                                                <= decoded[s]
+                                                <= m.get_signal_by_name(s).maximum + 1e-9)]
+        if implausible:
+            if IMPOSSIBLE not in o.get("error", ""):
+                problems.append(f"{where} ({m.name}): {implausible[0]} = "
+                                f"{decoded[implausible[0]]!r} is outside the DBC's range, but the "
+                                f"codec says {o.get('error', 'nothing')!r}")
+            refused += 1
+            continue
         if "error" in o:
             problems.append(f"{where} ({m.name}, DLC {m.length} in the DBC): codec says {o['error']}")
             continue
-        expected_name, rules, by_id = rules_for(m)
+        expected_name, rules, by_id_keys = rules_for(m, revision)
         if expected_name is None:
             problems.append(f"{m.name}: no rule in check_dbc.py for this DBC message")
             continue
         if o["name"] != expected_name:
             problems.append(f"{where}: DBC message {m.name}, codec name '{o['name']}'")
-        for key, value in by_id.items():
+        for key, value in by_id_keys.items():
             if o.get(key) != value:
                 problems.append(f"{where}: {key} = {o.get(key)}, expected {value} from the ID")
-        decoded = m.decode(payload, decode_choices=False, scaling=True)
         missing = set(decoded) - set(rules)
         extra = set(rules) - set(decoded)
         if missing or extra:
@@ -243,30 +320,153 @@ def main():
             if sig_name not in decoded:
                 continue
             checked_keys |= rule.keys
-            cpp, ok = rule(decoded[sig_name], o)
+            try:
+                cpp, ok = rule(decoded[sig_name], o)
+            except (KeyError, IndexError, TypeError) as e:
+                cpp, ok = f"<{e!r}>", False
             comparisons += 1
             covered_signals.setdefault(m.name, set()).add(sig_name)
             if not ok:
                 problems.append(f"{where} {m.name}.{sig_name}: DBC {decoded[sig_name]!r}, "
                                 f"C++ {cpp!r}")
-        uncovered = set(o) - META - DERIVED - BY_ID - checked_keys
+        reserved = RESERVED[revision].get(expected_name, set())
+        uncovered = set(o) - META - DERIVED - BY_ID - checked_keys - reserved
         if uncovered:
             problems.append(f"{m.name}: C++ fields {sorted(uncovered)} have no DBC signal")
         if len(problems) > 200:
             break
+    return problems, comparisons, covered_signals, refused
 
+
+# ---- planted mistakes -------------------------------------------------------------------------
+
+def block_of(text, frame_id):
+    """(start, end) of the BO_ block of `frame_id` in the DBC text."""
+    start = text.index(f"BO_ {frame_id} ")
+    end = text.find("\n\n", start)
+    return start, (len(text) if end < 0 else end)
+
+
+def plant_scale(text):
+    """The BMS pack voltage with the other revision's scale (0.01 <-> 0.1 V)."""
+    a, b = block_of(text, 0x361)
+    block = text[a:b]
+    new = re.sub(r"(SG_ voltage : \d+\|16@0\+ )\((0\.01|0\.1),0\)",
+                 lambda m: m.group(1) + ("(0.1,0)" if m.group(2) == "0.01" else "(0.01,0)"), block)
+    return text[:a] + new + text[b:]
+
+
+def plant_sign(text):
+    """0x221's steering angle with the opposite sign."""
+    a, b = block_of(text, 0x221)
+    block = text[a:b]
+    new = re.sub(r"(SG_ steering_angle : \d+\|16@0- )\(([0-9.]+),0\) \[([-0-9.]+)\|([-0-9.]+)\]",
+                 lambda m: f"{m.group(1)}(-{m.group(2)},0) [{m.group(3)}|{m.group(4)}]", block)
+    return text[:a] + new + text[b:]
+
+
+def plant_swapped_bits(text):
+    """The first two error bits of 0x211 with each other's names."""
+    a, b = block_of(text, 0x211)
+    block = text[a:b]
+    names = re.findall(r"SG_ (\w+) : \d+\|1@", block)
+    x, y = names[0], names[1]
+    new = block.replace(f"SG_ {x} :", "SG_ @@ :").replace(f"SG_ {y} :", f"SG_ {x} :")
+    new = new.replace("SG_ @@ :", f"SG_ {y} :")
+    return text[:a] + new + text[b:]
+
+
+def plant_missing_signal(text):
+    """0x221 without its speed signal."""
+    a, b = block_of(text, 0x221)
+    block = "\n".join(l for l in text[a:b].split("\n") if not l.startswith(" SG_ speed :"))
+    return text[:a] + block + text[b:]
+
+
+PLANTED = [("BMS voltage scale of the other revision", plant_scale),
+           ("0x221 steering sign flipped", plant_sign),
+           ("two 0x211 error bits swapped", plant_swapped_bits),
+           ("0x221 speed signal missing", plant_missing_signal)]
+
+
+# ---- main -------------------------------------------------------------------------------------
+
+def main():
+    args = parse_args(sys.argv[1:])
+    if not args.in_venv:
+        ensure_venv_and_reexec(args)
+    import cantools  # noqa: E402  (only inside the virtual environment)
+
+    with open(args.dbc) as f:
+        dbc_text = f.read()
+    db = cantools.database.load_string(dbc_text)  # strict: overlapping signals are refused
+    rng = random.Random(args.seed)
+    messages = sorted(db.messages, key=lambda m: m.frame_id)
+    other_ids = set()
+    if args.other_dbc:
+        other_ids = {m.frame_id for m in cantools.database.load_file(args.other_dbc).messages}
+
+    frames = []  # (id, payload)
+    for m in messages:
+        for p in payloads(m, args.frames, rng):
+            frames.append((m.frame_id, p))
+    dbc_ids = {m.frame_id for m in messages}
+    skipped = other_ids - dbc_ids
+    for other in range(0x800):  # every other standard ID must be unknown to the codec as well
+        if other not in dbc_ids and other not in skipped:
+            frames.append((other, bytes(rng.getrandbits(8) for _ in range(8))))
+
+    os.makedirs(args.work, exist_ok=True)
+    log_path = os.path.join(args.work, f"dbc_check_{args.protocol}.log")
+    with open(log_path, "w") as f:
+        for i, (fid, p) in enumerate(frames):
+            f.write(f"({1700000000 + i // 1000}.{i % 1000:06d}) can0 {fid:03X}#{p.hex().upper()}\n")
+    cmd = [args.cli, "decode", "--json", "--protocol", args.protocol, log_path]
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    if r.returncode != 0 or r.stderr:
+        die(f"'{' '.join(cmd)}' failed (exit {r.returncode}): {r.stderr}", 1)
+    lines = r.stdout.splitlines()
+    if len(lines) != len(frames):
+        die(f"{len(frames)} frames in, {len(lines)} JSON lines out", 1)
+
+    problems, comparisons, covered, refused = compare(db, frames, lines, args.protocol)
     if problems:
         unique = list(dict.fromkeys(problems))
-        print(f"check_dbc: {len(unique)} disagreement(s) between {args.dbc} and the C++ codec:")
+        print(f"check_dbc: {len(unique)} disagreement(s) between {args.dbc} and the C++ codec "
+              f"(--protocol {args.protocol}):")
         for p in unique[:40]:
             print("  " + p)
         if len(unique) > 40:
             print(f"  ... and {len(unique) - 40} more")
         sys.exit(1)
-    n_signals = sum(len(s) for s in covered_signals.values())
-    print(f"check_dbc: OK: {len(messages)} DBC messages, {n_signals} signals, "
-          f"{len(frames)} frames, {comparisons} signal comparisons with cantools "
-          f"{cantools.__version__}; {0x800 - len(dbc_ids)} other standard IDs unknown to both")
+
+    # The self-check: every planted mistake must be caught.
+    missed = []
+    for what, plant in PLANTED:
+        mutated = plant(dbc_text)
+        if mutated == dbc_text:
+            missed.append(f"{what}: could not be planted in {args.dbc}")
+            continue
+        found, _, _, _ = compare(cantools.database.load_string(mutated), frames, lines,
+                                 args.protocol)
+        if not found:
+            missed.append(f"{what}: not noticed")
+        else:
+            print(f"check_dbc: self-check: planted mistake '{what}' caught "
+                  f"({len(set(found))} disagreement(s))")
+    if missed:
+        print("check_dbc: the self-check failed; the comparison cannot be trusted:")
+        for m in missed:
+            print("  " + m)
+        sys.exit(1)
+
+    n_signals = sum(len(s) for s in covered.values())
+    print(f"check_dbc: OK: {args.dbc} (--protocol {args.protocol}): {len(messages)} DBC messages, "
+          f"{n_signals} signals, {len(frames)} frames ({refused} refused as impossible, as the "
+          f"DBC's ranges say), {comparisons} signal comparisons with cantools "
+          f"{cantools.__version__}; {0x800 - len(dbc_ids) - len(skipped)} other standard IDs "
+          f"unknown to both, {len(skipped)} of the other revision not checked here; "
+          f"{len(PLANTED)} planted mistakes caught")
 
 
 if __name__ == "__main__":

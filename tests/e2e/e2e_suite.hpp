@@ -84,9 +84,9 @@ class Rig {
   void kill_driver(bool dead) { driver_dead_ = dead; }
 
  protected:
-  void attach_driver(Bus& bus) {
+  void attach_driver(Bus& bus, ControllerConfig config = {}) {
     driver_bus_ = &bus;
-    controller_ = std::make_unique<ChassisController>(bus, ControllerConfig{});
+    controller_ = std::make_unique<ChassisController>(bus, config);
   }
   // Derived rigs call this first in their destructor: the controller sends its stop on
   // destruction, so it must go while their bus still exists.

@@ -26,11 +26,21 @@ std::unique_ptr<SocketCanBus> open_or_fail() {
 
 class VcanRig final : public Rig {
  public:
+  // Under qemu's emulation the chassis's sending thread stalls for up to half a second now and
+  // then; with the default 100 ms link timeout each stall would be a link loss, and link loss is
+  // an involuntary stop that latches. The link-loss cases silence the chassis for seconds, so a
+  // timeout above the VM's stalls keeps them meaningful (the exact 100 ms is tested in lock-step).
+  static ControllerConfig controller_config() {
+    ControllerConfig c;
+    c.link_timeout = std::chrono::milliseconds(800);
+    return c;
+  }
+
   VcanRig() : chassis_bus_(open_or_fail()), driver_bus_(open_or_fail()) {
     if (!chassis_bus_ || !driver_bus_) return;
     runner_ = std::make_unique<sim::VirtualChassisRunner>(*chassis_bus_,
                                                           sim::VirtualChassisConfig{}, clock_);
-    attach_driver(*driver_bus_);
+    attach_driver(*driver_bus_, controller_config());
   }
   ~VcanRig() override {
     release_driver();

@@ -253,9 +253,12 @@ TEST_F(VcanFaults, BusOffFromAnErrorFrameStopsTheChassisAndRestartResumes) {
       rig_.run_until([&] { return rig_.driver_bus().status().state == BusState::kBusOff; }, 2s));
   ASSERT_TRUE(rig_.run("tc qdisc add dev " + interface_name() + " root plug limit 512"));
   ASSERT_TRUE(rig_.run_until([&] { return rig_.state().refusal == MotionRefusal::kLinkLost; }, 2s));
-  ASSERT_TRUE(rig_.run_until([&] { return rig_.snapshot().speed == 0.0; }, 3s))
-      << "the chassis's watchdog must stop it: no 0x111 gets through";
-  EXPECT_TRUE(rig_.snapshot().host_link_lost);
+  // The driver treats bus-off as link loss at once, so the zero commands it sent before the plug
+  // went in may stop the chassis first; then no 0x111 gets through and the chassis's own
+  // watchdog declares the host lost.
+  ASSERT_TRUE(rig_.run_until([&] { return rig_.snapshot().speed == 0.0; }, 3s));
+  ASSERT_TRUE(rig_.run_until([&] { return rig_.snapshot().host_link_lost; }, 2s))
+      << "no 0x111 may get through the plugged queue";
 
   // Restart: the queue drains, traffic flows again, the controller reports error-active again
   // (the restart report is written once frames flow: right after the qdisc is removed the kernel

@@ -11,8 +11,9 @@ namespace ranger {
 
 enum class Errc {
   kUnknownId,        // frame ID not part of the RANGER protocol
-  kBadDlc,           // frame has a DLC other than the one the protocol defines for its ID
-  kOutOfRange,       // a value lies outside what the protocol can express (after saturation rules)
+  kBadDlc,           // frame shorter than its ID's layout (a longer one is read), or a DLC above 8
+  kOutOfRange,       // a value outside what the protocol can express (after saturation rules), or
+                     // content no model can send (a steering angle beyond 100 deg)
   kNotFinite,        // NaN or infinity where a number was required
   kInvalidArgument,  // any other bad input (unknown enum value, empty name, ...)
   kParseError,       // malformed text input (candump line, CLI argument)

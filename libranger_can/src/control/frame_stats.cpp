@@ -24,13 +24,13 @@ bool FrameStats::record(std::uint32_t id, Timestamp now, bool decoded, int extra
   const std::int64_t b = bucket_of(now);
   if (b > e.last_bucket) {
     // Empty the buckets that passed without a frame (all of them after a long silence).
-    const std::int64_t passed = std::min<std::int64_t>(b - e.last_bucket, kBuckets);
+    const std::int64_t passed = std::min<std::int64_t>(b - e.last_bucket, kBuckets + 1);
     for (std::int64_t k = 1; k <= passed; ++k) {
-      e.buckets[static_cast<std::size_t>((e.last_bucket + k) % kBuckets)] = 0;
+      e.buckets[static_cast<std::size_t>((e.last_bucket + k) % (kBuckets + 1))] = 0;
     }
     e.last_bucket = b;
   }
-  ++e.buckets[static_cast<std::size_t>(e.last_bucket % kBuckets)];
+  ++e.buckets[static_cast<std::size_t>(e.last_bucket % (kBuckets + 1))];
   ++e.counts.frames;
   if (!decoded) ++e.counts.rejected;
   if (extra_bytes > 0) {
@@ -45,13 +45,15 @@ double FrameStats::rate(std::uint32_t id, Timestamp now) const {
   if (i < 0) return 0.0;
   const Entry& e = entries_[static_cast<std::size_t>(i)];
   const std::int64_t newest = bucket_of(now);
-  // Buckets newest-(kBuckets-1) .. newest form the window; older counts have expired.
+  // Buckets newest-kBuckets .. newest-1 are whole, `newest` has run for `partial` (in (0, b]);
+  // older counts have expired. The counts cover exactly kBuckets b + partial.
   std::uint64_t sum = 0;
-  for (std::int64_t b = std::max(e.last_bucket - kBuckets + 1, newest - kBuckets + 1);
+  for (std::int64_t b = std::max(e.last_bucket - kBuckets, newest - kBuckets);
        b <= std::min(e.last_bucket, newest); ++b) {
-    sum += e.buckets[static_cast<std::size_t>(b % kBuckets)];
+    sum += e.buckets[static_cast<std::size_t>(b % (kBuckets + 1))];
   }
-  return static_cast<double>(sum) / seconds(bucket_ * kBuckets);
+  const auto partial = now - Timestamp(newest * bucket_.count());
+  return static_cast<double>(sum) / seconds(bucket_ * kBuckets + partial);
 }
 
 std::vector<FrameIdCounts> FrameStats::counts() const {

@@ -244,6 +244,9 @@ BodyTwist twist_from_command(const MotionCommand& command, MotionMode mode,
       return BodyTwist{0.0, 0.0,
                        interp::spin_yaw_rate_from_wheel_speed(command.spin_speed,
                                                               geometry.wheelbase, geometry.track)};
+    case MotionMode::kPark:  // no motion: the zero twist below
+    case MotionMode::kSideSlip:
+      break;
   }
   return BodyTwist{};
 }

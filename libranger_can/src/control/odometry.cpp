@@ -113,6 +113,9 @@ BodyTwist twist_from_motion_feedback(const MotionFeedback& feedback, MotionMode 
       return BodyTwist{0.0, 0.0,
                        interp::spin_yaw_rate_from_feedback_speed(feedback.speed, geometry.wheelbase,
                                                                  geometry.track)};
+    case MotionMode::kPark:  // no motion: the zero twist below
+    case MotionMode::kSideSlip:
+      break;
   }
   return BodyTwist{};
 }

@@ -1,13 +1,36 @@
 #include "ranger_can/sim/drivetrain_model.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <utility>
+
+#include "ranger_can/wire/vehicle_spec.hpp"
 
 namespace ranger::sim {
 
 namespace {
 constexpr double kGravity = 9.81;
-constexpr double kCellsInSeries = 13.0;  // a 48 V lithium pack: 13 cells, ~3.3 V empty, 4.2 V full
+// A 48 V LiFePO4 pack (manual 1.1: 铁锂电池): 15 cells of 3.2 V nominal.
+constexpr double kCellsInSeries = 15.0;
+static_assert(std::fabs(kCellsInSeries * 3.2 - vehicle_spec::kBatteryNominalVoltage) < 1e-9);
+// Open-circuit voltage of one LiFePO4 cell by SOC (%), at rest: steep below 10 % and above
+// 95 %, a plateau of 3.07-3.33 V between (46.0-50.0 V for the pack at 10-90 %).
+constexpr std::array<std::pair<double, double>, 13> kCellCurve = {{
+    {0.0, 2.80},
+    {5.0, 3.00},
+    {10.0, 3.07},
+    {20.0, 3.18},
+    {30.0, 3.22},
+    {40.0, 3.245},
+    {50.0, 3.26},
+    {60.0, 3.275},
+    {70.0, 3.29},
+    {80.0, 3.305},
+    {90.0, 3.33},
+    {95.0, 3.36},
+    {100.0, 3.45},
+}};
 
 // Encoder counters wrap around like the hardware's 32-bit counters do (a counter, not a value to
 // saturate).
@@ -33,8 +56,20 @@ void DrivetrainModel::set_soc(double soc) {
   if (std::isfinite(soc)) soc_ = std::clamp(soc, 0.0, 100.0);
 }
 
+double lifepo4_pack_open_circuit_voltage(double soc_percent) {
+  const double soc = std::isnan(soc_percent) ? 0.0 : std::clamp(soc_percent, 0.0, 100.0);
+  for (std::size_t i = 1; i < kCellCurve.size(); ++i) {
+    const auto [s1, v1] = kCellCurve[i];
+    if (soc <= s1) {
+      const auto [s0, v0] = kCellCurve[i - 1];
+      return kCellsInSeries * (v0 + (v1 - v0) * (soc - s0) / (s1 - s0));
+    }
+  }
+  return kCellsInSeries * kCellCurve.back().second;
+}
+
 double DrivetrainModel::open_circuit_voltage() const {
-  return kCellsInSeries * (3.3 + 0.9 * soc_ / 100.0);
+  return lifepo4_pack_open_circuit_voltage(soc_);
 }
 
 void DrivetrainModel::advance(double dt, const ChassisModel& motion, bool powered) {

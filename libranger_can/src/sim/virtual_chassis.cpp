@@ -14,40 +14,38 @@ namespace {
 
 using namespace std::chrono_literals;
 using protocol::ControlMode;
-using protocol::error_bit_index;
 using protocol::MotionMode;
 
-std::uint32_t bit(int byte, int b) {
-  return 1u << error_bit_index(byte, b);
+// 0x211 error bits the chassis itself drives (named in protocol.hpp, the manual's layout).
+std::uint32_t fault(protocol::Fault f, int motor = 0) {
+  return protocol::fault_bit(f, ErrorWordLayout::kManual32, motor);
 }
-
-// 0x211 error bits the chassis itself drives (positions per PROTOCOL.md).
-const std::uint32_t kBatteryUnderVoltage = bit(7, 0);
-const std::uint32_t kUltrasonicTriggered = bit(7, 1);
-const std::uint32_t kRemoteLost = bit(7, 2);
-const std::uint32_t kHostCommLost = bit(6, 1);
-const std::uint32_t kDriverStatusError = bit(6, 0);
-const std::uint32_t kOverTemperature = bit(6, 6);
-const std::uint32_t kOverCurrent = bit(6, 7);
+const std::uint32_t kBatteryUnderVoltage = fault(protocol::Fault::kBatteryUnderVoltage);
+const std::uint32_t kUltrasonicTriggered = fault(protocol::Fault::kUltrasonicTriggered);
+const std::uint32_t kRemoteLost = fault(protocol::Fault::kRemoteSignalLost);
+const std::uint32_t kHostCommLost = fault(protocol::Fault::kHostCommunicationLost);
+const std::uint32_t kDriverStatusError = fault(protocol::Fault::kDriverStatusError);
+const std::uint32_t kOverTemperature = fault(protocol::Fault::kOverTemperature);
+const std::uint32_t kOverCurrent = fault(protocol::Fault::kOverCurrent);
 
 // Communication fault bit of motor driver n = 1..8.
 std::uint32_t motor_comm_bit(int n) {
-  return n <= 4 ? bit(7, 2 + n) : bit(6, n - 3);
+  return fault(protocol::Fault::kMotorCommunication, n);
 }
-// Steering calibration fault of steering motor n = 5..8 (byte 5 bits 0..3).
+// Steering calibration fault of steering motor n = 5..8.
 std::uint32_t steering_calib_bit(int n) {
-  return bit(5, n - 5);
+  return fault(protocol::Fault::kSteeringCalibration, n);
 }
 
-// Driver status bits of 0x261-0x268 byte 5 (PROTOCOL.md).
-constexpr std::uint8_t kDriverSupplyLow = 1u << 0;
-constexpr std::uint8_t kDriverMotorOverTemp = 1u << 1;
-constexpr std::uint8_t kDriverOverCurrent = 1u << 2;
-constexpr std::uint8_t kDriverOverTemp = 1u << 3;
-constexpr std::uint8_t kDriverError = 1u << 5;
-constexpr std::uint8_t kDriverDisabled = 1u << 6;
-// BMS alarm/warning status 1, bit 2: under-voltage.
-constexpr std::uint8_t kBmsUnderVoltage = 1u << 2;
+// Driver status bits of 0x261-0x268 byte 5 (protocol.hpp).
+constexpr std::uint8_t kDriverSupplyLow = protocol::driver_status::kSupplyVoltageLow;
+constexpr std::uint8_t kDriverMotorOverTemp = protocol::driver_status::kMotorOverTemperature;
+constexpr std::uint8_t kDriverOverCurrent = protocol::driver_status::kDriverOverCurrent;
+constexpr std::uint8_t kDriverOverTemp = protocol::driver_status::kDriverOverTemperature;
+constexpr std::uint8_t kDriverError = protocol::driver_status::kDriverError;
+constexpr std::uint8_t kDriverDisabled = protocol::driver_status::kDriverDisabled;
+// BMS alarm/warning status 1: under-voltage.
+constexpr std::uint8_t kBmsUnderVoltage = protocol::bms_status::kUnderVoltage;
 
 constexpr double kLowBatteryCutoffSoc = 10.0;   // manual: under 10 % the drivers lose power
 constexpr double kLowBatteryWarningSoc = 15.0;  // manual: under 15 % the lights flash
@@ -120,10 +118,8 @@ void VirtualChassis::step(Timestamp now) {
     } else {
       const auto ids = protocol::all_ids();
       f.id = ids[garbage_rng_() % ids.size()];
-      const int expected = protocol::expected_dlc(f.id);
-      do {
-        f.dlc = static_cast<std::uint8_t>(garbage_rng_() % 9);
-      } while (f.dlc == expected);
+      // Shorter than its layout (a longer frame is valid: its extra bytes are ignored).
+      f.dlc = static_cast<std::uint8_t>(garbage_rng_() % protocol::layout_dlc(f.id));
     }
     for (int i = 0; i < f.dlc; ++i)
       f.data[i] = static_cast<std::uint8_t>(garbage_rng_());

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <vector>
 
 namespace ranger::interpretation {
 
@@ -27,6 +28,49 @@ double ackermann_curvature_from_mean_angle(double mean_angle, double wheelbase_m
   // equal form s / (root + h c) does not. Both are finite and positive in their branch.
   const double k = c > 0.0 ? s / (root + half_l * c) : (root - half_l * c) / (d * s);
   return std::copysign(k, mean_angle);
+}
+
+double ackermann_curvature_from_inner_angle(double inner_angle, double wheelbase_m,
+                                            double track_m) {
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  const bool geometry_ok =
+      std::isfinite(wheelbase_m) && wheelbase_m > 0.0 && std::isfinite(track_m) && track_m > 0.0;
+  if (!geometry_ok || std::isnan(inner_angle)) return kNaN;
+  if (inner_angle == 0.0) return 0.0;
+  const double a = std::fabs(inner_angle);
+  const double half_l = wheelbase_m / 2.0;
+  const double half_w = track_m / 2.0;
+  // The angle at |k| = inf; the denominator below is positive exactly below it.
+  if (a >= std::atan2(half_l, -half_w)) {
+    return std::copysign(std::numeric_limits<double>::infinity(), inner_angle);
+  }
+  return std::copysign(std::sin(a) / (half_l * std::cos(a) + half_w * std::sin(a)), inner_angle);
+}
+
+const std::vector<protocol::Fault>& critical_faults() {
+  using protocol::Fault;
+  static const std::vector<Fault> kFaults = {
+      Fault::kBatteryUnderVoltage,
+      Fault::kDriverStatusError,
+      Fault::kOverTemperature,
+      Fault::kOverCurrent,
+      Fault::kMotorCommunication,
+      Fault::kSteeringCalibration,
+      Fault::kSteeringCalibrationTimeout,
+      Fault::kSafetyEdge,
+      Fault::kSteeringEncoder,
+  };
+  return kFaults;
+}
+
+std::uint32_t critical_error_mask(ErrorWordLayout layout) {
+  std::uint32_t mask = 0;
+  for (const protocol::Fault f : critical_faults()) {
+    mask |= protocol::fault_bit(f, layout);
+    for (int motor = 1; motor <= protocol::kMotorCount; ++motor)
+      mask |= protocol::fault_bit(f, layout, motor);
+  }
+  return mask;
 }
 
 }  // namespace ranger::interpretation

@@ -1,7 +1,11 @@
 // The protocol's vocabulary as data: identifiers, DLCs, names of every defined bit.
 #include "ranger_can/wire/protocol.hpp"
 
+#include "ranger_can/wire/interpretation.hpp"
+
+#include <algorithm>
 #include <initializer_list>
+#include <iterator>
 #include <string>
 
 namespace ranger::protocol {
@@ -17,7 +21,7 @@ constexpr bool is_bms_id(std::uint32_t id) {
 
 }  // namespace
 
-std::vector<std::uint32_t> all_ids() {
+std::vector<std::uint32_t> manual_ids() {
   std::vector<std::uint32_t> ids = {kMotionCommandId, kMotionModeCommandId, kSystemStatusId,
                                     kMotionFeedbackId};
   for (std::uint32_t m = 1; m <= kMotorCount; ++m)
@@ -33,17 +37,29 @@ std::vector<std::uint32_t> all_ids() {
   return ids;  // ascending: 0x111 ... 0x36A, 0x421, 0x441, 0x451, 0x45A
 }
 
-bool is_known_id(std::uint32_t id) {
-  return expected_dlc(id) >= 0;
+std::vector<std::uint32_t> all_ids() {
+  std::vector<std::uint32_t> ids = manual_ids();
+  ids.insert(ids.end(),
+             {kLightCommandId, kLightStateId, kRemoteControlStateId, kOdometerId, kVersionId});
+  std::sort(ids.begin(), ids.end());
+  return ids;
 }
 
-int expected_dlc(std::uint32_t id) {
+bool is_known_id(std::uint32_t id) {
+  return layout_dlc(id) >= 0;
+}
+
+int layout_dlc(std::uint32_t id) {
   switch (id) {
     case kMotionCommandId:
+    case kLightCommandId:
     case kSystemStatusId:
     case kMotionFeedbackId:
+    case kLightStateId:
+    case kRemoteControlStateId:
     case kSteeringAnglesId:
     case kWheelSpeedsId:
+    case kOdometerId:
     case kUltrasonic1to4Id:
     case kUltrasonic5to8Id:
       return 8;
@@ -52,6 +68,7 @@ int expected_dlc(std::uint32_t id) {
     case kErrorClearCommandId:
     case kUltrasonicSettingId:
     case kUltrasonicSettingFeedbackId:
+    case kVersionId:
       return 1;
     case kMotionModeFeedbackId:
       return 2;
@@ -63,10 +80,34 @@ int expected_dlc(std::uint32_t id) {
   return -1;
 }
 
+int expected_dlc(std::uint32_t id) {
+  return layout_dlc(id);
+}
+
+bool is_version_request(const CanFrame& f) {
+  if (f.dlc < 1 || f.data[0] != kVersionRequestValue) return false;
+  const std::size_t n = std::min<std::size_t>(f.dlc, CanFrame::kMaxDlc);
+  for (std::size_t i = 1; i < n; ++i) {
+    if (f.data[i] != 0) return false;
+  }
+  return true;
+}
+
+int extra_bytes(const CanFrame& frame) {
+  if (frame.is_error) return 0;
+  const int layout = layout_dlc(frame.id);
+  if (layout < 0) return 0;
+  if (frame.id == kVersionId && !is_version_request(frame)) return 0;  // an answer: all text
+  const int dlc = std::min<int>(frame.dlc, static_cast<int>(CanFrame::kMaxDlc));
+  return dlc > layout ? dlc - layout : 0;
+}
+
 std::string_view frame_name(std::uint32_t id) {
   switch (id) {
     case kMotionCommandId:
       return "motion_command";
+    case kLightCommandId:
+      return "light_command";
     case kMotionModeCommandId:
       return "motion_mode_command";
     case kControlModeCommandId:
@@ -75,16 +116,24 @@ std::string_view frame_name(std::uint32_t id) {
       return "error_clear_command";
     case kUltrasonicSettingId:
       return "ultrasonic_setting";
+    case kVersionId:
+      return "version";
     case kSystemStatusId:
       return "system_status";
     case kMotionFeedbackId:
       return "motion_feedback";
+    case kLightStateId:
+      return "light_state";
+    case kRemoteControlStateId:
+      return "remote_control";
     case kSteeringAnglesId:
       return "steering_angles";
     case kWheelSpeedsId:
       return "wheel_speeds";
     case kMotionModeFeedbackId:
       return "motion_mode";
+    case kOdometerId:
+      return "odometer";
     case kUltrasonic1to4Id:
     case kUltrasonic5to8Id:
       return "ultrasonic";
@@ -99,6 +148,57 @@ std::string_view frame_name(std::uint32_t id) {
   return "unknown";
 }
 
+// ---- Motion modes -------------------------------------------------------------------------------
+
+namespace {
+
+// Each numbering's modes in wire order (index = wire value). Plain arrays: the codec maps modes on
+// every 0x141 and 0x291 without allocating.
+constexpr MotionMode kManualModes[] = {MotionMode::kAckermann, MotionMode::kOblique,
+                                       MotionMode::kSpin};
+constexpr MotionMode kAgxV2Modes[] = {MotionMode::kAckermann, MotionMode::kOblique,
+                                      MotionMode::kSpin, MotionMode::kPark, MotionMode::kSideSlip};
+constexpr MotionMode kMiniV1Modes[] = {MotionMode::kAckermann, MotionMode::kOblique,
+                                       MotionMode::kSpin, MotionMode::kSideSlip};
+
+struct ModeTable {
+  const MotionMode* modes;
+  std::size_t count;
+};
+
+ModeTable mode_table(ModeNumbering numbering) {
+  switch (numbering) {
+    case ModeNumbering::kManual:
+      return {kManualModes, std::size(kManualModes)};
+    case ModeNumbering::kAgxV2:
+      return {kAgxV2Modes, std::size(kAgxV2Modes)};
+    case ModeNumbering::kMiniV1:
+      return {kMiniV1Modes, std::size(kMiniV1Modes)};
+  }
+  return {nullptr, 0};
+}
+
+}  // namespace
+
+std::vector<MotionMode> motion_modes(ModeNumbering numbering) {
+  const ModeTable t = mode_table(numbering);
+  return std::vector<MotionMode>(t.modes, t.modes + t.count);
+}
+
+std::optional<MotionMode> motion_mode_from_wire(std::uint8_t raw, ModeNumbering numbering) {
+  const ModeTable t = mode_table(numbering);
+  if (raw < t.count) return t.modes[raw];
+  return std::nullopt;
+}
+
+std::optional<std::uint8_t> motion_mode_to_wire(MotionMode mode, ModeNumbering numbering) {
+  const ModeTable t = mode_table(numbering);
+  for (std::size_t i = 0; i < t.count; ++i) {
+    if (t.modes[i] == mode) return static_cast<std::uint8_t>(i);
+  }
+  return std::nullopt;
+}
+
 std::string_view to_string(MotionMode m) {
   switch (m) {
     case MotionMode::kAckermann:
@@ -107,6 +207,10 @@ std::string_view to_string(MotionMode m) {
       return "oblique";
     case MotionMode::kSpin:
       return "spin";
+    case MotionMode::kPark:
+      return "park";
+    case MotionMode::kSideSlip:
+      return "side_slip";
   }
   return "unknown";
 }
@@ -117,6 +221,8 @@ std::string_view to_string(ControlMode m) {
       return "standby";
     case ControlMode::kCan:
       return "can";
+    case ControlMode::kUart:
+      return "uart";
     case ControlMode::kRemote:
       return "remote";
   }
@@ -131,6 +237,34 @@ std::string_view to_string(VehicleStatus s) {
       return "emergency_stop";
     case VehicleStatus::kAbnormal:
       return "abnormal";
+  }
+  return "unknown";
+}
+
+std::string_view to_string(RemoteSwitch s) {
+  switch (s) {
+    case RemoteSwitch::kUndefined:
+      return "undefined";
+    case RemoteSwitch::kMiddle:
+      return "middle";
+    case RemoteSwitch::kUp:
+      return "up";
+    case RemoteSwitch::kDown:
+      return "down";
+  }
+  return "unknown";
+}
+
+std::string_view to_string(LightMode m) {
+  switch (m) {
+    case LightMode::kOff:
+      return "off";
+    case LightMode::kOn:
+      return "on";
+    case LightMode::kBreathing:
+      return "breathing";
+    case LightMode::kCustom:
+      return "custom";
   }
   return "unknown";
 }
@@ -152,7 +286,13 @@ std::string error_clear_description(std::uint8_t code) {
 
 // ---- 0x211 error bits -------------------------------------------------------------------------
 
-const std::vector<NamedBit>& system_error_bits() {
+int error_word_bits(ErrorWordLayout layout) {
+  return layout == ErrorWordLayout::kAgxV2_16 ? 16 : 32;
+}
+
+namespace {
+
+const std::vector<NamedBit>& manual_error_bits() {
   // Wheel order of the manual (RF, RR, LR, LF), named as in geometry.hpp's joint names.
   static const std::vector<NamedBit> bits = {
       // byte 7 (least significant)
@@ -206,7 +346,22 @@ const std::vector<NamedBit>& system_error_bits() {
   return bits;
 }
 
-namespace {
+const std::vector<NamedBit>& agx16_error_bits() {
+  // PROTOCOL_AGX_V2.md: generic to the vendor's chassis family.
+  static const std::vector<NamedBit> bits = {
+      {0, "battery_fault", "battery fault"},
+      {1, "battery_warning", "battery warning"},
+      {2, "remote_signal_lost", "remote-control signal lost"},
+      {3, "motor1_communication", "communication fault of motor 1 (front-right wheel)"},
+      {4, "motor2_communication", "communication fault of motor 2 (rear-right wheel)"},
+      {5, "motor3_communication", "communication fault of motor 3 (rear-left wheel)"},
+      {6, "motor4_communication", "communication fault of motor 4 (front-left wheel)"},
+      {7, "steering_encoder", "steering encoder fault"},
+      {8, "motor_driver", "motor driver fault"},
+      {9, "host_communication_lost", "communication with the host lost"},
+  };
+  return bits;
+}
 
 std::vector<std::string> names_of_set_bits(std::uint32_t word, int width,
                                            const std::vector<NamedBit>& table) {
@@ -226,58 +381,149 @@ std::vector<std::string> names_of_set_bits(std::uint32_t word, int width,
   return names;
 }
 
-std::uint32_t mask_of(std::initializer_list<int> indices) {
-  std::uint32_t m = 0;
-  for (int i : indices)
-    m |= 1u << i;
-  return m;
+std::uint32_t manual_bit(int byte, int bit) {
+  return 1u << error_bit_index(byte, bit);
 }
 
 }  // namespace
 
+const std::vector<NamedBit>& system_error_bits(ErrorWordLayout layout) {
+  return layout == ErrorWordLayout::kAgxV2_16 ? agx16_error_bits() : manual_error_bits();
+}
+
+const std::vector<NamedBit>& system_error_bits() {
+  return manual_error_bits();
+}
+
+std::vector<std::string> error_bit_names(std::uint32_t error_word, ErrorWordLayout layout) {
+  return names_of_set_bits(error_word, error_word_bits(layout), system_error_bits(layout));
+}
+
 std::vector<std::string> error_bit_names(std::uint32_t error_word) {
-  return names_of_set_bits(error_word, 32, system_error_bits());
+  return error_bit_names(error_word, ErrorWordLayout::kManual32);
+}
+
+bool is_critical_error(std::uint32_t error_word, ErrorWordLayout layout) {
+  return (error_word & interpretation::critical_error_mask(layout)) != 0;
 }
 
 bool is_critical_error(std::uint32_t error_word) {
-  // Faults after which the chassis does not drive until they are cleared (0x441 or KEY1):
-  // collision, driver and communication faults, protections, calibration faults. Warnings (steering
-  // servo), host-link loss (cured by commanding again), ultrasonic triggering and remote-control
-  // loss are transient conditions and do not count.
-  static const std::uint32_t kCritical = mask_of({
-      error_bit_index(7, 0),
-      error_bit_index(7, 3),
-      error_bit_index(7, 4),
-      error_bit_index(7, 5),
-      error_bit_index(7, 6),
-      error_bit_index(6, 0),
-      error_bit_index(6, 2),
-      error_bit_index(6, 3),
-      error_bit_index(6, 4),
-      error_bit_index(6, 5),
-      error_bit_index(6, 6),
-      error_bit_index(6, 7),
-      error_bit_index(5, 0),
-      error_bit_index(5, 1),
-      error_bit_index(5, 2),
-      error_bit_index(5, 3),
-      error_bit_index(5, 4),
-      error_bit_index(5, 5),
-  });
-  return (error_word & kCritical) != 0;
+  return is_critical_error(error_word, ErrorWordLayout::kManual32);
+}
+
+std::string_view to_string(Fault f) {
+  switch (f) {
+    case Fault::kBatteryUnderVoltage:
+      return "battery_under_voltage";
+    case Fault::kBatteryWarning:
+      return "battery_warning";
+    case Fault::kUltrasonicTriggered:
+      return "ultrasonic_triggered";
+    case Fault::kRemoteSignalLost:
+      return "remote_signal_lost";
+    case Fault::kHostCommunicationLost:
+      return "host_communication_lost";
+    case Fault::kDriverStatusError:
+      return "driver_status_error";
+    case Fault::kOverTemperature:
+      return "over_temperature";
+    case Fault::kOverCurrent:
+      return "over_current";
+    case Fault::kMotorCommunication:
+      return "motor_communication";
+    case Fault::kSteeringCalibration:
+      return "steering_calibration";
+    case Fault::kSteeringCalibrationTimeout:
+      return "steering_calibration_timeout";
+    case Fault::kSafetyEdge:
+      return "safety_edge";
+    case Fault::kSteeringServoWarning:
+      return "steering_servo_warning";
+    case Fault::kSteeringEncoder:
+      return "steering_encoder";
+  }
+  return "unknown";
+}
+
+std::uint32_t fault_bit(Fault fault, ErrorWordLayout layout, int motor) {
+  const bool steering_motor = motor >= 5 && motor <= kMotorCount;
+  if (layout == ErrorWordLayout::kAgxV2_16) {
+    switch (fault) {
+      case Fault::kBatteryUnderVoltage:
+        return 0x0001;
+      case Fault::kBatteryWarning:
+        return 0x0002;
+      case Fault::kRemoteSignalLost:
+        return 0x0004;
+      case Fault::kMotorCommunication:
+        return motor >= 1 && motor <= 4 ? 0x0008u << (motor - 1) : 0;
+      case Fault::kSteeringEncoder:
+        return 0x0080;
+      case Fault::kDriverStatusError:
+        return 0x0100;
+      case Fault::kHostCommunicationLost:
+        return 0x0200;
+      default:
+        return 0;
+    }
+  }
+  switch (fault) {
+    case Fault::kBatteryUnderVoltage:
+      return manual_bit(7, 0);
+    case Fault::kUltrasonicTriggered:
+      return manual_bit(7, 1);
+    case Fault::kRemoteSignalLost:
+      return manual_bit(7, 2);
+    case Fault::kMotorCommunication:
+      if (motor >= 1 && motor <= 4) return manual_bit(7, 2 + motor);
+      return steering_motor ? manual_bit(6, motor - 3) : 0;
+    case Fault::kDriverStatusError:
+      return manual_bit(6, 0);
+    case Fault::kHostCommunicationLost:
+      return manual_bit(6, 1);
+    case Fault::kOverTemperature:
+      return manual_bit(6, 6);
+    case Fault::kOverCurrent:
+      return manual_bit(6, 7);
+    case Fault::kSteeringCalibration:
+      return steering_motor ? manual_bit(5, motor - 5) : 0;
+    case Fault::kSteeringCalibrationTimeout:
+      return manual_bit(5, 4);
+    case Fault::kSafetyEdge:
+      return manual_bit(5, 5);
+    case Fault::kSteeringServoWarning:
+      return steering_motor ? manual_bit(4, motor - 5) : 0;
+    case Fault::kBatteryWarning:
+    case Fault::kSteeringEncoder:
+      return 0;
+  }
+  return 0;
 }
 
 // ---- 0x261-0x268 driver status bits -----------------------------------------------------------
 
+namespace {
+// The bit number of a one-bit mask.
+constexpr int bit_of(std::uint8_t mask) {
+  int i = 0;
+  while (mask > 1) {
+    mask = static_cast<std::uint8_t>(mask >> 1);
+    ++i;
+  }
+  return i;
+}
+}  // namespace
+
 const std::vector<NamedBit>& driver_status_bits() {
+  namespace ds = driver_status;
   static const std::vector<NamedBit> bits = {
-      {0, "supply_voltage_low", "power supply voltage too low"},
-      {1, "motor_over_temperature", "motor over-temperature"},
-      {2, "driver_over_current", "driver over-current"},
-      {3, "driver_over_temperature", "driver over-temperature"},
-      {4, "sensor_abnormal", "sensor status abnormal"},
-      {5, "driver_error", "driver error"},
-      {6, "driver_disabled", "driver disabled (0 = enabled)"},
+      {bit_of(ds::kSupplyVoltageLow), "supply_voltage_low", "power supply voltage too low"},
+      {bit_of(ds::kMotorOverTemperature), "motor_over_temperature", "motor over-temperature"},
+      {bit_of(ds::kDriverOverCurrent), "driver_over_current", "driver over-current"},
+      {bit_of(ds::kDriverOverTemperature), "driver_over_temperature", "driver over-temperature"},
+      {bit_of(ds::kSensorAbnormal), "sensor_abnormal", "sensor status abnormal"},
+      {bit_of(ds::kDriverError), "driver_error", "driver error"},
+      {bit_of(ds::kDriverDisabled), "driver_disabled", "driver disabled (0 = enabled)"},
   };
   return bits;
 }
@@ -290,18 +536,19 @@ std::vector<std::string> driver_status_names(std::uint8_t status) {
 
 const std::vector<NamedBit>& bms_status1_bits() {
   static const std::vector<NamedBit> bits = {
-      {1, "over_voltage", "over-voltage"},
-      {2, "under_voltage", "under-voltage"},
-      {3, "high_temperature", "high temperature"},
-      {4, "low_temperature", "low temperature"},
-      {7, "discharge_over_current", "discharge over-current"},
+      {bit_of(bms_status::kOverVoltage), "over_voltage", "over-voltage"},
+      {bit_of(bms_status::kUnderVoltage), "under_voltage", "under-voltage"},
+      {bit_of(bms_status::kHighTemperature), "high_temperature", "high temperature"},
+      {bit_of(bms_status::kLowTemperature), "low_temperature", "low temperature"},
+      {bit_of(bms_status::kDischargeOverCurrent), "discharge_over_current",
+       "discharge over-current"},
   };
   return bits;
 }
 
 const std::vector<NamedBit>& bms_status2_bits() {
   static const std::vector<NamedBit> bits = {
-      {0, "charge_over_current", "charging over-current"},
+      {bit_of(bms_status::kChargeOverCurrent), "charge_over_current", "charging over-current"},
   };
   return bits;
 }
@@ -317,7 +564,8 @@ std::vector<std::string> bms_status_names(std::uint8_t status1, std::uint8_t sta
 // ---- Ultrasonic -------------------------------------------------------------------------------
 
 std::string_view ultrasonic_status_name(std::int16_t raw) {
-  if (raw >= 0) return "ok";
+  if (raw == interpretation::kUltrasonicNoReading) return "no_reading";
+  if (raw > 0) return "ok";
   switch (static_cast<UltrasonicCode>(raw)) {
     case UltrasonicCode::kOffline:
       return "offline";

@@ -2,8 +2,11 @@
 
 #include <cstdarg>
 #include <cstdio>
+#include <initializer_list>
+#include <utility>
 #include <vector>
 
+#include "ranger_can/wire/interpretation.hpp"
 #include "ranger_can/wire/protocol.hpp"
 
 namespace ranger::cli {
@@ -63,17 +66,38 @@ std::string bms_slot(int battery) {
 
 // ---- JSON -------------------------------------------------------------------------------------
 
+// The wire value of a 0x141 mode (the raw byte when decoding found no mode) and its name.
+int mode_wire_value(const MotionModeCommand& m, const ProtocolProfile& p) {
+  if (!m.mode_known) return m.mode_raw;
+  const auto v = proto::motion_mode_to_wire(m.mode, p.mode_numbering);
+  return v ? *v : static_cast<int>(m.mode);
+}
+std::string_view mode_name(proto::MotionMode mode, bool known) {
+  return known ? proto::to_string(mode) : std::string_view("unknown");
+}
+
+// Whether the agx_v2 fields of 0x111/0x221 (bytes 2-5) are worth a place on a text line.
+bool show_v2_fields(const ProtocolProfile& p, std::initializer_list<double> values) {
+  if (p.spin_field == SpinField::kYawRate) return true;
+  for (double v : values) {
+    if (v != 0.0) return true;
+  }
+  return false;
+}
+
 struct JsonFields {
   JsonWriter& w;
+  const ProtocolProfile& p;
 
   void operator()(const MotionCommand& m) const {
     w.key("linear_speed").number(m.linear_speed);
+    w.key("yaw_rate").number(m.yaw_rate);
     w.key("spin_speed").number(m.spin_speed);
     w.key("steering_angle").number(m.steering_angle);
   }
   void operator()(const MotionModeCommand& m) const {
-    w.key("mode").integer(static_cast<int>(m.mode));
-    w.key("mode_name").string(proto::to_string(m.mode));
+    w.key("mode").integer(mode_wire_value(m, p));
+    w.key("mode_name").string(mode_name(m.mode, m.mode_known));
   }
   void operator()(const ControlModeCommand& m) const {
     w.key("mode").integer(static_cast<int>(m.mode));
@@ -91,11 +115,14 @@ struct JsonFields {
     w.key("control_mode_name").string(proto::to_string(s.control_mode));
     w.key("battery_voltage").number(s.battery_voltage);
     w.key("error_bits").unsigned_integer(s.error_bits);
-    write_names(w, "errors", proto::error_bit_names(s.error_bits));
-    w.key("critical").boolean(proto::is_critical_error(s.error_bits));
+    write_names(w, "errors", proto::error_bit_names(s.error_bits, p.error_word));
+    w.key("critical").boolean(proto::is_critical_error(s.error_bits, p.error_word));
+    if (s.counter) w.key("counter").integer(*s.counter);
   }
   void operator()(const MotionFeedback& m) const {
     w.key("speed").number(m.speed);
+    w.key("yaw_rate").number(m.yaw_rate);
+    w.key("lateral_speed").number(m.lateral_speed);
     w.key("steering_angle").number(m.steering_angle);
   }
   void operator()(const MotorHighSpeedFeedback& m) const {
@@ -126,7 +153,7 @@ struct JsonFields {
   }
   void operator()(const MotionModeFeedback& m) const {
     w.key("mode").integer(m.mode_raw);
-    w.key("mode_name").string(proto::to_string(m.mode));
+    w.key("mode_name").string(mode_name(m.mode, m.mode_known));
     w.key("switching").boolean(m.switching);
   }
   void operator()(const UltrasonicFeedback& m) const {
@@ -158,19 +185,55 @@ struct JsonFields {
     write_names(w, "alarms", proto::bms_status_names(a.alarm1, a.alarm2));
     write_names(w, "warnings", proto::bms_status_names(a.warning1, a.warning2));
   }
+  template <typename Light>
+  void light(const Light& l) const {
+    w.key("enable").boolean(l.enable);
+    w.key("front_mode").integer(static_cast<int>(l.front_mode));
+    w.key("front_mode_name").string(proto::to_string(l.front_mode));
+    w.key("front_custom").integer(l.front_custom);
+    w.key("rear_mode").integer(static_cast<int>(l.rear_mode));
+    w.key("rear_mode_name").string(proto::to_string(l.rear_mode));
+    w.key("rear_custom").integer(l.rear_custom);
+    w.key("counter").integer(l.counter);
+  }
+  void operator()(const LightCommand& l) const { light(l); }
+  void operator()(const LightState& l) const { light(l); }
+  void operator()(const RemoteControlState& r) const {
+    const std::pair<const char*, proto::RemoteSwitch> switches[] = {
+        {"swa", r.swa}, {"swb", r.swb}, {"swc", r.swc}, {"swd", r.swd}};
+    for (const auto& [key, position] : switches) {
+      w.key(key).integer(static_cast<int>(position));
+      w.key(std::string(key) + "_name").string(proto::to_string(position));
+    }
+    w.key("stick_right_h").integer(r.stick_right_h);
+    w.key("stick_right_v").integer(r.stick_right_v);
+    w.key("stick_left_v").integer(r.stick_left_v);
+    w.key("stick_left_h").integer(r.stick_left_h);
+    w.key("var_a").integer(r.var_a);
+    w.key("counter").integer(r.counter);
+  }
+  void operator()(const OdometerFeedback& o) const {
+    w.key("left_wheel").integer(o.left_wheel);
+    w.key("right_wheel").integer(o.right_wheel);
+  }
+  void operator()(const VersionRequest&) const { w.key("request").boolean(true); }
+  void operator()(const VersionResponse& v) const { w.key("text").string(v.view()); }
 };
 
 // ---- Text -------------------------------------------------------------------------------------
 
 struct TextFields {
   std::string& out;
+  const ProtocolProfile& p;
 
   void operator()(const MotionCommand& m) const {
-    appendf(out, "linear=%.3f m/s spin=%.3f m/s steering=%.2f deg", m.linear_speed, m.spin_speed,
-            m.steering_angle * kDegPerRad);
+    appendf(out, "linear=%.3f m/s ", m.linear_speed);
+    if (show_v2_fields(p, {m.yaw_rate})) appendf(out, "yaw_rate=%.3f rad/s ", m.yaw_rate);
+    appendf(out, "spin=%.3f m/s steering=%.2f deg", m.spin_speed, m.steering_angle * kDegPerRad);
   }
   void operator()(const MotionModeCommand& m) const {
-    appendf(out, "mode=%d (%s)", static_cast<int>(m.mode), proto::to_string(m.mode).data());
+    appendf(out, "mode=%d (%s)", mode_wire_value(m, p),
+            std::string(mode_name(m.mode, m.mode_known)).c_str());
   }
   void operator()(const ControlModeCommand& m) const {
     appendf(out, "mode=%d (%s)", static_cast<int>(m.mode), proto::to_string(m.mode).data());
@@ -182,14 +245,19 @@ struct TextFields {
     out += m.enable ? "enable=yes" : "enable=no";
   }
   void operator()(const SystemStatus& s) const {
-    appendf(out, "vehicle=%s control=%s battery=%.1f V errors=0x%08X ",
+    appendf(out, "vehicle=%s control=%s battery=%.1f V errors=0x%0*X ",
             proto::to_string(s.vehicle_status).data(), proto::to_string(s.control_mode).data(),
-            s.battery_voltage, s.error_bits);
-    append_names(out, proto::error_bit_names(s.error_bits));
-    if (proto::is_critical_error(s.error_bits)) out += " CRITICAL";
+            s.battery_voltage, proto::error_word_bits(p.error_word) / 4, s.error_bits);
+    append_names(out, proto::error_bit_names(s.error_bits, p.error_word));
+    if (proto::is_critical_error(s.error_bits, p.error_word)) out += " CRITICAL";
+    if (s.counter) appendf(out, " counter=%d", *s.counter);
   }
   void operator()(const MotionFeedback& m) const {
-    appendf(out, "speed=%.3f m/s steering=%.2f deg", m.speed, m.steering_angle * kDegPerRad);
+    appendf(out, "speed=%.3f m/s ", m.speed);
+    if (show_v2_fields(p, {m.yaw_rate, m.lateral_speed})) {
+      appendf(out, "yaw_rate=%.3f rad/s lateral=%.3f m/s ", m.yaw_rate, m.lateral_speed);
+    }
+    appendf(out, "steering=%.2f deg", m.steering_angle * kDegPerRad);
   }
   void operator()(const MotorHighSpeedFeedback& m) const {
     appendf(out, "motor=%d rpm=%.0f current=%.1f A position=%d", m.motor, m.rpm, m.current,
@@ -211,13 +279,13 @@ struct TextFields {
     out += "m/s";
   }
   void operator()(const MotionModeFeedback& m) const {
-    appendf(out, "mode=%d (%s) switching=%s", m.mode_raw, proto::to_string(m.mode).data(),
-            m.switching ? "yes" : "no");
+    appendf(out, "mode=%d (%s) switching=%s", m.mode_raw,
+            std::string(mode_name(m.mode, m.mode_known)).c_str(), m.switching ? "yes" : "no");
   }
   void operator()(const UltrasonicFeedback& m) const {
     for (int i = 0; i < 4; ++i) {
       if (i > 0) out += ' ';
-      if (m.raw[i] >= 0) {
+      if (interpretation::ultrasonic_distance_m(m.raw[i])) {  // 0 is no reading, not 0 mm
         appendf(out, "s%d=%d mm", m.first_sensor + i, m.raw[i]);
       } else {
         appendf(out, "s%d=%s", m.first_sensor + i, proto::ultrasonic_status_name(m.raw[i]).data());
@@ -238,6 +306,39 @@ struct TextFields {
     out += " warnings=";
     append_names(out, proto::bms_status_names(a.warning1, a.warning2));
   }
+  template <typename Light>
+  void light(const Light& l) const {
+    appendf(out, "enable=%s front=%s/%d rear=%s/%d counter=%d", l.enable ? "yes" : "no",
+            proto::to_string(l.front_mode).data(), l.front_custom,
+            proto::to_string(l.rear_mode).data(), l.rear_custom, l.counter);
+  }
+  void operator()(const LightCommand& l) const { light(l); }
+  void operator()(const LightState& l) const { light(l); }
+  void operator()(const RemoteControlState& r) const {
+    appendf(out,
+            "swa=%s swb=%s swc=%s swd=%s right_h=%d right_v=%d left_v=%d left_h=%d var_a=%d "
+            "counter=%d",
+            proto::to_string(r.swa).data(), proto::to_string(r.swb).data(),
+            proto::to_string(r.swc).data(), proto::to_string(r.swd).data(), r.stick_right_h,
+            r.stick_right_v, r.stick_left_v, r.stick_left_h, r.var_a, r.counter);
+  }
+  void operator()(const OdometerFeedback& o) const {
+    appendf(out, "left=%d right=%d (raw)", static_cast<int>(o.left_wheel),
+            static_cast<int>(o.right_wheel));
+  }
+  void operator()(const VersionRequest&) const { out += "request"; }
+  void operator()(const VersionResponse& v) const {
+    out += "text=\"";
+    for (const char c : v.view()) {
+      const auto u = static_cast<unsigned char>(c);
+      if (u >= 0x20 && u < 0x7F && c != '"' && c != '\\') {
+        out += c;
+      } else {
+        appendf(out, "\\x%02X", u);
+      }
+    }
+    out += '"';
+  }
 };
 
 std::string_view name_of(const CanFrame& f) {
@@ -246,15 +347,16 @@ std::string_view name_of(const CanFrame& f) {
 
 }  // namespace
 
-void write_message_json(JsonWriter& w, const Message& message) {
-  std::visit(JsonFields{w}, message);
+void write_message_json(JsonWriter& w, const Message& message, const ProtocolProfile& profile) {
+  std::visit(JsonFields{w, profile}, message);
 }
 
-void append_message_text(std::string& out, const Message& message) {
-  std::visit(TextFields{out}, message);
+void append_message_text(std::string& out, const Message& message, const ProtocolProfile& profile) {
+  std::visit(TextFields{out, profile}, message);
 }
 
-void append_frame_json(std::string& out, const CanFrame& frame, std::string_view iface) {
+void append_frame_json(std::string& out, const CanFrame& frame, std::string_view iface,
+                       const ProtocolProfile& profile) {
   JsonWriter w(out);
   w.begin_object();
   w.key("t").seconds(frame.stamp);
@@ -266,16 +368,18 @@ void append_frame_json(std::string& out, const CanFrame& frame, std::string_view
   std::string hex;
   append_hex_data(hex, frame, '\0');
   w.string(hex);
-  const Result<Message> decoded = decode(frame);
+  if (const int extra = proto::extra_bytes(frame); extra > 0) w.key("extra_bytes").integer(extra);
+  const Result<Message> decoded = decode(frame, profile);
   if (decoded) {
-    write_message_json(w, *decoded);
+    write_message_json(w, *decoded, profile);
   } else {
     w.key("error").string(decoded.error().message);
   }
   w.end_object();
 }
 
-void append_frame_text(std::string& out, const CanFrame& frame, std::string_view iface) {
+void append_frame_text(std::string& out, const CanFrame& frame, std::string_view iface,
+                       const ProtocolProfile& profile) {
   append_seconds(out, frame.stamp);
   out += ' ';
   out.append(iface.data(), iface.size());
@@ -285,9 +389,12 @@ void append_frame_text(std::string& out, const CanFrame& frame, std::string_view
     appendf(out, " %03X", frame.id);
   }
   appendf(out, " %-28s ", std::string(name_of(frame)).c_str());
-  const Result<Message> decoded = decode(frame);
+  const Result<Message> decoded = decode(frame, profile);
   if (decoded) {
-    append_message_text(out, *decoded);
+    append_message_text(out, *decoded, profile);
+    if (const int extra = proto::extra_bytes(frame); extra > 0) {
+      appendf(out, "  [+%d byte%s ignored]", extra, extra == 1 ? "" : "s");
+    }
   } else {
     out += "error: " + decoded.error().message + "  [";
     out += std::to_string(frame.dlc);

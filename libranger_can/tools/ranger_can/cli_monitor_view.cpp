@@ -87,99 +87,35 @@ std::string ultrasonic_text(std::int16_t raw) {
   return std::string(protocol::ultrasonic_status_name(raw));
 }
 
-template <typename T>
-void store(std::optional<Stamped<T>>& slot, const T& v, const CanFrame& f, Timestamp now) {
-  slot = Stamped<T>{v, now, f.stamp};
-}
-
 }  // namespace
-
-ChassisMonitor::ChassisMonitor(std::chrono::nanoseconds rate_window) : window_(rate_window) {}
 
 void ChassisMonitor::on_frame(const CanFrame& frame, Timestamp now) {
   if (frame.is_error) {
     ++error_frames_;
     return;
   }
-  ++frames_;
-  auto& q = arrivals_[frame.id];
-  q.push_back(now);
-  while (!q.empty() && q.front() <= now - window_)
-    q.pop_front();
-
   auto decoded = decode(frame);
+  stats_.record(frame.id, now, decoded.ok(), frame.dlc - protocol::expected_dlc(frame.id));
   if (!decoded) {
     ++decode_errors_;
     return;
   }
-  std::visit(
-      [&](const auto& m) {
-        using T = std::decay_t<decltype(m)>;
-        if constexpr (std::is_same_v<T, MotionCommand>) {
-          motion_command_ = Seen<MotionCommand>{m, now};
-        } else if constexpr (std::is_same_v<T, MotionModeCommand>) {
-          motion_mode_command_ = Seen<MotionModeCommand>{m, now};
-        } else if constexpr (std::is_same_v<T, ControlModeCommand>) {
-          control_mode_command_ = Seen<ControlModeCommand>{m, now};
-        } else if constexpr (std::is_same_v<T, ErrorClearCommand>) {
-          error_clear_command_ = Seen<ErrorClearCommand>{m, now};
-        } else if constexpr (std::is_same_v<T, UltrasonicSettingCommand>) {
-          // shown through the chassis's 0x45A answer
-        } else {
-          ++feedback_frames_;
-          if constexpr (std::is_same_v<T, SystemStatus>) store(fb_.system_status, m, frame, now);
-          if constexpr (std::is_same_v<T, MotionFeedback>) store(fb_.motion, m, frame, now);
-          if constexpr (std::is_same_v<T, MotionModeFeedback>)
-            store(fb_.motion_mode, m, frame, now);
-          if constexpr (std::is_same_v<T, SteeringAnglesFeedback>) {
-            store(fb_.steering_angles, m, frame, now);
-          }
-          if constexpr (std::is_same_v<T, WheelSpeedsFeedback>)
-            store(fb_.wheel_speeds, m, frame, now);
-          if constexpr (std::is_same_v<T, MotorHighSpeedFeedback>) {
-            if (m.motor >= 1 && m.motor <= protocol::kMotorCount) {
-              store(fb_.motor_high_speed[m.motor - 1], m, frame, now);
-            }
-          }
-          if constexpr (std::is_same_v<T, MotorLowSpeedFeedback>) {
-            if (m.motor >= 1 && m.motor <= protocol::kMotorCount) {
-              store(fb_.motor_low_speed[m.motor - 1], m, frame, now);
-            }
-          }
-          if constexpr (std::is_same_v<T, BmsData>) {
-            if (m.battery >= 0 && m.battery <= protocol::kBatteryCount)
-              store(fb_.bms[m.battery], m, frame, now);
-          }
-          if constexpr (std::is_same_v<T, BmsAlarm>) {
-            if (m.battery >= 0 && m.battery <= protocol::kBatteryCount) {
-              store(fb_.bms_alarm[m.battery], m, frame, now);
-            }
-          }
-          if constexpr (std::is_same_v<T, UltrasonicFeedback>) {
-            store(fb_.ultrasonic[m.first_sensor == 5 ? 1 : 0], m, frame, now);
-          }
-          if constexpr (std::is_same_v<T, UltrasonicSettingFeedback>) {
-            store(fb_.ultrasonic_setting, m, frame, now);
-          }
-        }
-      },
-      *decoded);
+  // The chassis's feedback goes to the store the driver uses; the host's commands (other nodes
+  // driving this chassis) are kept here.
+  if (fb_.record(*decoded, frame.stamp, now)) return;
+  if (const auto* m = std::get_if<MotionCommand>(&*decoded)) {
+    motion_command_ = Seen<MotionCommand>{*m, now};
+  } else if (const auto* mm = std::get_if<MotionModeCommand>(&*decoded)) {
+    motion_mode_command_ = Seen<MotionModeCommand>{*mm, now};
+  } else if (const auto* cm = std::get_if<ControlModeCommand>(&*decoded)) {
+    control_mode_command_ = Seen<ControlModeCommand>{*cm, now};
+  } else if (const auto* ec = std::get_if<ErrorClearCommand>(&*decoded)) {
+    error_clear_command_ = Seen<ErrorClearCommand>{*ec, now};
+  }
 }
 
 double ChassisMonitor::rate(std::uint32_t id, Timestamp now) const {
-  auto it = arrivals_.find(id);
-  if (it == arrivals_.end()) return 0.0;
-  // Intervals between the frames inside the window: (n - 1) / (last - first). Unbiased whatever
-  // the phase of the window, and right from the second frame on.
-  Timestamp first{0}, last{0};
-  long n = 0;
-  for (Timestamp t : it->second) {
-    if (t <= now - window_ || t > now) continue;
-    if (n++ == 0) first = t;
-    last = t;
-  }
-  const double span = std::chrono::duration<double>(last - first).count();
-  return n >= 2 && span > 0 ? static_cast<double>(n - 1) / span : 0.0;
+  return stats_.rate(id, now);
 }
 
 std::string ChassisMonitor::render_text(std::string_view iface, const BusStatus& bus, Timestamp now,
@@ -191,17 +127,17 @@ std::string ChassisMonitor::render_text(std::string_view iface, const BusStatus&
   std::string bus_state(to_string(bus.state));
   bus_state = bus.state == BusState::kActive ? st.green(bus_state) : st.red(bus_state);
   double total_rate = 0;
-  for (const auto& [id, q] : arrivals_)
-    total_rate += rate(id, now);
+  for (const FrameIdCounts& c : stats_.counts())
+    total_rate += rate(c.id, now);
   line(st.bold("RANGER monitor  " + std::string(iface)) + "   bus " + bus_state +
        (bus.detail.empty() ? "" : " (" + bus.detail + ")") + "   frames " +
-       std::to_string(frames_) + fmt("  %.0f/s", total_rate) + "   undecodable " +
+       std::to_string(stats_.total()) + fmt("  %.0f/s", total_rate) + "   undecodable " +
        std::to_string(decode_errors_) + "   error frames " +
        std::to_string(error_frames_ + bus.stats.error_frames) + "   dropped rx/tx " +
        std::to_string(bus.stats.rx_dropped) + "/" + std::to_string(bus.stats.tx_dropped));
 
   if (!fb_.system_status) {
-    line(st.red(frames_ == 0 ? "no frames received yet: is the chassis on and the bus up?"
+    line(st.red(stats_.total() == 0 ? "no frames received yet: is the chassis on and the bus up?"
                              : "no 0x211 system status received yet"));
   } else {
     const auto& s = fb_.system_status->value;
@@ -340,11 +276,12 @@ std::string ChassisMonitor::render_text(std::string_view iface, const BusStatus&
   // Frame rates: every ID seen, plus the periodic feedback IDs that are missing.
   line("Rates /s  (expected in brackets; " + st.red("red") + " = more than 20% off)");
   std::vector<std::uint32_t> ids;
-  for (const auto& [id, q] : arrivals_)
-    ids.push_back(id);
+  for (const FrameIdCounts& c : stats_.counts())
+    ids.push_back(c.id);
   for (auto id : protocol::all_ids()) {
     const bool optional_battery = id >= protocol::kBmsBaseId + 2 && id < protocol::kBmsBaseId + 10;
-    if (nominal_rate(id) > 0 && !optional_battery && !arrivals_.count(id)) ids.push_back(id);
+    const bool seen = std::find(ids.begin(), ids.end(), id) != ids.end();
+    if (nominal_rate(id) > 0 && !optional_battery && !seen) ids.push_back(id);
   }
   std::sort(ids.begin(), ids.end());
   std::string row;
@@ -378,7 +315,7 @@ std::string ChassisMonitor::render_json(std::string_view iface, const BusStatus&
   w.key("tx_dropped").unsigned_integer(bus.stats.tx_dropped);
   w.key("error_frames").unsigned_integer(bus.stats.error_frames + error_frames_);
   w.end_object();
-  w.key("frames").unsigned_integer(frames_);
+  w.key("frames").unsigned_integer(stats_.total());
   w.key("undecodable").unsigned_integer(decode_errors_);
   if (fb_.system_status) {
     const auto& s = fb_.system_status->value;
@@ -433,8 +370,8 @@ std::string ChassisMonitor::render_json(std::string_view iface, const BusStatus&
     w.end_object();
   }
   w.key("rates").begin_object();
-  for (const auto& [id, q] : arrivals_)
-    w.key(hex_id(id)).number(rate(id, now));
+  for (const FrameIdCounts& c : stats_.counts())
+    w.key(hex_id(c.id)).number(rate(c.id, now));
   w.end_object();
   w.end_object();
   return out;

@@ -14,14 +14,16 @@
 
 #include "ranger_can/transport/bus.hpp"
 #include "ranger_can/wire/codec.hpp"
-#include "ranger_can/control/controller.hpp"  // ChassisFeedback, Stamped
+#include "ranger_can/control/feedback.hpp"
+#include "ranger_can/control/frame_stats.hpp"
 #include "ranger_can/wire/frame.hpp"
 
 namespace ranger::cli {
 
 class ChassisMonitor {
  public:
-  explicit ChassisMonitor(std::chrono::nanoseconds rate_window = std::chrono::seconds(1));
+  explicit ChassisMonitor(std::chrono::nanoseconds rate_window = std::chrono::seconds(1))
+      : stats_(rate_window) {}
 
   // A frame received at `now` (the monitor's clock).
   void on_frame(const CanFrame& frame, Timestamp now);
@@ -35,9 +37,9 @@ class ChassisMonitor {
 
   // Frames per second of `id` over the window ending at `now`.
   double rate(std::uint32_t id, Timestamp now) const;
-  std::uint64_t frames() const { return frames_; }
+  std::uint64_t frames() const { return stats_.total(); }
   // True once any chassis feedback frame decoded.
-  bool heard_chassis() const { return feedback_frames_ > 0; }
+  bool heard_chassis() const { return fb_.heard(); }
   const ChassisFeedback& feedback() const { return fb_; }
 
  private:
@@ -47,15 +49,12 @@ class ChassisMonitor {
     Timestamp received{0};
   };
 
-  std::chrono::nanoseconds window_;
   ChassisFeedback fb_;
   std::optional<Seen<MotionCommand>> motion_command_;  // commands from other nodes (the host)
   std::optional<Seen<MotionModeCommand>> motion_mode_command_;
   std::optional<Seen<ControlModeCommand>> control_mode_command_;
   std::optional<Seen<ErrorClearCommand>> error_clear_command_;
-  std::map<std::uint32_t, std::deque<Timestamp>> arrivals_;
-  std::uint64_t frames_ = 0;
-  std::uint64_t feedback_frames_ = 0;
+  FrameStats stats_;
   std::uint64_t decode_errors_ = 0;
   std::uint64_t error_frames_ = 0;
 };

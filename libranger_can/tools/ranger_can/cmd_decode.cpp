@@ -1,5 +1,6 @@
-// `ranger_can decode [FILE] [--json]`: candump logs in, one decoded line per frame out. Reading
-// (bounded lines, numbered errors, read errors reported) is cli_input's.
+// `ranger_can decode [FILE] [--json] [--protocol REV] [--set NAME=VALUE]...`: candump logs in, one
+// decoded line per frame out, under a protocol profile (cli_profile). Reading (bounded lines,
+// numbered errors, read errors reported) is cli_input's.
 #include <optional>
 #include <ostream>
 #include <string>
@@ -8,20 +9,21 @@
 #include "cli_frame_format.hpp"
 #include "cli_input.hpp"
 #include "cli_options.hpp"
+#include "cli_profile.hpp"
 #include "ranger_can/wire/candump_log.hpp"
 
 namespace ranger::cli {
 
 namespace {
 
-int decode_stream(std::istream& in, bool json, Io io) {
+int decode_stream(std::istream& in, bool json, const ProtocolProfile& profile, Io io) {
   std::string out;
   const CandumpReadSummary summary = read_candump(in, "decode", io.err, [&](const LogEntry& e) {
     out.clear();
     if (json) {
-      append_frame_json(out, e.frame, e.iface);
+      append_frame_json(out, e.frame, e.iface, profile);
     } else {
-      append_frame_text(out, e.frame, e.iface);
+      append_frame_text(out, e.frame, e.iface, profile);
     }
     out += '\n';
     io.out << out;
@@ -37,8 +39,10 @@ int decode_stream(std::istream& in, bool json, Io io) {
 
 int decode_main(const ParsedArgs& args, Io io) {
   const bool json = args.has("--json");
+  const Result<ProtocolProfile> profile = profile_from_args(args);
+  if (!profile) return usage_error(decode_command(), io, profile.error().message);
   return with_input(args.get("FILE"), "decode", io,
-                    [&](std::istream& in) { return decode_stream(in, json, io); });
+                    [&](std::istream& in) { return decode_stream(in, json, *profile, io); });
 }
 
 }  // namespace
@@ -52,16 +56,21 @@ const CommandSpec& decode_command() {
       "timestamps ('can0  221   [8]  00 96 00 ...').\n"
       "\n"
       "Prints one line per frame: human-readable text, or with --json one JSON object per line:\n"
-      "  t (s, 0 if the line had none), iface, id (integer), name, dlc, data (hex), then the\n"
-      "  message's fields in SI units with the manual's signs (steering: rad, positive = right;\n"
-      "  speeds: m/s; voltage V; current A; temperature degC; soc/soh %), or `error` for a frame\n"
-      "  with a bad DLC, an unknown ID (name \"unknown\") or an error frame.\n"
+      "  t (s, 0 if the line had none), iface, id (integer), name, dlc, data (hex), extra_bytes\n"
+      "  (only for a frame longer than its layout: those bytes were ignored), then the message's\n"
+      "  fields in SI units with the manual's signs (steering: rad, positive = right; speeds:\n"
+      "  m/s; voltage V; current A; temperature degC; soc/soh %), or `error` for a frame shorter\n"
+      "  than its layout, an unknown ID (name \"unknown\"), content impossible under the protocol\n"
+      "  profile (a steering angle beyond 100 deg) or an error frame.\n"
+      "\n"
+      "Frames are read under a protocol profile: --protocol picks the revision (units, signs,\n"
+      "the error-word layout, mode numbering), --set changes one interpretation of it.\n"
       "\n"
       "Malformed lines are reported on stderr as 'line N: reason' (the first 20, then a count)\n"
       "and skipped; blank lines are ignored; frames with extended (29-bit) IDs belong to other\n"
       "devices on the bus: they are counted, not decoded.",
       {optional_arg("FILE", "the candump log; standard input when absent or '-'", any_text())},
-      {flag("--json", "one JSON object per line")},
+      {flag("--json", "one JSON object per line"), protocol_option(), set_option()},
       "Exit status: 0 when the input held at least one frame to decode; 1 when it held none\n"
       "(empty, only malformed lines or only other devices' frames: the reason is on stderr) or\n"
       "could not be opened or read; 2 on a usage error.",

@@ -1,5 +1,7 @@
 // `ranger_can odom [FILE]`: replays a candump log through the driver's odometry (the very
-// ranger::Odometry class the ROS node runs) and prints the pose as JSON lines.
+// ranger::Odometry class the ROS node runs) and prints the pose as JSON lines. Frames are decoded
+// under the protocol profile of --protocol/--set (cli_profile), so the odometry sees every
+// revision in the one convention of codec.hpp.
 #include <istream>
 #include <limits>
 #include <optional>
@@ -11,6 +13,7 @@
 #include "cli_input.hpp"
 #include "cli_json.hpp"
 #include "cli_options.hpp"
+#include "cli_profile.hpp"
 #include "ranger_can/control/odometry.hpp"
 #include "ranger_can/wire/candump_log.hpp"
 
@@ -20,6 +23,7 @@ namespace {
 
 struct Options {
   OdometryConfig config;
+  ProtocolProfile profile;
   std::optional<std::string> path;  // absent: standard input
   long every = 1;
   bool quiet = false;
@@ -49,7 +53,9 @@ int replay(std::istream& in, const Options& opt, Io io) {
   std::uint64_t steps = 0;
   const CandumpReadSummary summary = read_candump(in, "odom", io.err, [&](const LogEntry& e) {
     if (e.has_timestamp) ++timestamped;
-    if (!odom.on_frame(e.frame)) return;
+    if (e.frame.is_error) return;
+    const Result<Message> message = decode(e.frame, opt.profile);
+    if (!message || !odom.on_message(*message, e.frame.stamp)) return;
     ++steps;
     if (!opt.quiet && steps % static_cast<std::uint64_t>(opt.every) == 0) {
       out.clear();
@@ -89,6 +95,9 @@ int odom_main(const ParsedArgs& args, Io io) {
   opt.config.geometry.track = args.number("--track", opt.config.geometry.track);
   opt.every = static_cast<long>(args.integer("--every", 1));
   opt.quiet = args.has("--quiet");
+  const Result<ProtocolProfile> profile = profile_from_args(args);
+  if (!profile) return usage_error(odom_command(), io, profile.error().message);
+  opt.profile = *profile;
   if (Status st = opt.config.validate(); !st) {
     return usage_error(odom_command(), io, st.error().message);
   }
@@ -118,9 +127,10 @@ const CommandSpec& odom_command() {
       "\n"
       "The log needs timestamps (candump -L, or candump -ta): odometry integrates over the "
       "frames'\n"
-      "own times. Steps longer than 0.5 s or going backwards are not integrated. Malformed lines\n"
-      "are reported on stderr as 'line N: reason' (the first 20, then a count) and skipped;\n"
-      "frames with extended (29-bit) IDs (other devices) are counted and skipped.",
+      "own times. Steps longer than 0.5 s or going backwards are not integrated. Frames are\n"
+      "decoded under the protocol profile of --protocol and --set (units, signs, lengths).\n"
+      "Malformed lines are reported on stderr as 'line N: reason' (the first 20, then a count)\n"
+      "and skipped; frames with extended (29-bit) IDs (other devices) are counted and skipped.",
       {optional_arg("FILE", "the candump log; standard input when absent or '-'", any_text())},
       {
           option("--source", "wheels|motion",
@@ -138,6 +148,8 @@ const CommandSpec& odom_command() {
           option("--every", "N", "print every Nth step only (default 1)",
                  integer_in(1, std::numeric_limits<std::int32_t>::max())),
           flag("--quiet", "print the final pose only"),
+          protocol_option(),
+          set_option(),
       },
       "Exit status: 0 when the log gave at least one odometry step; 1 when it gave none (empty,\n"
       "no timestamps, no motion feedback: the reason is on stderr, and no pose is printed) or\n"

@@ -21,7 +21,8 @@ struct FrameIdCounts {
 
 class FrameStats {
  public:
-  // Rates average over `window`, in ten buckets (so a rate is exact to within a tenth of it).
+  // Rates average over the last `window` (ten whole buckets of a tenth of it) plus the part of the
+  // current bucket that has passed.
   explicit FrameStats(std::chrono::nanoseconds window = std::chrono::seconds(1));
 
   // One received data frame of `id` (11-bit) at `now`. Returns true when this is the first frame
@@ -39,10 +40,12 @@ class FrameStats {
   static constexpr int kBuckets = 10;
   struct Entry {
     FrameIdCounts counts;
-    std::array<std::uint32_t, kBuckets> buckets{};
+    std::array<std::uint32_t, kBuckets + 1> buckets{};  // ten whole ones and the current one
     std::int64_t last_bucket = 0;  // absolute bucket index of the newest count
   };
-  std::int64_t bucket_of(Timestamp t) const { return t.count() / bucket_.count(); }
+  // Bucket k holds the frames of (k b, (k+1) b]: a frame at `now` is in the current bucket, the
+  // one exactly a window ago is not (a steady stream then counts exactly window / period).
+  std::int64_t bucket_of(Timestamp t) const { return (t.count() - 1) / bucket_.count(); }
 
   std::chrono::nanoseconds window_;
   std::chrono::nanoseconds bucket_;

@@ -2,7 +2,10 @@
 // currents, encoder positions and temperatures, and a pack that drains with load. Derived from
 // the motion model's wheel states; nothing here feeds back into the motion. The numbers are
 // first-order physics with the manual's vehicle data (135 kg, 48 V, 24 Ah per battery), good
-// enough for dashboards and alarms, not a calibrated model of the real drives.
+// enough for dashboards and alarms, not a calibrated model of the real drives. The pack is the
+// manual's lithium iron phosphate (wire/vehicle_spec.hpp): 15 cells in series, a flat plateau of
+// about 3.2-3.3 V per cell, so 46-50 V (the manual's normal range) over 10-90 % SOC, with steep
+// ends below and above.
 #pragma once
 
 #include <array>
@@ -34,6 +37,11 @@ struct DrivetrainConfig {
   double motor_heating = 0.8;               // degC above ambient per A^2 at steady state
   double driver_heating = 0.4;              // degC above ambient per A^2 at steady state
 };
+
+// Open-circuit voltage of the 48 V LiFePO4 pack at `soc_percent` (clamped to 0..100): a typical
+// LiFePO4 cell curve (piecewise linear), times 15 cells. 42 V empty, 48 V nominal near 20 %,
+// 46.0-50.0 V from 10 % to 90 %, 51.75 V full.
+double lifepo4_pack_open_circuit_voltage(double soc_percent);
 
 struct MotorTelemetry {
   double rpm = 0.0;

@@ -1,13 +1,23 @@
-// The manual's open points, decided once.
+// The manual's open points and the field interpretations, decided once.
 //
-// shared/reference/PROTOCOL.md lists six places where the RANGER manual is cut off or silent
-// (points 1-6); points 7-9 are further readings the code needs that PROTOCOL.md does not list.
-// Each decision below is the only place in the code base that encodes it: every other file calls
-// these names, so a test on a real chassis that disproves one reading is a one-line change here
-// (and docs/PROTOCOL_INTERPRETATIONS.md says why each reading was chosen).
+// shared/reference/PROTOCOL.md lists the places where the RANGER manual is cut off or silent;
+// points 7-9 below are further readings the code needs. Where a reading differs between the
+// manual and the vendor's later revision (PROTOCOL_AGX_V2.md), it is a run-time setting of the
+// protocol profile (profile.hpp) and the functions here take the profile's value; the constants
+// here are then the manual's reading (its preset). Every other file calls these names, and
+// docs/PROTOCOL_INTERPRETATIONS.md says why each reading was chosen.
+//
+// Decoded messages carry the manual's signs whatever the profile (the codec converts), so the
+// REP-103 conversions below hold for every revision.
 #pragma once
 
 #include <cmath>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "ranger_can/wire/profile.hpp"
+#include "ranger_can/wire/protocol.hpp"
 
 namespace ranger::interpretation {
 
@@ -20,14 +30,22 @@ inline constexpr double kMaxLinearSpeedMps = 2.6;
 inline constexpr double kLargeSteeringThresholdRad = 20.0 * M_PI / 180.0;
 
 // 0x221 steering feedback: the manual states negative = left, positive = right. REP-103 is the
-// opposite (positive = left, towards +y).
+// opposite (positive = left, towards +y). Decoded messages always use the manual's sign; the
+// sign on the wire is the profile's steering_sign_221, applied by the codec.
 inline constexpr double kManualSteeringSignVsRep103 = -1.0;
-// Open point 2 — 0x111 steering sign: not stated; read as the same convention as 0x221. Kept as a
-// constant of its own so that a chassis turning the other way flips the command only, not the
-// feedback: code that produces or reads a 0x111 angle uses the *_command_steering functions.
+// Open point 2 — 0x111 steering sign: not stated; the manual preset reads it as 0x221's
+// (profile: steering_sign_111, applied by the codec). Decoded and encoded MotionCommands use the
+// manual's sign; code that produces or reads a 0x111 angle uses the *_command_steering functions.
 inline constexpr double kCommandSteeringSignVsRep103 = kManualSteeringSignVsRep103;
-// Open point 3 — 0x271 per-wheel angle sign: read as the same as 0x221 (positive = right).
+// Open point 3 — 0x271 per-wheel angle sign: not stated; the manual preset reads it as 0x221's
+// (positive = right; profile: steering_sign_271, applied by the codec).
 inline constexpr double kManualWheelAngleSignVsRep103 = -1.0;
+
+// A steering angle beyond any model's reach: the largest angle any RANGER model steers is 90 deg
+// (oblique mode), the spin position about 58 deg. A 0x221 or 0x271 angle beyond this (after the
+// profile's unit) cannot be true under that profile; the codec refuses it (Errc::kOutOfRange,
+// naming the ID and the value), so a wrong unit shows as counted errors, never as motion.
+inline constexpr double kMaxPlausibleSteeringRad = 100.0 * M_PI / 180.0;
 
 // Converts a steering/wheel angle between the manual's convention and REP-103's (involutions).
 // 0x221 (feedback) steering:
@@ -53,8 +71,54 @@ inline double manual_from_rep103_wheel_angle(double rep103_rad) {
 }
 
 // Open point 4 — 0x211 byte 0 = 0x01 is absent from this manual's table; another printing of the
-// manual lists it as emergency shut-down. Decoded as VehicleStatus::kEmergencyStop.
+// manual lists it as emergency shut-down. Decoded as VehicleStatus::kEmergencyStop. The profile's
+// vehicle_status_1_is_estop is the run-time setting (the codec uses it); this is its default.
 inline constexpr bool kVehicleStatus1IsEmergencyStop = true;
+
+// ---- 0x211 error word: the critical set (per layout) -------------------------------------------
+// Faults after which the chassis does not drive until they are cleared (their own 0x441 code or
+// KEY1; 0x441 code 0x00 clears only the others): collision, driver, communication and sensor
+// faults, protections, calibration faults, battery under-voltage. Warnings (steering servo,
+// battery warning), host-link loss (cured by commanding again), ultrasonic triggering and
+// remote-control loss are transient conditions and do not count. Motor-numbered faults count for
+// every motor.
+const std::vector<protocol::Fault>& critical_faults();
+// The bits of critical_faults() in a layout's error word.
+std::uint32_t critical_error_mask(ErrorWordLayout layout);
+
+// ---- Ultrasonic (0x342, 0x343) ----------------------------------------------------------------
+// The manual: a positive value is a distance (printed "nm"; millimetres is the plausible unit), a
+// negative value a code. 0 is neither: read as "no reading" (no echo, or nothing measured yet),
+// never as an obstacle touching the sensor.
+inline constexpr std::int16_t kUltrasonicNoReading = 0;
+inline constexpr double kUltrasonicMetresPerUnit = 0.001;
+// The distance in metres for a raw value that is one; nullopt for "no reading" and the codes.
+inline std::optional<double> ultrasonic_distance_m(std::int16_t raw) {
+  if (raw <= kUltrasonicNoReading) return std::nullopt;
+  return raw * kUltrasonicMetresPerUnit;
+}
+
+// ---- BMS current sign (0x361 bytes 4-5) --------------------------------------------------------
+// The manual does not say which way the current counts; the profile's bms_current_sign does.
+// These give the current as a discharge (positive = the pack supplies the chassis) from the wire's
+// value and back (involutions).
+inline double bms_discharge_current(double wire_current, const ProtocolProfile& profile) {
+  return wire_current * profile.bms_current_sign;
+}
+inline double bms_wire_current(double discharge_current, const ProtocolProfile& profile) {
+  return discharge_current * profile.bms_current_sign;
+}
+
+// ---- Spin sign ---------------------------------------------------------------------------------
+// A spin value as on the wire (0x111 spin speed or yaw rate, 0x221 in spin mode) to
+// counter-clockwise positive and back (the profile's spin_sign; involutions). The codec passes
+// spin values as they are on the wire; the kinematics, odometry and virtual chassis call these.
+inline double spin_ccw_from_wire(double wire_value, const ProtocolProfile& profile) {
+  return wire_value * profile.spin_sign;
+}
+inline double spin_wire_from_ccw(double ccw_value, const ProtocolProfile& profile) {
+  return ccw_value * profile.spin_sign;
+}
 
 // Open point 5 — spin speed (0x111 bytes 4-5, mm/s, counter-clockwise positive) is the wheels'
 // tangential speed, so the body yaw rate is omega = v / hypot(wheelbase/2, track/2).
@@ -91,6 +155,36 @@ inline double ackermann_mean_front_angle(double curvature, double wheelbase_m, d
 // `mean_angle`; |mean_angle| >= pi/2 gives +-infinity (turning about the body centre); NaN or a
 // non-positive/non-finite wheelbase or track gives NaN.
 double ackermann_curvature_from_mean_angle(double mean_angle, double wheelbase_m, double track_m);
+
+// The other reading of point 6 (the manual's 0x221 table says "actual inner steering angle"; the
+// vendor's drivers steer the inner front wheel): the inner front wheel's angle,
+// tan(inner) = (L/2)|k| / (1 - (W/2)|k|), with the sign of k. It passes 90 deg at R = W/2 and
+// reaches pi - atan(L/W) (about 122 deg on a RANGER) at |k| = inf.
+inline double ackermann_inner_front_angle(double curvature, double wheelbase_m, double track_m) {
+  if (curvature == 0.0) return 0.0;
+  const double k = std::fabs(curvature);
+  if (std::isinf(k)) return std::copysign(std::atan2(wheelbase_m / 2.0, -track_m / 2.0), curvature);
+  return std::copysign(std::atan2(wheelbase_m / 2.0 * k, 1.0 - track_m / 2.0 * k), curvature);
+}
+// Its inverse in closed form: k = sin a / ((L/2) cos a + (W/2) sin a) for the magnitude a, with
+// the sign of `inner_angle`; |inner_angle| >= pi - atan(L/W) gives +-infinity; NaN or a bad
+// geometry gives NaN.
+double ackermann_curvature_from_inner_angle(double inner_angle, double wheelbase_m, double track_m);
+
+// Point 6 by the profile's steering_reference: the angle 0x111 steers (and 0x221 reports) in
+// Ackermann mode for body-centre curvature k, and its inverse (REP-103 signs).
+inline double ackermann_front_angle(double curvature, double wheelbase_m, double track_m,
+                                    SteeringReference reference) {
+  return reference == SteeringReference::kInnerFront
+             ? ackermann_inner_front_angle(curvature, wheelbase_m, track_m)
+             : ackermann_mean_front_angle(curvature, wheelbase_m, track_m);
+}
+inline double ackermann_curvature_from_front_angle(double angle, double wheelbase_m, double track_m,
+                                                   SteeringReference reference) {
+  return reference == SteeringReference::kInnerFront
+             ? ackermann_curvature_from_inner_angle(angle, wheelbase_m, track_m)
+             : ackermann_curvature_from_mean_angle(angle, wheelbase_m, track_m);
+}
 
 // ---- Readings beyond PROTOCOL.md's list ------------------------------------------------------
 
@@ -134,6 +228,23 @@ inline double ackermann_body_speed_from_feedback_speed(double feedback_speed_mps
 inline double ackermann_feedback_speed_from_body_speed(double body_speed_mps, double curvature,
                                                        double wheelbase_m, double track_m) {
   return body_speed_mps * ackermann_mean_wheel_speed_factor(curvature, wheelbase_m, track_m);
+}
+// Point 8 by the profile's feedback_speed: kMeanWheel as above, kBodyCentre the identity.
+inline double ackermann_body_speed_from_feedback_speed(double feedback_speed_mps, double curvature,
+                                                       double wheelbase_m, double track_m,
+                                                       FeedbackSpeed reading) {
+  return reading == FeedbackSpeed::kBodyCentre
+             ? feedback_speed_mps
+             : ackermann_body_speed_from_feedback_speed(feedback_speed_mps, curvature, wheelbase_m,
+                                                        track_m);
+}
+inline double ackermann_feedback_speed_from_body_speed(double body_speed_mps, double curvature,
+                                                       double wheelbase_m, double track_m,
+                                                       FeedbackSpeed reading) {
+  return reading == FeedbackSpeed::kBodyCentre
+             ? body_speed_mps
+             : ackermann_feedback_speed_from_body_speed(body_speed_mps, curvature, wheelbase_m,
+                                                        track_m);
 }
 
 // Point 9 — 0x221 speed in spin mode is the wheels' signed tangential speed, counter-clockwise

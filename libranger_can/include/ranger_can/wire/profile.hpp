@@ -5,15 +5,21 @@
 // and lengths; the manual itself leaves several points open (PROTOCOL.md). Each such point is a
 // field below, with a named setting (parse/print by name, validated) and a default per revision
 // and model. A revision is a preset of these fields, never a copy of the codec: nothing outside
-// profile.cpp branches on a revision's name.
+// profile.cpp branches on a revision's name. docs/PROTOCOL_INTERPRETATIONS.md lists every setting
+// with its values, its default per revision and the evidence for it.
 //
-// The codec (codec.hpp) takes a profile for everything on the wire: units, signs, which bytes
-// carry what, frame lengths, the error-word layout, the BMS scale and the motion-mode numbering.
-// Decoded messages are always in one convention, whatever the profile: SI units and the manual's
-// signs (steering positive = right, spin counter-clockwise positive), so the layers above never
-// look at the profile for units or signs. The geometric readings (which angle 0x111 steers in
-// Ackermann mode, which speed 0x111/0x221 carry) are profile fields too, applied by the control
-// layer's kinematics and odometry and by the virtual chassis.
+// Who applies which field:
+//  * The codec (codec.hpp) applies everything about the wire: steering units and signs per frame,
+//    the error-word layout, the BMS voltage scale, the driver-status enable bit, the meaning of
+//    vehicle status 0x01, the motion-mode numbering and the DLC of the frames it encodes. Decoded
+//    messages are always in one convention, whatever the profile: SI units and the manual's signs
+//    (steering positive = right; driver status bit 6 set = disabled).
+//  * Not the codec: `spin_sign` (0x111 bytes 2-5 and 0x221 bytes 0-3 carry spin only in spin
+//    mode, so the codec passes spin values as they are on the wire and the kinematics, odometry
+//    and virtual chassis apply the sign), `spin_field` (which field the kinematics fills),
+//    `steering_reference` and `feedback_speed` (geometric readings: interpretation.hpp's
+//    ackermann_front_angle / ackermann_body_speed_from_feedback_speed take them), and
+//    `bms_current_sign` (interpretation::bms_discharge_current).
 #pragma once
 
 #include <cstdint>
@@ -52,14 +58,19 @@ enum class FeedbackSpeed {
 };
 // Layout of 0x211 bytes 4-7.
 enum class ErrorWordLayout {
-  kManual32,    // bytes 4-7 one big-endian 32-bit error word (manual)
-  kAgxV2_16,    // bytes 4-5 a 16-bit error word, byte 6 reserved, byte 7 a counter (agx_v2)
+  kManual32,  // bytes 4-7 one big-endian 32-bit error word (manual)
+  kAgxV2_16,  // bytes 4-5 a 16-bit error word, byte 6 reserved, byte 7 a counter (agx_v2)
 };
 // Wire values of the motion modes (0x141, 0x291).
 enum class ModeNumbering {
   kManual,  // 0 Ackermann, 1 oblique, 2 spin
   kAgxV2,   // + 3 park, 4 side slip
   kMiniV1,  // + 3 side slip (no park)
+};
+// Meaning of bit 6 of the motor drivers' status byte (0x261-0x268 byte 5).
+enum class DriverStatusBit6 {
+  kDisabled,  // 1 = driver disabled (the manual)
+  kEnabled,   // 1 = driver enabled (the vendor's software)
 };
 
 struct ProtocolProfile {
@@ -76,40 +87,57 @@ struct ProtocolProfile {
   SteeringReference steering_reference = SteeringReference::kMeanFront;
   SpinField spin_field = SpinField::kWheelSpeed;
   // +1: a positive spin value on the wire turns counter-clockwise (the manual); -1: clockwise.
+  // Applied above the codec (see the top of this file).
   int spin_sign = +1;
   FeedbackSpeed feedback_speed = FeedbackSpeed::kMeanWheel;
   ErrorWordLayout error_word = ErrorWordLayout::kManual32;
   bool vehicle_status_1_is_estop = true;  // 0x211 byte 0 = 0x01 (open point 4)
   double bms_voltage_scale = 0.01;        // V per unit of 0x361 bytes 2-3: 0.01 or 0.1
   // +1: a positive 0x361 current is a discharge (the pack supplies the chassis); -1: a charge.
-  int bms_current_sign = +1;
+  // -1 is what the code base has always assumed (sensor_msgs/BatteryState's convention, the
+  // virtual chassis); the manual does not say. Applied by interpretation::bms_discharge_current.
+  int bms_current_sign = -1;
   ModeNumbering mode_numbering = ModeNumbering::kManual;
-  // DLC of every frame the host sends: 0 = each frame's own layout length, 8 = padded to 8.
+  DriverStatusBit6 driver_status_bit6 = DriverStatusBit6::kDisabled;
+  // DLC of every frame the codec encodes (commands, and the virtual chassis's feedback): 0 = each
+  // frame's own layout length (protocol::layout_dlc), 8 = padded with zero bytes to 8.
   int tx_dlc = 0;
 
   // Every field in range; the message names the setting (e.g. "tx_dlc = 5: valid 0 or 8").
   Status validate() const;
 };
+// Same revision and the same value in every setting.
+bool operator==(const ProtocolProfile& a, const ProtocolProfile& b);
+inline bool operator!=(const ProtocolProfile& a, const ProtocolProfile& b) {
+  return !(a == b);
+}
 
 // The preset of a revision: "manual" or "agx_v2". kInvalidArgument lists the valid names.
 Result<ProtocolProfile> protocol_preset(std::string_view revision);
 const std::vector<std::string>& protocol_revision_names();  // {"manual", "agx_v2"}
+// The manual's preset, without a Result (the codec's overloads without a profile use it).
+const ProtocolProfile& manual_profile();
 
 // ---- Settings by name -------------------------------------------------------------------------
 // Every field of ProtocolProfile (except `revision`) as a named setting, the one table the node's
 // parameters, the CLI's --set option, commissioning files and docs/PROTOCOL_INTERPRETATIONS.md
 // are checked against.
 struct ProfileSetting {
-  std::string_view name;         // "steering_unit_111", ...
-  std::string_view description;  // one line
+  std::string_view name;                 // "steering_unit_111", ...
+  std::string_view description;          // one line
   std::vector<std::string_view> values;  // the valid values, as text ("centideg", "millirad")
 };
 const std::vector<ProfileSetting>& profile_settings();
 // The value of setting `name` in `profile`, as text.
 Result<std::string> get_setting(const ProtocolProfile& profile, std::string_view name);
-// Sets `name` to `value` (text, as listed in profile_settings()). Errors name the setting and list
-// the valid values.
+// Sets `name` to `value` (text, as listed in profile_settings()). Errors (kInvalidArgument) name
+// the setting and list the valid values; an unknown name lists the valid names.
 Status set_setting(ProtocolProfile& profile, std::string_view name, std::string_view value);
+// The same for one "NAME=VALUE" text (the CLI's --set, commissioning files).
+Status apply_setting(ProtocolProfile& profile, std::string_view assignment);
+// "agx_v2", or "agx_v2 with steering_unit_271=centideg,tx_dlc=0": the revision and every
+// setting that differs from its preset (for logs and diagnostics).
+std::string describe(const ProtocolProfile& profile);
 
 // Text names of the enumerations (as used by the settings).
 std::string_view to_string(AngleUnit v);
@@ -119,5 +147,6 @@ std::string_view to_string(SpinField v);
 std::string_view to_string(FeedbackSpeed v);
 std::string_view to_string(ErrorWordLayout v);
 std::string_view to_string(ModeNumbering v);
+std::string_view to_string(DriverStatusBit6 v);
 
 }  // namespace ranger

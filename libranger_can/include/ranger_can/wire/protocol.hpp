@@ -1,31 +1,45 @@
-// The RANGER CAN protocol's vocabulary: identifiers, enumerations and named bits, exactly as the
-// manual (section 3.2, transcribed in shared/reference/PROTOCOL.md) defines them. Units and
-// scaling live in codec.hpp; the manual's open points live in interpretation.hpp.
+// The RANGER CAN protocol's vocabulary: identifiers, enumerations and named bits, as the manual
+// (section 3.2, transcribed in shared/reference/PROTOCOL.md) and the vendor's later revision
+// (shared/reference/PROTOCOL_AGX_V2.md) define them. Where the two revisions differ, the facts of
+// both are here, selected by a profile field (profile.hpp): the error-word layout, the motion-mode
+// numbering. Units and scaling live in codec.hpp; the manual's open points in interpretation.hpp.
 #pragma once
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "ranger_can/wire/frame.hpp"
+#include "ranger_can/wire/profile.hpp"
 
 namespace ranger::protocol {
 
 // ---- Identifiers ------------------------------------------------------------------------------
 // Host -> chassis
 inline constexpr std::uint32_t kMotionCommandId = 0x111;
+inline constexpr std::uint32_t kLightCommandId = 0x121;  // agx_v2
 inline constexpr std::uint32_t kMotionModeCommandId = 0x141;
 inline constexpr std::uint32_t kControlModeCommandId = 0x421;
 inline constexpr std::uint32_t kErrorClearCommandId = 0x441;
 inline constexpr std::uint32_t kUltrasonicSettingId = 0x451;
+// Both directions (agx_v2): the host's version request (DLC 1, byte 0 = 0x01) and the chassis's
+// answers (ASCII text, up to 8 characters a frame).
+inline constexpr std::uint32_t kVersionId = 0x4A1;
+inline constexpr std::uint8_t kVersionRequestValue = 0x01;
 // Chassis -> host
 inline constexpr std::uint32_t kSystemStatusId = 0x211;
 inline constexpr std::uint32_t kMotionFeedbackId = 0x221;
+inline constexpr std::uint32_t kLightStateId = 0x231;          // agx_v2
+inline constexpr std::uint32_t kRemoteControlStateId = 0x241;  // agx_v2
 inline constexpr std::uint32_t kMotorHighSpeedBaseId = 0x250;  // + motor number 1..8
 inline constexpr std::uint32_t kMotorLowSpeedBaseId = 0x260;   // + motor number 1..8
 inline constexpr std::uint32_t kSteeringAnglesId = 0x271;
 inline constexpr std::uint32_t kWheelSpeedsId = 0x281;
 inline constexpr std::uint32_t kMotionModeFeedbackId = 0x291;
+inline constexpr std::uint32_t kOdometerId = 0x311;  // agx_v2
 inline constexpr std::uint32_t kUltrasonic1to4Id = 0x342;
 inline constexpr std::uint32_t kUltrasonic5to8Id = 0x343;
 inline constexpr std::uint32_t kUltrasonicSettingFeedbackId = 0x45A;
@@ -35,12 +49,24 @@ inline constexpr int kMotorCount = 8;
 inline constexpr int kUltrasonicCount = 8;
 inline constexpr int kBatteryCount = 4;  // slots 1..4; index 0 is the whole pack
 
-// Every identifier the protocol defines, in ascending order (used for receive filters, the DBC
-// cross-check and frame-rate statistics).
+// Every identifier of either revision, in ascending order (receive filters, the DBC cross-check,
+// frame-rate statistics). The decoder knows all of them whatever the profile.
 std::vector<std::uint32_t> all_ids();
+// The identifiers of the manual (section 3.2), in ascending order.
+std::vector<std::uint32_t> manual_ids();
 bool is_known_id(std::uint32_t id);
-// The DLC the protocol defines for `id`, or -1 for an unknown ID.
+// The length of `id`'s layout: the bytes its decoder reads (-1 for an unknown ID). A received
+// frame may be longer (its extra bytes are ignored), never shorter. 0x4A1: 1 (the request; an
+// answer's text is as long as the frame).
+int layout_dlc(std::uint32_t id);
+// Deprecated: the old name of layout_dlc (the DLC used to be the only one accepted).
 int expected_dlc(std::uint32_t id);
+// Bytes of `frame` past its layout that a decoder ignores (0 for an unknown ID, an error frame, a
+// frame not longer than its layout, or a 0x4A1 answer, whose text is the whole frame).
+int extra_bytes(const CanFrame& frame);
+// A 0x4A1 frame is the host's version request when byte 0 is 0x01 and every further byte is zero
+// (a request padded to 8 bytes); anything else on 0x4A1 is an answer (text).
+bool is_version_request(const CanFrame& frame);
 // A short snake_case name for `id` ("motion_command", "bms", ...), "unknown" otherwise.
 std::string_view frame_name(std::uint32_t id);
 
@@ -53,13 +79,43 @@ inline constexpr int kBmsPeriodMs = 500;        // 0x361-0x36A
 inline constexpr int kChassisCommandTimeoutMs = 500;
 inline constexpr int kKeepAlivePeriodMs = 20;
 
-// ---- Enumerations (values as on the wire) -----------------------------------------------------
-enum class MotionMode : std::uint8_t { kAckermann = 0x00, kOblique = 0x01, kSpin = 0x02 };
-enum class ControlMode : std::uint8_t { kStandby = 0x00, kCan = 0x01, kRemote = 0x03 };
-// 0x01 is not in this manual's table; see interpretation.hpp (kVehicleStatusEstop).
+// ---- Enumerations ------------------------------------------------------------------------------
+// Motion modes. The values are agx_v2's wire numbering; the wire value of a mode depends on the
+// profile's ModeNumbering (motion_mode_from_wire / motion_mode_to_wire): the manual knows only
+// 0-2, the MINI V1 sends side slip as 3 and has no park.
+enum class MotionMode : std::uint8_t {
+  kAckermann = 0x00,
+  kOblique = 0x01,
+  kSpin = 0x02,
+  kPark = 0x03,
+  kSideSlip = 0x04,
+};
+// Control modes (0x211 byte 1, 0x421). UART (0x02) is agx_v2's; the host may select only standby
+// and CAN.
+enum class ControlMode : std::uint8_t {
+  kStandby = 0x00,
+  kCan = 0x01,
+  kUart = 0x02,
+  kRemote = 0x03
+};
+// 0x01 is not in this manual's table; the profile's vehicle_status_1_is_estop decides.
 enum class VehicleStatus : std::uint8_t { kNormal = 0x00, kEmergencyStop = 0x01, kAbnormal = 0x02 };
 
-// 0x441 payload: which fault to clear.
+// The modes `numbering` defines, in wire order.
+std::vector<MotionMode> motion_modes(ModeNumbering numbering);
+// The mode wire value `raw` stands for under `numbering`; nullopt when it defines none.
+std::optional<MotionMode> motion_mode_from_wire(std::uint8_t raw, ModeNumbering numbering);
+// The wire value of `mode` under `numbering`; nullopt when the numbering has no such mode.
+std::optional<std::uint8_t> motion_mode_to_wire(MotionMode mode, ModeNumbering numbering);
+
+// 0x241 switch positions (two bits per switch; wire values). 0 is not defined.
+enum class RemoteSwitch : std::uint8_t { kUndefined = 0, kMiddle = 1, kUp = 2, kDown = 3 };
+// 0x121 / 0x231 light modes (wire values).
+enum class LightMode : std::uint8_t { kOff = 0, kOn = 1, kBreathing = 2, kCustom = 3 };
+
+// 0x441 payload: which fault to clear. 0x00 clears every fault that is not critical
+// (interpretation::critical_error_mask); a critical fault is cleared by its own code (0x01-0x10)
+// or by the remote control's KEY1.
 enum class ErrorClearCode : std::uint8_t {
   kAllNonCritical = 0x00,
   kMotor1Comm = 0x01,  // ... kMotor1Comm + (n-1) for motor n = 1..8
@@ -76,15 +132,23 @@ inline constexpr std::uint8_t kMaxErrorClearCode = 0x10;
 std::string_view to_string(MotionMode m);
 std::string_view to_string(ControlMode m);
 std::string_view to_string(VehicleStatus s);
-// Describes what a 0x441 code clears ("all non-critical faults", "motor driver 3 communication").
+std::string_view to_string(RemoteSwitch s);
+std::string_view to_string(LightMode m);
+// Describes what a 0x441 code clears ("all non-critical faults", "motor driver 3 communication
+// fault").
 std::string error_clear_description(std::uint8_t code);
 
 // ---- 0x211 error bits -------------------------------------------------------------------------
-// The four error bytes form one big-endian uint32 (byte 4 is the most significant), so a bit's
-// position in the word is (7 - byte) * 8 + bit.
+// Two layouts (profile.hpp, ErrorWordLayout):
+//  * kManual32: bytes 4-7 form one big-endian uint32 (byte 4 is the most significant), so a bit's
+//    position in the word is (7 - byte) * 8 + bit;
+//  * kAgxV2_16: bytes 4-5 form a big-endian uint16, byte 6 is reserved, byte 7 is a counter.
+// SystemStatus::error_bits holds the word of the layout in use.
 constexpr int error_bit_index(int byte, int bit) {
   return (7 - byte) * 8 + bit;
 }
+// Width of the error word, in bits: 32 or 16.
+int error_word_bits(ErrorWordLayout layout);
 
 struct NamedBit {
   int index;              // bit position in the word (or byte) it belongs to
@@ -92,34 +156,84 @@ struct NamedBit {
   std::string_view description;
 };
 
-// Every defined error bit of 0x211, in ascending bit order (reserved bits are absent).
-const std::vector<NamedBit>& system_error_bits();
+// Every defined error bit of a layout, in ascending bit order (reserved bits are absent).
+const std::vector<NamedBit>& system_error_bits(ErrorWordLayout layout);
+const std::vector<NamedBit>& system_error_bits();  // the manual's (kManual32)
 // Names of the bits set in `error_word`; reserved bits that are set appear as "reserved_bit_N".
-std::vector<std::string> error_bit_names(std::uint32_t error_word);
+std::vector<std::string> error_bit_names(std::uint32_t error_word, ErrorWordLayout layout);
+std::vector<std::string> error_bit_names(std::uint32_t error_word);  // kManual32
 
-// Bits that, when set, mean the chassis will not (or must not) move.
-bool is_critical_error(std::uint32_t error_word);
+// Bits that, when set, mean the chassis will not (or must not) move: the critical set of
+// interpretation.hpp (critical_error_mask).
+bool is_critical_error(std::uint32_t error_word, ErrorWordLayout layout);
+bool is_critical_error(std::uint32_t error_word);  // kManual32
+
+// Faults by meaning, so that the controller and the virtual chassis never write a bit position:
+// fault_bit() gives a fault's bit in a layout's word, 0 when the layout has no such bit. `motor`
+// numbers the motor for the faults marked so (protocol numbering, 1..8); 0 otherwise.
+enum class Fault {
+  kBatteryUnderVoltage,         // manual: byte 7 bit 0; agx16: 0x0001 battery fault
+  kBatteryWarning,              // agx16: 0x0002; manual: none
+  kUltrasonicTriggered,         // manual: byte 7 bit 1; agx16: none
+  kRemoteSignalLost,            // manual: byte 7 bit 2; agx16: 0x0004
+  kHostCommunicationLost,       // manual: byte 6 bit 1; agx16: 0x0200
+  kDriverStatusError,           // manual: byte 6 bit 0; agx16: 0x0100 motor driver
+  kOverTemperature,             // manual: byte 6 bit 6; agx16: none
+  kOverCurrent,                 // manual: byte 6 bit 7; agx16: none
+  kMotorCommunication,          // motor 1..8; manual: byte 7 bits 3-6, byte 6 bits 2-5;
+                                // agx16: motors 1..4 only, 0x0008..0x0040
+  kSteeringCalibration,         // steering motor 5..8; manual: byte 5 bits 0-3; agx16: none
+  kSteeringCalibrationTimeout,  // manual: byte 5 bit 4; agx16: none
+  kSafetyEdge,                  // manual: byte 5 bit 5; agx16: none
+  kSteeringServoWarning,        // steering motor 5..8; manual: byte 4 bits 0-3; agx16: none
+  kSteeringEncoder,             // agx16: 0x0080; manual: none
+};
+inline constexpr int kFaultCount = 14;
+std::string_view to_string(Fault f);  // "battery_under_voltage", ...
+std::uint32_t fault_bit(Fault fault, ErrorWordLayout layout, int motor = 0);
 
 // ---- 0x261-0x268 driver status bits -----------------------------------------------------------
+// In the manual's meaning (bit 6 set = disabled); the codec converts agx_v2's enable bit
+// (profile: driver_status_bit6).
+namespace driver_status {
+inline constexpr std::uint8_t kSupplyVoltageLow = 1u << 0;
+inline constexpr std::uint8_t kMotorOverTemperature = 1u << 1;
+inline constexpr std::uint8_t kDriverOverCurrent = 1u << 2;
+inline constexpr std::uint8_t kDriverOverTemperature = 1u << 3;
+inline constexpr std::uint8_t kSensorAbnormal = 1u << 4;
+inline constexpr std::uint8_t kDriverError = 1u << 5;
+inline constexpr std::uint8_t kDriverDisabled = 1u << 6;
+}  // namespace driver_status
 const std::vector<NamedBit>& driver_status_bits();
 std::vector<std::string> driver_status_names(std::uint8_t status);
 
 // ---- 0x362... BMS alarm / warning bits --------------------------------------------------------
 // Status byte 1 (alarm and warning use the same layout) and status byte 2.
+namespace bms_status {
+inline constexpr std::uint8_t kOverVoltage = 1u << 1;           // status byte 1
+inline constexpr std::uint8_t kUnderVoltage = 1u << 2;          // status byte 1
+inline constexpr std::uint8_t kHighTemperature = 1u << 3;       // status byte 1
+inline constexpr std::uint8_t kLowTemperature = 1u << 4;        // status byte 1
+inline constexpr std::uint8_t kDischargeOverCurrent = 1u << 7;  // status byte 1
+inline constexpr std::uint8_t kChargeOverCurrent = 1u << 0;     // status byte 2
+}  // namespace bms_status
 const std::vector<NamedBit>& bms_status1_bits();
 const std::vector<NamedBit>& bms_status2_bits();
 // Names of the bits set in one status pair (alarm1/alarm2 or warning1/warning2); reserved bits
 // appear as "reserved_bit_N" (status byte 1) or "status2_reserved_bit_N" (status byte 2).
 std::vector<std::string> bms_status_names(std::uint8_t status1, std::uint8_t status2);
 
-// ---- Ultrasonic negative distance codes -------------------------------------------------------
+// ---- Ultrasonic distance codes ----------------------------------------------------------------
+// The manual: a positive value is a distance, a negative one a code. 0 is neither: it is read as
+// "no reading" (interpretation::kUltrasonicNoReading).
 enum class UltrasonicCode : std::int16_t {
   kOffline = -1,
   kChecksumFailed = -2,
   kAbnormalData = -3,
   kSystemException = -4,
 };
-// "ok" for a non-negative raw value, otherwise the code's name ("offline", ...) or "unknown_code".
+// "ok" for a positive raw value (a distance), "no_reading" for 0, otherwise the code's name
+// ("offline", ...) or "unknown_code".
 std::string_view ultrasonic_status_name(std::int16_t raw);
 
 }  // namespace ranger::protocol

@@ -1,0 +1,40 @@
+# Runs `TOOL scenario SCRIPT [ARG]` RUNS times (1 or 2) and fails unless each run exits with
+# EXPECT_RC, its stderr matches EXPECT_STDERR (a regular expression, when given), and -- with
+# RUNS 2 -- both runs printed the same bytes on stdout.
+#   cmake -DTOOL=... -DSCRIPT=... [-DARG=...] [-DEXPECT_RC=0] [-DEXPECT_STDERR=...] [-DRUNS=1]
+#         -P run_scenario.cmake
+if(NOT DEFINED EXPECT_RC)
+  set(EXPECT_RC 0)
+endif()
+if(NOT RUNS)
+  set(RUNS 1)
+endif()
+set(args scenario ${SCRIPT})
+if(ARG)
+  list(APPEND args ${ARG})
+endif()
+
+set(first_out "")
+foreach(run RANGE 1 ${RUNS})
+  execute_process(COMMAND ${TOOL} ${args} RESULT_VARIABLE rc OUTPUT_VARIABLE out
+    ERROR_VARIABLE err TIMEOUT 100)
+  message("run ${run}: ${TOOL} ${args} -> exit ${rc}, ${err}")
+  if(NOT rc STREQUAL "${EXPECT_RC}")
+    string(LENGTH "${out}" n)
+    if(n GREATER 4000)
+      string(SUBSTRING "${out}" 0 4000 out)
+    endif()
+    message(FATAL_ERROR "exit status ${rc}, expected ${EXPECT_RC}\nstdout (start):\n${out}")
+  endif()
+  if(EXPECT_STDERR AND NOT err MATCHES "${EXPECT_STDERR}")
+    message(FATAL_ERROR "stderr does not match '${EXPECT_STDERR}'")
+  endif()
+  if(out STREQUAL "")
+    message(FATAL_ERROR "no output")
+  endif()
+  if(run EQUAL 1)
+    set(first_out "${out}")
+  elseif(NOT out STREQUAL first_out)
+    message(FATAL_ERROR "run ${run} printed other bytes than run 1: the output is not deterministic")
+  endif()
+endforeach()
