@@ -240,8 +240,9 @@ void fill_bits(std::uint32_t word, const std::vector<protocol::NamedBit>& bits,
 }
 }  // namespace
 
-void fill_system_errors(std::uint32_t error_word, ranger_msgs::SystemErrors& out) {
-  fill_bits(error_word, protocol::system_error_bits(), system_error_fields(), out);
+void fill_system_errors(std::uint32_t error_word, ranger::ErrorWordLayout layout,
+                        ranger_msgs::SystemErrors& out) {
+  fill_bits(error_word, protocol::system_error_bits(layout), system_error_fields(), out);
 }
 
 ranger_msgs::DriverStatus to_driver_status(std::uint8_t status) {
@@ -353,8 +354,8 @@ ranger_msgs::SystemState to_system_state(const ranger::DriverSnapshot& snapshot,
     out.motion_mode_name = "unknown";
   }
   out.error_word = state.error_bits;
-  fill_system_errors(state.error_bits, out.errors);
-  out.active_errors = protocol::error_bit_names(state.error_bits);
+  fill_system_errors(state.error_bits, snapshot.profile.error_word, out.errors);
+  out.active_errors = protocol::error_bit_names(state.error_bits, snapshot.profile.error_word);
   if (state.refusal != ranger::MotionRefusal::kNone) {
     out.motion_inhibited_reason = std::string(ranger::to_string(state.refusal));
   }

@@ -284,7 +284,8 @@ bool RangerNode::on_clear_errors(ranger_msgs::ClearErrors::Request& req,
   if (outcome.state == State::kAnswered && outcome.error_word) {
     res.success = true;
     res.error_word = *outcome.error_word;
-    const auto names = protocol::error_bit_names(res.error_word);
+    const auto names =
+        protocol::error_bit_names(res.error_word, driver_->snapshot()->profile.error_word);
     res.message = asked + ": the chassis answered with error word " + hex_word(res.error_word) +
                   (names.empty() ? " (no errors)" : " (" + join(names) + ")");
     ROS_INFO("%s", res.message.c_str());
@@ -522,7 +523,7 @@ void RangerNode::log_state_changes(const ranger::DriverSnapshot& s) {
     last_refusal_ = c.refusal;
   }
   if (c.error_bits != last_error_bits_) {
-    const auto names = protocol::error_bit_names(c.error_bits);
+    const auto names = protocol::error_bit_names(c.error_bits, s.profile.error_word);
     if (names.empty()) {
       ROS_INFO("chassis errors cleared (error word %s)", hex_word(c.error_bits).c_str());
     } else {

@@ -54,7 +54,7 @@ TEST(NamedBits, EachErrorBitSetsExactlyItsField) {
   const auto& fields = system_error_fields();
   for (const auto& bit : protocol::system_error_bits()) {
     ranger_msgs::SystemErrors msg;
-    fill_system_errors(1u << bit.index, msg);
+    fill_system_errors(1u << bit.index, ranger::ErrorWordLayout::kManual32, msg);
     for (const auto& [name, field] : fields) {
       EXPECT_EQ(msg.*field != 0, name == bit.name) << "bit " << bit.name << ", field " << name;
     }

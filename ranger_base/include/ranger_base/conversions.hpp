@@ -71,8 +71,10 @@ std::vector<std::string> cause_names(ranger::StopCauses causes);
 
 ranger_msgs::SystemState to_system_state(const ranger::DriverSnapshot& snapshot,
                                          const ros::Time& stamp);
-// Sets every SystemErrors field from the chassis's error word, through libranger_can's bit names.
-void fill_system_errors(std::uint32_t error_word, ranger_msgs::SystemErrors& out);
+// Sets every SystemErrors field from the chassis's error word, through libranger_can's bit names
+// for the word's layout (the protocol profile's).
+void fill_system_errors(std::uint32_t error_word, ranger::ErrorWordLayout layout,
+                        ranger_msgs::SystemErrors& out);
 ranger_msgs::DriverStatus to_driver_status(std::uint8_t status);
 ranger_msgs::BmsFlags to_bms_flags(std::uint8_t status1, std::uint8_t status2);
 
