@@ -427,13 +427,6 @@ ranger_msgs::BmsStateArray to_bms_state(const ranger::ChassisFeedback& feedback,
   return out;
 }
 
-const PackDesign& pack_design() {
-  // User manual: "48 V batteries, 24 Ah each, up to four"; battery type lithium iron phosphate;
-  // normal voltage range 46-50 V.
-  static const PackDesign design{48.0, 46.0, 50.0};
-  return design;
-}
-
 sensor_msgs::BatteryState to_battery_state(const ranger::ChassisFeedback& fb, Timestamp now,
                                            const ros::Time& stamp) {
   using sensor_msgs::BatteryState;
@@ -443,7 +436,8 @@ sensor_msgs::BatteryState to_battery_state(const ranger::ChassisFeedback& fb, Ti
   out.design_capacity = kNaN;  // 24 Ah per battery, but how many are fitted is not reported
   out.power_supply_status = BatteryState::POWER_SUPPLY_STATUS_UNKNOWN;
   out.power_supply_health = BatteryState::POWER_SUPPLY_HEALTH_UNKNOWN;
-  out.power_supply_technology = BatteryState::POWER_SUPPLY_TECHNOLOGY_LIFE;  // LiFePO4
+  static_assert(ranger::vehicle_spec::kBatteryChemistry == "LiFePO4");
+  out.power_supply_technology = BatteryState::POWER_SUPPLY_TECHNOLOGY_LIFE;
   out.location = "pack";
 
   const auto& pack = fb.bms[0];

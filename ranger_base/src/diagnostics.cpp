@@ -151,12 +151,12 @@ void diagnose_errors(const DriverSnapshot& s, DiagnosticStatusWrapper& out) {
 
 void diagnose_battery(const DriverSnapshot& s, DiagnosticStatusWrapper& out) {
   const auto& fb = s.feedback;
-  const PackDesign& design = pack_design();
-  out.add("Technology", "LiFePO4");
-  out.add("Nominal voltage (V)", design.nominal_voltage);
+  namespace spec = ranger::vehicle_spec;
+  out.add("Technology", std::string(spec::kBatteryChemistry));
+  out.add("Nominal voltage (V)", spec::kBatteryNominalVoltage);
   out.add("Normal voltage range (V)",
-          std::to_string(static_cast<int>(design.normal_min_voltage)) + "-" +
-              std::to_string(static_cast<int>(design.normal_max_voltage)));
+          std::to_string(static_cast<int>(spec::kBatteryNormalMinVoltage)) + "-" +
+              std::to_string(static_cast<int>(spec::kBatteryNormalMaxVoltage)));
   if (fb.system_status) out.add("Voltage (system status)", fb.system_status->value.battery_voltage);
   const auto& pack = fb.bms[0];
   if (!pack) {
@@ -171,7 +171,7 @@ void diagnose_battery(const DriverSnapshot& s, DiagnosticStatusWrapper& out) {
   out.add("Temperature (degC)", d.temperature);
   if (s.controller.low_battery()) {
     out.summary(DiagnosticStatus::ERROR, "battery below the cut-off: the chassis refuses motion");
-  } else if (d.soc < 15.0) {  // manual: the lights flash below 15 %
+  } else if (d.soc < ranger::vehicle_spec::kLowBatteryWarningSoc) {  // the lights flash
     out.summary(DiagnosticStatus::WARN, "battery low");
   } else {
     out.summary(DiagnosticStatus::OK, "battery ok");

@@ -299,12 +299,6 @@ TEST(Battery, PercentageStaysInZeroToOne) {
   EXPECT_FLOAT_EQ(to_battery_state(fb, 1s, ros::Time(1.0)).percentage, 1.0f);
 }
 
-TEST(Battery, TheManualsPackDesign) {
-  EXPECT_DOUBLE_EQ(pack_design().nominal_voltage, 48.0);
-  EXPECT_DOUBLE_EQ(pack_design().normal_min_voltage, 46.0);
-  EXPECT_DOUBLE_EQ(pack_design().normal_max_voltage, 50.0);
-}
-
 TEST(Battery, WithoutBmsTheStatusVoltageIsUsedAndPercentageUnknown) {
   ranger::ChassisFeedback fb;
   ranger::SystemStatus status;

@@ -134,6 +134,14 @@ TEST(Diagnostics, FaultsAreListedByNameAndStoppingOnesAreErrors) {
   EXPECT_EQ(none.level, DiagnosticStatus::OK);
 }
 
+TEST(Diagnostics, BatteryShowsTheManualsPack) {
+  DiagnosticStatusWrapper out;
+  diagnose_battery(healthy(), out);
+  EXPECT_EQ(value(out, "Technology"), "LiFePO4");
+  EXPECT_EQ(std::stod(value(out, "Nominal voltage (V)")), 48.0);
+  EXPECT_EQ(value(out, "Normal voltage range (V)"), "46-50");
+}
+
 TEST(Diagnostics, LowBatteryIsAnError) {
   auto s = healthy();
   ranger::BmsData d;

@@ -84,18 +84,10 @@ ranger_msgs::ActuatorStateArray to_actuator_state(const ranger::ChassisFeedback&
 ranger_msgs::BmsStateArray to_bms_state(const ranger::ChassisFeedback& feedback,
                                         ranger::Timestamp now, const ros::Time& stamp);
 
-// The RANGER's battery pack per its user manual (LiFePO4, 48 V nominal, 46-50 V normal). The
-// library's control layer has no names for these yet: this is the one place the node keeps them.
-struct PackDesign {
-  double nominal_voltage;     // V
-  double normal_min_voltage;  // V
-  double normal_max_voltage;  // V
-};
-const PackDesign& pack_design();
-
 // The whole pack (the BMS reports, or the system status's voltage until it does). percentage in
-// 0..1; technology LiFePO4; cell_voltage / cell_temperature carry one entry per battery slot 1..4,
-// NaN for an empty slot (ranger_msgs/BmsStateArray has the per-slot details and present flags).
+// 0..1; technology LiFePO4 (ranger::vehicle_spec); cell_voltage / cell_temperature carry one entry
+// per battery slot 1..4, NaN for an empty slot (ranger_msgs/BmsStateArray has the per-slot details
+// and present flags).
 sensor_msgs::BatteryState to_battery_state(const ranger::ChassisFeedback& feedback,
                                            ranger::Timestamp now, const ros::Time& stamp);
 ranger_msgs::UltrasonicState to_ultrasonic_state(const ranger::DriverSnapshot& snapshot,
