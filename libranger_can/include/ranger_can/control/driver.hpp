@@ -31,8 +31,10 @@
 #include "ranger_can/control/controller.hpp"
 #include "ranger_can/control/feedback.hpp"
 #include "ranger_can/control/frame_stats.hpp"
+#include "ranger_can/control/identification.hpp"
 #include "ranger_can/control/joint_tracker.hpp"
 #include "ranger_can/control/odometry.hpp"
+#include "ranger_can/control/plausibility.hpp"
 #include "ranger_can/result.hpp"
 #include "ranger_can/transport/bus.hpp"
 #include "ranger_can/transport/bus_source.hpp"
@@ -41,8 +43,26 @@
 
 namespace ranger {
 
+// Where the protocol settings come from.
+enum class ProtocolChoice {
+  kForced,  // controller.profile as it is (a preset, --set values, a commissioning file)
+  kAuto,    // identified from the chassis before anything moves (identification.hpp)
+};
+std::string_view to_string(ProtocolChoice c);  // "forced" / "auto"
+
 struct DriverConfig {
   ControllerConfig controller;  // geometry, limits, protocol profile, timeouts, ...
+  // kAuto: the driver listens before it sends anything, decides the settings from the chassis's
+  // frames and a zero-speed steering probe, and refuses speed (kIdentifying) until then; a
+  // chassis it cannot identify within identification.timeout stays at rest, the snapshot's
+  // identification.message saying what to set. controller.profile is then only the fallback
+  // for decoding nothing (it is replaced by the decision). kForced (the default) as before.
+  ProtocolChoice protocol = ProtocolChoice::kForced;
+  // kAuto only: start from this preset ("manual", "agx_v2") instead of deciding it.
+  std::optional<std::string> identify_revision;
+  IdentificationConfig identification;
+  // The plausibility monitors (plausibility.hpp), whatever the settings came from.
+  PlausibilityConfig plausibility;
   // Source, timeouts and covariances; its geometry and profile are the controller's (one vehicle,
   // one reading: the driver copies them).
   OdometryConfig odometry;
@@ -52,7 +72,7 @@ struct DriverConfig {
   std::chrono::nanoseconds request_answer_timeout = std::chrono::milliseconds(500);
   std::string thread_name = "ranger_driver";  // for top -H and the performance script
 
-  Status validate() const;  // the controller's and the odometry's checks
+  Status validate() const;  // the controller's, odometry's, identification's, monitors' checks
 };
 
 // What became of a request posted through the mailbox.
@@ -93,7 +113,15 @@ struct DriverSnapshot {
   OdometryState odometry;
   WheelJoints joints;
   FrameStats frames;
-  ProtocolProfile profile;  // the settings in use
+  ProtocolProfile profile;  // the settings in use (the identification's proposal until decided)
+
+  // Where the settings came from, and (kAuto) the identification: phase, decided profile,
+  // evidence lines, confidence, and the failure message naming what to set.
+  ProtocolChoice protocol = ProtocolChoice::kForced;
+  std::optional<IdentificationStatus> identification;
+  // The plausibility monitors: persistent mismatches (WARN, with the value to try) and the one
+  // that stopped the robot (also ControllerState::implausible_reason).
+  PlausibilityStatus plausibility;
 
   std::vector<RequestOutcome> requests;  // the most recent ones, oldest first (at most 16)
   std::uint64_t loop_iterations = 0;
@@ -134,6 +162,7 @@ class Driver {
   // kInvalidArgument (nothing posted) for a code outside 0x00..0x10; else the request's id.
   Result<std::uint64_t> clear_errors(std::uint8_t code);
   std::uint64_t set_ultrasonic(bool enable);
+  // Also clears a plausibility stop (the operator takes it on): the monitors start over.
   std::uint64_t resume();
 
   // Blocks the calling thread until request `id` is answered or failed, or `timeout` passes
@@ -157,6 +186,9 @@ class Driver {
   void try_open(Timestamp now);
   void apply_mail(Timestamp now);
   void handle_frame(const CanFrame& frame, Timestamp now);
+  void run_identification(Timestamp now);
+  void run_plausibility(Timestamp now);
+  void use_profile(const ProtocolProfile& profile);
   void update_requests(Timestamp now);
   void publish(Timestamp now);
   void deliver_events();
@@ -171,6 +203,10 @@ class Driver {
   // ---- owned by the driver thread (or the lock-step caller) ----
   std::unique_ptr<Bus> bus_;
   std::unique_ptr<ChassisController> controller_;
+  ProtocolProfile profile_;  // the settings in use (decoding, odometry, monitors)
+  std::optional<ChassisIdentifier> identifier_;
+  PlausibilityMonitor monitor_;
+  std::string applied_stop_;  // the monitor's stop passed to the controller
   Odometry odometry_;
   WheelJointTracker joints_;
   FrameStats frames_;
