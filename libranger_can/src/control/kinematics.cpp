@@ -296,6 +296,33 @@ std::array<double, kWheelCount> wheel_angles_for_command(const MotionCommand& co
   return angles;
 }
 
+BodyTwist fit_body_twist(const std::array<WheelMeasurement, kWheelCount>& wheels,
+                         const VehicleGeometry& geometry) {
+  // Rows per wheel: [1 0 -y_i] and [0 1 x_i]; normal matrix N = A^T A and right side A^T r.
+  double sx = 0.0, sy = 0.0, sr2 = 0.0;
+  double bu = 0.0, bw = 0.0, bt = 0.0;
+  for (int i = 0; i < kWheelCount; ++i) {
+    const WheelPosition p = geometry.wheel_position(i);
+    const WheelMeasurement& m = wheels[static_cast<std::size_t>(i)];
+    const double u = m.speed * std::cos(m.angle);
+    const double w = m.speed * std::sin(m.angle);
+    sx += p.x;
+    sy += p.y;
+    sr2 += p.x * p.x + p.y * p.y;
+    bu += u;
+    bw += w;
+    bt += p.x * w - p.y * u;
+  }
+  const double n = kWheelCount;
+  // N = [[n, 0, -sy], [0, n, sx], [-sy, sx, sr2]]. Rows 1 and 2 give vx = (bu + sy*wz)/n and
+  // vy = (bw - sx*wz)/n; row 3 (-sy*vx + sx*vy + sr2*wz = bt) then yields wz. The denominator is
+  // the wheels' spread about their centroid: positive unless all wheels sit on one point.
+  const double spread = sr2 - (sx * sx + sy * sy) / n;
+  if (!(spread > 1e-12)) return BodyTwist{};
+  const double wz = (bt + sy * bu / n - sx * bw / n) / spread;
+  return BodyTwist{(bu + sy * wz) / n, (bw - sx * wz) / n, wz};
+}
+
 WheelStates wheel_states_from_twist(const BodyTwist& twist, const VehicleGeometry& geometry,
                                     const std::array<double, kWheelCount>& hold_angles) {
   WheelStates wheels{};

@@ -116,6 +116,17 @@ double max_ackermann_curvature(double max_steering, const VehicleGeometry& geome
 
 // ---- Per-wheel rigid-body relations (shared by odometry, simulator and tests) ----------------
 
+// Per-wheel measurement in REP-103 terms (angle from 0x271, speed from 0x281).
+using WheelMeasurement = WheelState;
+
+// Forward kinematics: the least-squares body twist (vx, vy, wz) of four measured wheels at
+// `geometry`'s positions (pure function). Each wheel i at (x_i, y_i) with heading th_i and signed
+// speed s_i gives vx - wz*y_i = s_i*cos(th_i) and vy + wz*x_i = s_i*sin(th_i): eight equations
+// for three unknowns, solved in closed form through the 3x3 normal equations. One formula for
+// every motion mode; a wheel turned by 180 deg with a negated speed gives the same fit.
+BodyTwist fit_body_twist(const std::array<WheelMeasurement, kWheelCount>& wheels,
+                         const VehicleGeometry& geometry);
+
 // Wheel states that realise `twist`: wheel i at (x_i, y_i) moves with
 // v_i = (vx - wz*y_i, vy + wz*x_i); its angle is that direction folded into [-90, 90] deg with the
 // speed negated when folded. A wheel that does not move keeps `hold_angles[i]` (steering does not

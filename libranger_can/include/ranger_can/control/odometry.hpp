@@ -80,12 +80,8 @@ struct OdometryState {
   std::uint64_t fallback_steps = 0;  // steps from 0x221 while the configured source was kWheels
 };
 
-// Per-wheel measurement in REP-103 terms (angle from 0x271 via interpretation.hpp, speed 0x281).
-using WheelMeasurement = WheelState;
-
-// The least-squares body twist for the four wheels at `geometry`'s positions (pure function).
-BodyTwist fit_body_twist(const std::array<WheelMeasurement, kWheelCount>& wheels,
-                         const VehicleGeometry& geometry);
+// The forward kinematics the primary source uses, fit_body_twist (the least-squares body twist
+// of four measured wheels), sits beside the inverse ones in kinematics.hpp.
 
 // The body twist from 0x221 in `mode`, in the profile's readings (pure function):
 //  * Ackermann: the steering angle (the front wheels' mean or the inner one: steering_reference)
