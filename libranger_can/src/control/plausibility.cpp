@@ -56,7 +56,7 @@ Status PlausibilityConfig::validate() const {
   }
   if (!(unit_ratio > 1.0) || !(min_steering > 0.0) || !(min_reference_angle > 0.0) ||
       !(min_yaw_rate > 0.0) || !(min_speed_difference > 0.0) || !(min_speed > 0.0) ||
-      out_of_range_frames < 1) {
+      out_of_range_frames < 1 || !(rigid_residual > 0.0) || !(margin > 1.0)) {
     return Error{Errc::kOutOfRange,
                  "plausibility: unit_ratio must be > 1, the angles, rates and speeds > 0, "
                  "out_of_range_frames >= 1"};
@@ -83,10 +83,10 @@ void PlausibilityMonitor::reset() {
   out_of_range_ = 0;
   byte7_.reset();
   byte7_steps_ = byte7_increments_ = 0;
-  for (Timer* t : {&steering_, &reference_, &yaw_, &speed_, &range_, &counter_, &bms_})
+  for (Timer* t : {&steering_, &reference_, &yaw_, &speed_, &rigid_, &range_, &counter_, &bms_})
     t->clear();
   // Sign and unit mismatches stop after stop_after; subtle ones warn, then stop.
-  for (Timer* t : {&steering_, &yaw_, &range_, &counter_}) {
+  for (Timer* t : {&steering_, &yaw_, &rigid_, &range_, &counter_}) {
     t->warn_after = std::chrono::nanoseconds(0);
     t->stop_after = config_.stop_after;
   }
@@ -201,10 +201,12 @@ void PlausibilityMonitor::update(Timestamp now, const ControllerState& c, const 
     reference_.clear();
     yaw_.clear();
     speed_.clear();
+    rigid_.clear();
   } else {
     check_steering(now, c, fb);
     check_yaw(now, c, odo);
     check_speed(now, c, fb);
+    check_rigid(now, fb);
   }
   publish(now);
 }
@@ -420,9 +422,89 @@ void PlausibilityMonitor::check_speed(Timestamp now, const ControllerState& c,
   }
 }
 
+void PlausibilityMonitor::check_rigid(Timestamp now, const ChassisFeedback& fb) {
+  if (!is_fresh(fb.wheel_speeds, now, std::chrono::milliseconds(100)) ||
+      !is_fresh(fb.steering_angles, now, std::chrono::milliseconds(100))) {
+    rigid_.clear();
+    return;
+  }
+  if (fb.wheel_speeds->received == rigid_sample_) return;  // judged this sample already
+  rigid_sample_ = fb.wheel_speeds->received;
+  const auto& speeds = fb.wheel_speeds->value.speeds;
+  double norm = 0.0, fastest = 0.0;
+  for (double v : speeds) {
+    norm += v * v;
+    fastest = std::max(fastest, std::fabs(v));
+  }
+  if (fastest < config_.min_speed) {
+    rigid_.clear();
+    return;
+  }
+  // The angles as the wire carried them, read under each 0x271 unit and sign.
+  const Result<CanFrame> wire = encode(fb.steering_angles->value, profile_);
+  if (!wire) return;
+  const AngleUnit units[2] = {AngleUnit::kCentidegree, AngleUnit::kMilliradian};
+  const SteeringSign signs[2] = {SteeringSign::kRightPositive, SteeringSign::kLeftPositive};
+  double ours = -1.0, best = 1e9;
+  int best_h = -1;
+  for (int h = 0; h < 4; ++h) {
+    ProtocolProfile p = profile_;
+    p.steering_unit_271 = units[h / 2];
+    p.steering_sign_271 = signs[h % 2];
+    const Result<Message> m = decode(*wire, p);
+    if (!m) continue;
+    const auto& a = std::get<SteeringAnglesFeedback>(*m).angles;
+    std::array<WheelMeasurement, kWheelCount> wheels{};
+    for (int i = 0; i < kWheelCount; ++i)
+      wheels[i] = {interpretation::rep103_from_manual_wheel_angle(a[i]), speeds[i]};
+    const BodyTwist t = fit_body_twist(wheels, geometry_);
+    double r = 0.0;
+    for (int i = 0; i < kWheelCount; ++i) {
+      const WheelPosition pos = geometry_.wheel_position(i);
+      const double ex = t.vx - t.wz * pos.y - speeds[i] * std::cos(wheels[i].angle);
+      const double ey = t.vy + t.wz * pos.x - speeds[i] * std::sin(wheels[i].angle);
+      r += ex * ex + ey * ey;
+    }
+    r = std::sqrt(r / norm);
+    const bool is_ours = p.steering_unit_271 == profile_.steering_unit_271 &&
+                         p.steering_sign_271 == profile_.steering_sign_271;
+    if (is_ours) {
+      ours = r;
+    } else if (r < best) {
+      best = r;
+      best_h = h;
+    }
+  }
+  if (ours < 0.0) return;
+  ++status_.checks;
+  if (best_h < 0 || ours < config_.rigid_residual || ours < config_.margin * best) {
+    rigid_.clear();
+    return;
+  }
+  PlausibilityFinding x;
+  x.check = "rigid_body";
+  std::string settings, values;
+  if (units[best_h / 2] != profile_.steering_unit_271) {
+    settings = "steering_unit_271";
+    values = std::string(to_string(units[best_h / 2]));
+  }
+  if (signs[best_h % 2] != profile_.steering_sign_271) {
+    settings += std::string(settings.empty() ? "" : " and ") + "steering_sign_271";
+    values +=
+        std::string(values.empty() ? "" : " and ") + std::string(to_string(signs[best_h % 2]));
+  }
+  x.setting = settings;
+  x.try_value = values;
+  x.detail =
+      "the wheels' angles and speeds are no rigid-body motion under the settings (residual " +
+      num("%.3f", ours) + "), they are under " + values + " (" + num("%.3f", best) +
+      "); check the 0x111 steering settings with them";
+  hold(rigid_, x, now, {}, {});
+}
+
 void PlausibilityMonitor::publish(Timestamp now) {
   status_.warnings.clear();
-  for (Timer* t : {&range_, &counter_, &steering_, &yaw_, &reference_, &speed_, &bms_}) {
+  for (Timer* t : {&range_, &counter_, &rigid_, &steering_, &yaw_, &reference_, &speed_, &bms_}) {
     if (!t->finding) continue;
     const auto held = now - t->finding->since;
     if (held >= t->warn_after) status_.warnings.push_back(*t->finding);

@@ -27,6 +27,12 @@
 //    body centre's speed of the wheels' fit (0x281, 0x271) where the two differ by at least
 //    `min_speed_difference`: warns "feedback_speed: try body_centre", stops after
 //    `subtle_stop_after`.
+//  * rigid body (every mode, wheels rolling at >= `min_speed`): the four wheels' angles (0x271)
+//    and speeds (0x281) form one rigid-body motion (fit_body_twist) under the right 0x271 unit
+//    and sign only. Another reading fitting `margin` times better while ours is off by more than
+//    `rigid_residual` (relative RMS) names that reading (stops). This catches what the steering
+//    check cannot: a 0x111 and a 0x271 setting both wrong the same way (a manual driver on an
+//    agx_v2 chassis reads back exactly what it asked for, while the chassis steers elsewhere).
 //  * 0x271/0x221 refused as beyond any model's reach (kOutOfRange), `out_of_range_frames` in a
 //    row: the unit (stops).
 //  * 0x211 byte 7 counting up under the manual's 32-bit error word: error_word (stops; the
@@ -57,7 +63,7 @@ namespace ranger {
 struct PlausibilityConfig {
   bool enabled = true;
   // The commanded steering must have held (within 1 deg) this long before the wheels are judged.
-  std::chrono::nanoseconds steering_settle = std::chrono::milliseconds(1000);
+  std::chrono::nanoseconds steering_settle = std::chrono::milliseconds(800);
   // A sign or unit mismatch persisting this long stops.
   std::chrono::nanoseconds stop_after = std::chrono::milliseconds(500);
   // A subtle mismatch (reference, 0x221 speed, BMS scale) persisting this long warns...
@@ -72,6 +78,8 @@ struct PlausibilityConfig {
   double min_speed_difference = 0.005;  // m/s between mean wheel and body-centre speed
   double min_speed = 0.1;               // m/s for the 0x221 speed check
   int out_of_range_frames = 10;
+  double rigid_residual = 0.05;  // relative RMS velocity error of the wheels' rigid-body fit
+  double margin = 3.0;           // another reading must fit this many times better
 
   Status validate() const;  // durations >= 0 (stop_after > 0), ratios > 1, angles > 0
 };
@@ -125,6 +133,7 @@ class PlausibilityMonitor {
   void check_steering(Timestamp now, const ControllerState& c, const ChassisFeedback& fb);
   void check_yaw(Timestamp now, const ControllerState& c, const OdometryState& odo);
   void check_speed(Timestamp now, const ControllerState& c, const ChassisFeedback& fb);
+  void check_rigid(Timestamp now, const ChassisFeedback& fb);
   void publish(Timestamp now);
 
   PlausibilityConfig config_;
@@ -141,8 +150,9 @@ class PlausibilityMonitor {
   double yaw_cmd_sign_ = 0.0;
   Timestamp yaw_since_{0};
   Timer yaw_;
-  // speed
-  Timer speed_;
+  // speed, rigid body
+  Timer speed_, rigid_;
+  Timestamp rigid_sample_{0};
   // frames
   int out_of_range_ = 0;
   std::uint32_t out_of_range_id_ = 0;
