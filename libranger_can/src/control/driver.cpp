@@ -11,7 +11,10 @@
 #include <exception>
 #include <utility>
 
+#include <cstdio>
+
 #include "ranger_can/wire/codec.hpp"
+#include "ranger_can/wire/interpretation.hpp"
 #include "ranger_can/wire/protocol.hpp"
 
 namespace ranger {
@@ -102,6 +105,7 @@ struct Driver::Mail {
   std::optional<MotionRequest> command;  // the latest twist
   bool zero_seen = false;                // a zero twist came before the latest (it re-arms)
   std::optional<std::optional<protocol::MotionMode>> mode;
+  std::optional<std::optional<StandstillProbe>> probe;
   struct Action {
     enum Kind { kClearErrors, kUltrasonic, kResume } kind;
     std::uint64_t id;
@@ -223,6 +227,14 @@ std::uint64_t Driver::set_ultrasonic(bool enable) {
   return id;
 }
 
+void Driver::standstill_probe(std::optional<StandstillProbe> probe) {
+  {
+    std::lock_guard<std::mutex> lock(mail_mutex_);
+    mail_->probe = probe;
+  }
+  wake();
+}
+
 std::uint64_t Driver::resume() {
   std::uint64_t id = 0;
   {
@@ -330,6 +342,7 @@ void Driver::apply_mail(Timestamp now) {
     std::swap(mail, *mail_);
   }
   if (mail.mode) controller_->request_motion_mode(*mail.mode, now);
+  if (mail.probe) probe_ = *mail.probe;
   if (mail.command) {
     if (mail.zero_seen && !is_zero(mail.command->twist)) {
       controller_->set_command(MotionRequest{}, now);  // its re-arm must not be lost
@@ -458,6 +471,7 @@ void Driver::step(Timestamp now) {
     }
     apply_mail(now);
     run_identification(now);
+    run_standstill_probe();
     controller_->tick(now);
     run_plausibility(now);
     update_requests(now);
@@ -498,6 +512,25 @@ void Driver::run_identification(Timestamp now) {
   controller_->set_quiet(r.quiet);
   controller_->set_probe(r.mode, r.probe);
   controller_->set_identifying(st.message);
+}
+
+void Driver::run_standstill_probe() {
+  if (identifier_ && !identifier_->status().decided_ok()) return;  // the identification's
+  if (probe_) {
+    MotionCommand c;
+    c.steering_angle = interpretation::manual_from_rep103_command_steering(probe_->steering);
+    char what[96];
+    std::snprintf(what, sizeof what, "standstill probe: %s, %.1f deg",
+                  std::string(protocol::to_string(probe_->mode)).c_str(),
+                  probe_->steering * 180.0 / M_PI);
+    controller_->set_identifying(what);
+    controller_->set_probe(probe_->mode, c);
+    probe_active_ = true;
+  } else if (probe_active_) {
+    controller_->set_probe(std::nullopt, std::nullopt);
+    controller_->set_identifying("");
+    probe_active_ = false;
+  }
 }
 
 void Driver::run_plausibility(Timestamp now) {

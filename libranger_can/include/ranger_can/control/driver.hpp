@@ -88,6 +88,14 @@ struct RequestOutcome {
 };
 std::string_view to_string(RequestOutcome::State s);  // "pending", "sent", "answered", "failed"
 
+// A zero-speed probe at standstill (`ranger_can commission`): the wheels stand in `mode` at
+// `steering` (REP-103 rad: the front wheels' reference angle in Ackermann, the direction of travel
+// in oblique mode), nothing rolls.
+struct StandstillProbe {
+  protocol::MotionMode mode = protocol::MotionMode::kAckermann;
+  double steering = 0.0;
+};
+
 // A frame the driver sent, as the observer sees it.
 struct SentEvent {
   SentFrame sent;                              // frame, message, achieved twist, shutdown flag
@@ -164,6 +172,9 @@ class Driver {
   std::uint64_t set_ultrasonic(bool enable);
   // Also clears a plausibility stop (the operator takes it on): the monitors start over.
   std::uint64_t resume();
+  // While set (after the identification, if any): speed is refused (kIdentifying, "standstill
+  // probe ...") and the probe is commanded; nullopt ends it.
+  void standstill_probe(std::optional<StandstillProbe> probe);
 
   // Blocks the calling thread until request `id` is answered or failed, or `timeout` passes
   // (then the outcome as it stands). Only with start(); in lock-step read the snapshot instead.
@@ -188,6 +199,7 @@ class Driver {
   void handle_frame(const CanFrame& frame, Timestamp now);
   void run_identification(Timestamp now);
   void run_plausibility(Timestamp now);
+  void run_standstill_probe();
   void use_profile(const ProtocolProfile& profile);
   void update_requests(Timestamp now);
   void publish(Timestamp now);
@@ -207,6 +219,8 @@ class Driver {
   std::optional<ChassisIdentifier> identifier_;
   PlausibilityMonitor monitor_;
   std::string applied_stop_;  // the monitor's stop passed to the controller
+  std::optional<StandstillProbe> probe_;
+  bool probe_active_ = false;
   Odometry odometry_;
   WheelJointTracker joints_;
   FrameStats frames_;
