@@ -74,6 +74,19 @@ Status apply_set_options(ProtocolProfile& profile, const ParsedArgs& args) {
   return ok_status();
 }
 
+bool slurp(std::istream& in, std::string& text) {
+  try {
+    std::string line;
+    while (std::getline(in, line)) {
+      text += line;
+      text += '\n';
+    }
+    return !in.bad();
+  } catch (...) {  // a filebuf may throw on a read error (e.g. EISDIR)
+    return false;
+  }
+}
+
 std::vector<CanFrame> frames_of_text(const std::string& text) {
   std::vector<CanFrame> frames;
   std::istringstream in(text);

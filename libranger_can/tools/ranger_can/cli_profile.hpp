@@ -16,6 +16,7 @@
 //                 if (!profile) return usage_error(spec, io, profile.error().message);
 #pragma once
 
+#include <istream>
 #include <optional>
 #include <string>
 #include <vector>
@@ -50,6 +51,9 @@ Result<ProtocolProfile> profile_for_frames(const ParsedArgs& args,
                                            const std::vector<CanFrame>& frames,
                                            const VehicleGeometry& geometry = {},
                                            IdentificationStatus* status = nullptr);
+// Reads the whole stream into `text`; false on a read error (an exception of the stream's buffer
+// included).
+bool slurp(std::istream& in, std::string& text);
 // The frames of a candump text (malformed lines skipped: the command's own reader reports them).
 std::vector<CanFrame> frames_of_text(const std::string& text);
 

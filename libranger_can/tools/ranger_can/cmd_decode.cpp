@@ -44,8 +44,11 @@ int decode_main(const ParsedArgs& args, Io io) {
   if (protocol_is_auto(args)) {
     // Two passes: the whole log identifies the settings, then every frame is decoded under them.
     return with_input(args.get("FILE"), "decode", io, [&](std::istream& in) {
-      const std::string text((std::istreambuf_iterator<char>(in)),
-                             std::istreambuf_iterator<char>());
+      std::string text;
+      if (!slurp(in, text)) {
+        io.err << "ranger_can decode: read error\n";
+        return 1;
+      }
       const Result<ProtocolProfile> profile = profile_for_frames(args, frames_of_text(text));
       if (!profile) return usage_error(decode_command(), io, profile.error().message);
       std::istringstream again(text);

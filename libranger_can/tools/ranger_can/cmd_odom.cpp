@@ -106,8 +106,11 @@ int odom_main(const ParsedArgs& args, Io io) {
   if (protocol_is_auto(args)) {
     // Two passes: the whole log identifies the settings, then the odometry replays it.
     return with_input(opt.path, "odom", io, [&](std::istream& in) {
-      const std::string text((std::istreambuf_iterator<char>(in)),
-                             std::istreambuf_iterator<char>());
+      std::string text;
+      if (!slurp(in, text)) {
+        io.err << "ranger_can odom: read error\n";
+        return 1;
+      }
       const Result<ProtocolProfile> identified =
           profile_for_frames(args, frames_of_text(text), opt.config.geometry);
       if (!identified) return usage_error(odom_command(), io, identified.error().message);
