@@ -5,6 +5,7 @@
 // (each distance printed as "[stop] ..."), right settings never trip over long drives.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -13,11 +14,13 @@
 #include <string>
 #include <vector>
 
+#include "ranger_can/control/commissioning.hpp"
 #include "ranger_can/control/driver.hpp"
 #include "ranger_can/control/identification.hpp"
 #include "ranger_can/sim/sim_bus_source.hpp"
 #include "ranger_can/wire/candump_log.hpp"
 #include "ranger_can/wire/codec.hpp"
+#include "support/cli_run.hpp"
 #include "support/identify_rig.hpp"
 
 namespace ranger {
@@ -375,6 +378,136 @@ TEST(Plausibility, ResumeClearsTheStopAndTheMonitorTripsAgain) {
   ASSERT_TRUE(rig.drive_until_stopped({0.6, 0.0, 0.3}, MotionMode::kAckermann, 20s));
   EXPECT_EQ(rig.snapshot()->controller.refusal, MotionRefusal::kImplausible);
 }
+
+// ---- every virtual chassis variant (sim:VARIANT) ------------------------------------------------
+
+namespace variants {
+
+bool known(const std::string& v) {
+  const auto& names = sim::variant_names();
+  return std::find(names.begin(), names.end(), v) != names.end();
+}
+
+// The RANGER MINI V1's geometry and limits (libranger_can/models/ranger_mini_v1.yaml), which a
+// driver must be given: the steering probe and the spin position are geometry.
+void mini_v1_geometry(DriverConfig& c) {
+  c.controller.geometry.wheelbase = 0.36;
+  c.controller.geometry.track = 0.36;
+  c.controller.geometry.wheel_radius = 0.085;
+  c.controller.limits.max_ackermann_steering = 0.698;
+  c.controller.limits.max_oblique_steering = 0.698;
+  c.controller.limits.max_spin_wheel_speed = 0.076;
+}
+
+// What each variant speaks (sim_bus_source.cpp's table), as the settings a commissioning should
+// find; nullopt for the undecidable one.
+std::optional<ProtocolProfile> truth(const std::string& v) {
+  ProtocolProfile p = preset("manual");
+  if (v == "agx_v2") p = preset("agx_v2");
+  if (v == "padded") p.tx_dlc = 8;
+  if (v == "spin_cw") p.spin_sign = -1;
+  if (v == "steer_left_positive") {
+    p.steering_sign_111 = p.steering_sign_221 = p.steering_sign_271 = SteeringSign::kLeftPositive;
+  }
+  if (v == "speed221_body") p.feedback_speed = FeedbackSpeed::kBodyCentre;
+  if (v == "inner_angle") p.steering_reference = SteeringReference::kInnerFront;
+  if (v == "mini_v1") {
+    p = preset("agx_v2");
+    p.steering_unit_111 = p.steering_unit_221 = p.steering_unit_271 = AngleUnit::kCentidegree;
+    p.steering_sign_111 = p.steering_sign_221 = p.steering_sign_271 = SteeringSign::kRightPositive;
+    p.spin_field = SpinField::kWheelSpeed;
+    p.spin_sign = -1;
+    p.mode_numbering = ModeNumbering::kMiniV1;
+  }
+  if (v == "undecidable") return std::nullopt;
+  return p;
+}
+
+const std::vector<std::string> kAll = {
+    "manual",        "agx_v2",      "padded",  "spin_cw",    "steer_left_positive",
+    "speed221_body", "inner_angle", "mini_v1", "undecidable"};
+
+}  // namespace variants
+
+class EveryVariant : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(EveryVariant, AutoIdentifiesItAndDrivesTheRoute) {
+  const std::string v = GetParam();
+  if (!variants::known(v)) GTEST_SKIP() << "sim:" << v << " comes with the variants merge";
+  DriverConfig c = test::auto_config();
+  if (v == "mini_v1") variants::mini_v1_geometry(c);
+  IdentifyRig rig("sim:" + v, c);
+  rig.set_rearm(true);
+  rig.command({0.5, 0.0, 0.0});
+  ASSERT_TRUE(rig.run_until([&] { return rig.snapshot()->identification->done(); }, 15s));
+  const auto s = rig.snapshot();
+  const IdentificationStatus& id = *s->identification;
+  std::printf("[identify] variant=%s %s time=%.2f s confidence=%.3f profile=%s\n", v.c_str(),
+              std::string(to_string(id.phase)).c_str(), seconds(id.elapsed()), id.confidence,
+              describe(id.profile).c_str());
+  EXPECT_EQ(rig.truth().distance_travelled, 0.0) << "nothing rolled while identifying";
+  EXPECT_LE(id.elapsed(), IdentificationConfig{}.timeout);
+  if (v == "undecidable") {
+    EXPECT_EQ(id.phase, IdentificationPhase::kFailed);
+    rig.run_for(3s);
+    const auto after = rig.snapshot();
+    EXPECT_EQ(after->controller.refusal, MotionRefusal::kIdentifying);
+    EXPECT_NE(after->controller.identifying.find("ranger_can commission IFACE --wheels-lifted"),
+              std::string::npos)
+        << after->controller.identifying;
+    EXPECT_EQ(rig.truth().distance_travelled, 0.0) << "at rest";
+    return;
+  }
+  ASSERT_TRUE(id.decided_ok()) << id.message;
+  // What rest can tell is right; the rest is learned on the route (with a latched stop each).
+  const ProtocolProfile want = *variants::truth(v);
+  for (const IdentifiedSetting& d : id.decided) {
+    EXPECT_EQ(d.value, *get_setting(want, d.name)) << d.name << ": " << d.evidence;
+  }
+  rig.expect_route("sim:" + v + " auto", v == "mini_v1" ? 0.3 : 1.0);
+  const auto end = rig.snapshot();
+  for (const ProfileSetting& p : profile_settings()) {
+    const std::string name(p.name);
+    if (name == "vehicle_status_1_is_estop" || name == "bms_current_sign" ||
+        name == "driver_status_bit6" || name == "bms_voltage_scale" || name == "error_word" ||
+        name == "mode_numbering" || name == "tx_dlc") {
+      continue;  // not exercised by the route
+    }
+    if (name == "feedback_speed" && v == "mini_v1") continue;  // no turn sharp enough to tell
+    EXPECT_EQ(*get_setting(end->profile, name), *get_setting(want, name))
+        << name << " after the route on sim:" << v;
+  }
+}
+
+TEST_P(EveryVariant, CommissionWritesItsTrueSettingsAndTheFileDrivesTheRoute) {
+  const std::string v = GetParam();
+  if (!variants::known(v)) GTEST_SKIP() << "sim:" << v << " comes with the variants merge";
+  if (v == "mini_v1") GTEST_SKIP() << "commission takes the model's geometry with --model";
+  const std::string path = std::string(::testing::TempDir()) + "/commission_" + v + ".yaml";
+  std::remove(path.c_str());
+  const auto r =
+      test::run_cli(cli::run_commission, {"sim:" + v, "--wheels-lifted", "--output", path});
+  if (v == "undecidable") {
+    EXPECT_EQ(r.rc, 1);
+    EXPECT_NE(r.err.find("no file written"), std::string::npos) << r.err;
+    EXPECT_FALSE(std::ifstream(path).good());
+    return;
+  }
+  ASSERT_EQ(r.rc, 0) << r.err << r.out;
+  const auto loaded = load_commissioning_file(path);
+  ASSERT_TRUE(loaded.ok()) << loaded.error().message;
+  const ProtocolProfile want = *variants::truth(v);
+  for (const ProfileSetting& p : profile_settings()) {
+    EXPECT_EQ(*get_setting(*loaded, p.name), *get_setting(want, p.name))
+        << p.name << " commissioned on sim:" << v;
+  }
+  IdentifyRig rig("sim:" + v, test::forced_config(*loaded));
+  rig.expect_route("sim:" + v + " commissioned");
+  EXPECT_EQ(rig.rearms(), 0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Sim, EveryVariant, ::testing::ValuesIn(variants::kAll),
+                         [](const auto& info) { return info.param; });
 
 }  // namespace
 }  // namespace ranger

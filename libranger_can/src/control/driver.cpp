@@ -480,13 +480,17 @@ void Driver::step(Timestamp now) {
   deliver_events();
 }
 
-void Driver::use_profile(const ProtocolProfile& profile) {
+void Driver::use_profile(const ProtocolProfile& profile, bool reset_odometry) {
   if (profile == profile_) return;
   profile_ = profile;
   if (Status st = controller_->set_profile(profile); !st) return;
-  OdometryConfig c = odometry_config(config_);
-  c.profile = profile;
-  odometry_ = Odometry(c);  // nothing has moved yet: the pose starts here
+  if (reset_odometry) {
+    OdometryConfig c = odometry_config(config_);
+    c.profile = profile;
+    odometry_ = Odometry(c);  // nothing has moved yet: the pose starts here
+  } else {
+    odometry_.set_profile(profile);
+  }
   monitor_.set_profile(profile);
 }
 
@@ -536,10 +540,16 @@ void Driver::run_standstill_probe() {
 void Driver::run_plausibility(Timestamp now) {
   if (identifier_ && !identifier_->status().decided_ok()) return;
   monitor_.update(now, controller_->state(), controller_->feedback(), odometry_.state());
-  const auto& stop = monitor_.status().stop;
-  if (stop && applied_stop_.empty()) {
-    applied_stop_ = stop->text();
-    controller_->set_implausible(applied_stop_);
+  const auto stop = monitor_.status().stop;
+  if (!stop || !applied_stop_.empty()) return;
+  applied_stop_ = stop->text();
+  controller_->set_implausible(applied_stop_);  // the stop, latched
+  // Auto: a setting the identification could not decide at rest is learned here. The stop stays
+  // latched (a zero twist or resume re-arms); the cause itself is gone with the setting.
+  if (identifier_ && identifier_->adopt(stop->setting, stop->try_value, stop->detail)) {
+    use_profile(identifier_->status().profile, /*reset_odometry=*/false);
+    controller_->set_implausible("");
+    applied_stop_.clear();
   }
 }
 

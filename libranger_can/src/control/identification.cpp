@@ -568,6 +568,19 @@ void ChassisIdentifier::evaluate_steer(Timestamp now) {
     if (!dominated) gross.add(static_cast<int>(c), residuals[c]);
   }
   const double probe_tol = config_.angle_tolerance + 0.1 * 6.0 * config_.probe_angle;
+  // An answer too small to tell the readings apart: probe again in the unit the best fit names.
+  if (!gross.clear(probe_tol, config_.margin, 0.1 * kDeg) && gross.best >= 0 &&
+      gross.best_residual <= probe_tol && steer_probes_ < kMaxSteerProbes) {
+    const Combo& b = combos[static_cast<std::size_t>(gross.best)];
+    if (std::fabs(b.commanded) < kMinReferenceAngle &&
+        b.u111 != status_.profile.steering_unit_111) {
+      note("steering probe 1: 0x271 came back " + (plain ? values_text(*plain) : std::string("?")) +
+           ", too small to judge: probing again in " + std::string(to_string(b.u111)));
+      status_.profile.steering_unit_111 = b.u111;
+      begin_step(IdentificationPhase::kSteerProbe, now);
+      return;
+    }
+  }
   if (!gross.clear(probe_tol, config_.margin, 0.1 * kDeg)) {
     fail("the steering probe's answer fits no reading of the protocol: 0x111 steering " +
              deg(config_.probe_angle) + " to the left (as " +
@@ -790,6 +803,17 @@ void ChassisIdentifier::finish(Timestamp now) {
   }
   decide_passive(now);
   decide(now);
+}
+
+bool ChassisIdentifier::adopt(std::string_view name, std::string_view value, std::string evidence) {
+  auto it = std::find(status_.undecided.begin(), status_.undecided.end(), name);
+  if (!status_.decided_ok() || it == status_.undecided.end()) return false;
+  ProtocolProfile p = status_.profile;
+  if (!set_setting(p, name, value)) return false;
+  status_.undecided.erase(it);
+  set(name, value, "learned while driving: " + evidence);
+  status_.message = "identified: " + describe(status_.profile);
+  return true;
 }
 
 IdentificationRequest ChassisIdentifier::request() const {

@@ -38,9 +38,13 @@ class IdentifyRig {
   bool drive_until_stopped(const BodyTwist& twist, std::optional<protocol::MotionMode> mode,
                            std::chrono::nanoseconds timeout);
   std::chrono::nanoseconds stopped_after() const { return stopped_after_; }
+  // The commander answers a latched stop (kRearmRequired) with a zero twist, as a teleop does,
+  // then goes on with its twist; counted.
+  void set_rearm(bool on) { rearm_ = on; }
+  int rearms() const { return rearms_; }
   // Drives the route and checks the odometry against the ground truth (<= 1 % of the distance,
   // <= 1 deg of heading per turn); prints "[route] ...".
-  void expect_route(const std::string& label);
+  void expect_route(const std::string& label, double min_turns = 1.0);
 
   Driver& driver() { return *driver_; }
   sim::SimBusSource& sim() { return *sim_; }
@@ -62,6 +66,9 @@ class IdentifyRig {
   std::optional<MotionRequest> request_;
   Timestamp next_publish_{0};
   std::chrono::nanoseconds stopped_after_{0};
+  bool rearm_ = false;
+  int rearms_ = 0;
+  bool rearming_ = false;
 };
 
 }  // namespace ranger::test

@@ -61,7 +61,10 @@ struct DriverConfig {
   // kAuto only: start from this preset ("manual", "agx_v2") instead of deciding it.
   std::optional<std::string> identify_revision;
   IdentificationConfig identification;
-  // The plausibility monitors (plausibility.hpp), whatever the settings came from.
+  // The plausibility monitors (plausibility.hpp), whatever the settings came from. kAuto: a
+  // mismatch of a setting the identification could not decide at rest (the spin sign, 0x221's
+  // speed reading, ...) stops the robot all the same (latched: a zero twist or resume re-arms),
+  // and the value the monitor names is adopted, so that the re-armed robot drives right.
   PlausibilityConfig plausibility;
   // Source, timeouts and covariances; its geometry and profile are the controller's (one vehicle,
   // one reading: the driver copies them).
@@ -200,7 +203,7 @@ class Driver {
   void run_identification(Timestamp now);
   void run_plausibility(Timestamp now);
   void run_standstill_probe();
-  void use_profile(const ProtocolProfile& profile);
+  void use_profile(const ProtocolProfile& profile, bool reset_odometry = true);
   void update_requests(Timestamp now);
   void publish(Timestamp now);
   void deliver_events();

@@ -32,6 +32,8 @@
 //      its own unit and sign. An answer 5.7 times smaller than asked is probed once more in the
 //      corrected unit, so that the reference is judged at a useful angle;
 //    * back to Ackermann, wheels straight: decided.
+//    A first answer too small to judge (0.01 deg read where 0.001 rad was meant, or the reverse) is
+//    probed once more in the unit it suggests.
 //    Steps that get no settled 0x271 answer within `step_timeout`, or answers no combination
 //    explains, fail the identification, as does `timeout` overall: the robot stays at rest and
 //    status().message names the parameters to set and the commissioning command.
@@ -152,6 +154,12 @@ class ChassisIdentifier {
 
   const IdentificationStatus& status() const { return status_; }
   IdentificationRequest request() const;
+
+  // After the decision: a setting the identification could not decide (one of
+  // status().undecided) found out while driving (the plausibility monitors), e.g. spin_sign = cw
+  // from a spin that turned the other way. Moves it to status().decided with `evidence`; false
+  // (nothing changes) for a setting that was decided, or an invalid value.
+  bool adopt(std::string_view name, std::string_view value, std::string evidence);
 
  private:
   struct Hypothesis271 {
