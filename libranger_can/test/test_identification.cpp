@@ -506,6 +506,25 @@ TEST_P(EveryVariant, CommissionWritesItsTrueSettingsAndTheFileDrivesTheRoute) {
   EXPECT_EQ(rig.rearms(), 0);
 }
 
+TEST(Plausibility, AManualDriverOnAnAgxChassisIsCaught) {
+  if (!variants::known("agx_v2")) GTEST_SKIP() << "sim:agx_v2 comes with the variants merge";
+  IdentifyRig rig("sim:agx_v2", test::forced_config(preset("manual")));
+  rig.command({0.6, 0.0, 0.3}, MotionMode::kAckermann);
+  const Timestamp began = rig.now();
+  ASSERT_TRUE(
+      rig.run_until([&] { return !rig.snapshot()->controller.implausible_reason.empty(); }, 10s));
+  const std::string reason = rig.snapshot()->controller.implausible_reason;
+  const double after = seconds(rig.now() - began);
+  rig.run_for(2s);
+  const double distance = rig.truth().distance_travelled;
+  std::printf("[stop] wrong=manual_on_agx_v2 distance=%.3f m caught_after=%.2f s reason=%s\n",
+              distance, after, reason.c_str());
+  EXPECT_NE(reason.find("error_word: try agx16"), std::string::npos) << reason;
+  EXPECT_NE(rig.snapshot()->controller.refusal, MotionRefusal::kNone);
+  EXPECT_LE(distance, 0.05);
+  EXPECT_EQ(rig.truth().speed, 0.0);
+}
+
 INSTANTIATE_TEST_SUITE_P(Sim, EveryVariant, ::testing::ValuesIn(variants::kAll),
                          [](const auto& info) { return info.param; });
 
