@@ -333,7 +333,7 @@ TEST(CliDecode, AgxV2LogCounterIsNoFault) {
 }
 
 TEST(CliDecode, AgxV2LogUnderTheManualShowsWhyTheProfileMatters) {
-  const Outcome r = run({kAgxLog, "--json"});
+  const Outcome r = run({kAgxLog, "--json", "--protocol", "manual"});
   ASSERT_EQ(r.rc, 0) << r.err;
   std::size_t phantom = 0;
   for (const auto& line : lines_of(r.out)) {
@@ -367,13 +367,13 @@ TEST(CliDecode, AgxV2LogPaddedAndUnpaddedDecodeAlike) {
 
 TEST(CliDecode, ProtocolOptions) {
   const Outcome help = run({"--help"});
-  EXPECT_NE(help.out.find("--protocol manual|agx_v2"), std::string::npos) << help.out;
+  EXPECT_NE(help.out.find("--protocol auto|manual|agx_v2"), std::string::npos) << help.out;
   EXPECT_NE(help.out.find("--set NAME=VALUE"), std::string::npos);
   EXPECT_NE(help.out.find("steering_unit_271=centideg|millirad"), std::string::npos);
   const Outcome bad = run({kAgxLog, "--protocol", "vendor"});
   EXPECT_EQ(bad.rc, 2);
   EXPECT_EQ(bad.out, "");
-  EXPECT_NE(bad.err.find("--protocol: 'vendor' is not one of manual, agx_v2"), std::string::npos)
+  EXPECT_NE(bad.err.find("--protocol: 'vendor' is not one of auto, manual, agx_v2"), std::string::npos)
       << bad.err;
   const Outcome value = run({kAgxLog, "--set", "error_word=agx32"});
   EXPECT_EQ(value.rc, 2);
@@ -388,7 +388,8 @@ TEST(CliDecode, ProtocolOptions) {
       << name.err;
   // One setting on top of the manual: the 16-bit word alone removes the phantom faults.
   const Outcome word =
-      run({kAgxLog, "--json", "--set", "error_word=agx16", "--set", "bms_voltage_scale=0.1"});
+      run({kAgxLog, "--json", "--protocol", "manual", "--set", "error_word=agx16", "--set",
+           "bms_voltage_scale=0.1"});
   ASSERT_EQ(word.rc, 0) << word.err;
   EXPECT_NE(word.out.find(R"("voltage":51.2,)"), std::string::npos);
   EXPECT_NE(word.out.find(R"("errors":[],"critical":false,"counter":1})"), std::string::npos);

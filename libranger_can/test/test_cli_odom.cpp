@@ -295,7 +295,7 @@ TEST(CliOdom, TheWrongProtocolDoesNotReplayTheDrive) {
   // agx_v2's wheel angles read in the manual's 0.01 deg are 5.7 times too small: the replay is
   // off by metres, so a wrong --protocol shows.
   const std::string path = std::string(RANGER_DATA_DIR) + "/sample_agx_v2.log";
-  const Outcome o = run({path, "--quiet"});
+  const Outcome o = run({path, "--quiet", "--protocol", "manual"});
   ASSERT_EQ(o.rc, 0) << o.err;
   FinalPose p{};
   ASSERT_TRUE(parse_final(lines_of(o.out).back(), p)) << o.out;
@@ -318,7 +318,7 @@ TEST(CliOdom, ProtocolOptions) {
 
   const Outcome bad_protocol = run({path, "--protocol", "agx_v9"});
   EXPECT_EQ(bad_protocol.rc, 2);
-  EXPECT_NE(bad_protocol.err.find("'agx_v9' is not one of manual, agx_v2"), std::string::npos)
+  EXPECT_NE(bad_protocol.err.find("'agx_v9' is not one of auto, manual, agx_v2"), std::string::npos)
       << bad_protocol.err;
   const Outcome bad_value = run({path, "--set", "steering_unit_271=degrees"});
   EXPECT_EQ(bad_value.rc, 2);

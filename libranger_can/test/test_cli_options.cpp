@@ -213,7 +213,9 @@ TEST(CliCommands, EveryOptionInTheHelpIsAcceptedByTheParser) {
       SCOPED_TRACE(o.name);
       const std::string shown = (o.short_name != 0 ? std::string("-") + o.short_name + ", " : "") +
                                 o.name + (o.value_name.empty() ? "" : " " + o.value_name);
-      EXPECT_NE(help.find("  " + shown + " "), std::string::npos);
+      // A long left column puts the help on the next line (format_rows).
+      EXPECT_TRUE(help.find("  " + shown + " ") != std::string::npos ||
+                  help.find("  " + shown + "\n") != std::string::npos);
       Args args = required;
       args.push_back(o.name);
       if (!o.value_name.empty()) {

@@ -70,6 +70,8 @@ std::string_view to_string(MotionRefusal r) {
       return "cmd_timeout";
     case MotionRefusal::kBelowMinimum:
       return "below_minimum";
+    case MotionRefusal::kIdentifying:
+      return "identifying";
   }
   return "unknown";
 }
@@ -339,17 +341,68 @@ Status ChassisController::resume(Timestamp now) {
 }
 
 void ChassisController::set_implausible(std::string reason) {
+  if (reason == implausible_reason_) return;
   implausible_reason_ = std::move(reason);
+  state_.implausible_reason = implausible_reason_;
   command_changed_ = true;
   update_causes();
   update_faults();
 }
 
+void ChassisController::set_identifying(std::string reason) {
+  if (reason == state_.identifying) return;
+  state_.identifying = std::move(reason);
+  if (state_.identifying.empty()) {
+    probe_mode_.reset();
+    state_.probe.reset();
+  }
+  command_changed_ = true;
+}
+
+void ChassisController::set_quiet(bool quiet) {
+  if (quiet == state_.quiet) return;
+  state_.quiet = quiet;
+  command_changed_ = true;
+  if (!quiet) next_control_request_ = state_.now;  // ask for CAN mode at the next tick
+}
+
+void ChassisController::set_probe(std::optional<MotionMode> mode,
+                                  std::optional<MotionCommand> command) {
+  if (mode && !drivable_mode(*mode)) mode.reset();
+  if (command) {
+    // Zero speed, whatever the caller filled in: a probe never rolls a wheel.
+    command->linear_speed = 0.0;
+    command->spin_speed = 0.0;
+    command->yaw_rate = 0.0;
+  }
+  const bool changed =
+      mode != probe_mode_ || command.has_value() != state_.probe.has_value() ||
+      (command && state_.probe && command->steering_angle != state_.probe->steering_angle);
+  probe_mode_ = mode;
+  state_.probe = command;
+  if (changed) command_changed_ = true;
+}
+
+Status ChassisController::set_profile(const ProtocolProfile& profile) {
+  if (Status st = profile.validate(); !st) return st;
+  config_.profile = profile;
+  faults_valid_ = false;  // the error word's names depend on the layout
+  command_changed_ = true;
+  update_causes();
+  update_faults();
+  return ok_status();
+}
+
 void ChassisController::shutdown(Timestamp now) {
   if (state_.shut_down) return;
   state_.now = now;
-  // Stop, whatever the state: a zero 0x111 never hurts.
+  // Stop, whatever the state: a zero 0x111 never hurts (unless nothing was ever said: quiet).
   send_motion(MotionCommand{}, nullptr, now, /*shutdown=*/true);
+  if (config_.release_control_on_shutdown && state_.control_mode == ControlMode::kCan &&
+      !state_.quiet) {
+    ++state_.counters.control_mode_requests;
+    send(ControlModeCommand{ControlMode::kStandby}, now, nullptr, /*shutdown=*/true);
+  }
   state_.shut_down = true;
   mode_switch_.cancel();
   state_.mode_switch = mode_switch_.status();
@@ -430,7 +483,7 @@ void ChassisController::update_causes() {
 }
 
 void ChassisController::run_control_mode(Timestamp now) {
-  if (config_.listen_only || !config_.auto_command_mode) return;
+  if (config_.listen_only || !config_.auto_command_mode || state_.quiet) return;
   if (state_.link != LinkState::kConnected || state_.reclaim_blocked) return;
   // Only standby is answered with a request: remote control is never fought, and an unknown
   // mode is not guessed at.
@@ -468,6 +521,7 @@ MotionRefusal ChassisController::evaluate_refusal() const {
   if (state_.latched_causes != 0) return MotionRefusal::kRearmRequired;
   if (state_.control_mode != ControlMode::kCan) return MotionRefusal::kStandby;
   if (!state_.motion_mode) return MotionRefusal::kModeUnknown;
+  if (!state_.identifying.empty()) return MotionRefusal::kIdentifying;
   if (state_.cmd_timed_out) return MotionRefusal::kCmdTimeout;
   if (selector_.below_minimum(state_.requested.twist)) return MotionRefusal::kBelowMinimum;
   return MotionRefusal::kNone;
@@ -514,9 +568,12 @@ void ChassisController::run_motion(Timestamp now) {
   // 2. Everything that forbids motion except a mode switch.
   MotionRefusal refusal = evaluate_refusal();
   // A switch that failed goes on retrying at its bounded rate (it stops nothing else).
+  // The identification's probe: zero speed, a steering angle, possibly in another mode.
+  const bool probing = refusal == MotionRefusal::kIdentifying && state_.probe.has_value();
   const bool may_drive =
-      (refusal == MotionRefusal::kNone || refusal == MotionRefusal::kModeSwitchFailed) &&
-      state_.has_command;
+      ((refusal == MotionRefusal::kNone || refusal == MotionRefusal::kModeSwitchFailed) &&
+       state_.has_command) ||
+      (probing && probe_mode_.has_value());
 
   // 3. Motion-mode switching: decide the wanted mode, then stop -> 0x141 -> confirmation.
   std::optional<MotionMode> mode_to_send;
@@ -525,7 +582,9 @@ void ChassisController::run_motion(Timestamp now) {
   } else {
     const MotionMode current = *state_.motion_mode;
     MotionMode wanted = current;
-    if (state_.requested.mode) {
+    if (probing) {
+      wanted = *probe_mode_;
+    } else if (state_.requested.mode) {
       wanted = *state_.requested.mode;
     } else if (state_.mode_override) {
       wanted = *state_.mode_override;
@@ -586,6 +645,9 @@ void ChassisController::run_motion(Timestamp now) {
     }
   } else {
     state_.limited = BodyTwist{};  // refusals stop at once; the limiter restarts from zero
+    if (probing && !state_.chassis_switching && !mode_switch_.active()) {
+      command = *state_.probe;  // zero speeds (set_probe), the probe's steering
+    }
   }
   limiter_started_ = true;
   last_limit_time_ = now;
@@ -620,7 +682,7 @@ void ChassisController::run_motion(Timestamp now) {
 
 bool ChassisController::send(const Message& message, Timestamp now,
                              const KinematicsSolution* solution, bool shutdown) {
-  if (config_.listen_only) return false;
+  if (config_.listen_only || state_.quiet) return false;
   Result<CanFrame> frame = encode(message, config_.profile);
   if (!frame) {
     ++state_.counters.send_failures;
@@ -649,7 +711,7 @@ bool ChassisController::send(const Message& message, Timestamp now,
 void ChassisController::send_motion(const MotionCommand& command,
                                     const KinematicsSolution* solution, Timestamp now,
                                     bool shutdown) {
-  if (config_.listen_only) return;
+  if (config_.listen_only || state_.quiet) return;
   state_.last_motion_command = command;
   state_.last_motion_command_time = now;
   if (send(command, now, solution, shutdown)) ++state_.counters.motion_commands_sent;

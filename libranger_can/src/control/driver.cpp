@@ -11,7 +11,10 @@
 #include <exception>
 #include <utility>
 
+#include <cstdio>
+
 #include "ranger_can/wire/codec.hpp"
+#include "ranger_can/wire/interpretation.hpp"
 #include "ranger_can/wire/protocol.hpp"
 
 namespace ranger {
@@ -69,9 +72,20 @@ std::string_view to_string(RequestOutcome::State s) {
   return "unknown";
 }
 
+std::string_view to_string(ProtocolChoice c) {
+  return c == ProtocolChoice::kAuto ? "auto" : "forced";
+}
+
 Status DriverConfig::validate() const {
   if (Status st = controller.validate(); !st) return st;
   if (Status st = odometry.validate(); !st) return st;
+  if (Status st = plausibility.validate(); !st) return st;
+  if (protocol == ProtocolChoice::kAuto) {
+    if (Status st = identification.validate(); !st) return st;
+    if (identify_revision) {
+      if (auto p = protocol_preset(*identify_revision); !p) return p.error();
+    }
+  }
   if (reconnect_interval.count() <= 0 || request_answer_timeout.count() <= 0) {
     return Error{Errc::kOutOfRange,
                  "driver: reconnect_interval and request_answer_timeout must be > 0"};
@@ -91,6 +105,7 @@ struct Driver::Mail {
   std::optional<MotionRequest> command;  // the latest twist
   bool zero_seen = false;                // a zero twist came before the latest (it re-arms)
   std::optional<std::optional<protocol::MotionMode>> mode;
+  std::optional<std::optional<StandstillProbe>> probe;
   struct Action {
     enum Kind { kClearErrors, kUltrasonic, kResume } kind;
     std::uint64_t id;
@@ -104,6 +119,8 @@ Driver::Driver(DriverConfig config, std::shared_ptr<BusSource> source, const Clo
     : config_(std::move(config)),
       source_(std::move(source)),
       clock_(clock),
+      profile_(config_.controller.profile),
+      monitor_(config_.plausibility, config_.controller.geometry, config_.controller.profile),
       odometry_(odometry_config(config_)),
       joints_(config_.controller.geometry.wheel_radius),
       mail_(std::make_unique<Mail>()),
@@ -112,6 +129,7 @@ Driver::Driver(DriverConfig config, std::shared_ptr<BusSource> source, const Clo
   auto first = std::make_shared<DriverSnapshot>();
   first->bus_name = source_ ? source_->name() : "";
   first->profile = config_.controller.profile;
+  first->protocol = config_.protocol;
   snapshot_ = std::move(first);
 }
 
@@ -209,6 +227,14 @@ std::uint64_t Driver::set_ultrasonic(bool enable) {
   return id;
 }
 
+void Driver::standstill_probe(std::optional<StandstillProbe> probe) {
+  {
+    std::lock_guard<std::mutex> lock(mail_mutex_);
+    mail_->probe = probe;
+  }
+  wake();
+}
+
 std::uint64_t Driver::resume() {
   std::uint64_t id = 0;
   {
@@ -271,6 +297,14 @@ void Driver::try_open(Timestamp now) {
   controller_->set_send_observer([this](const SentFrame& sent) {
     events_.push_back(SentEvent{sent, std::chrono::system_clock::now()});
   });
+  if (config_.protocol == ProtocolChoice::kAuto) {
+    // Listen before speaking: the controller hears nothing and says nothing until the
+    // identification has proposed the settings.
+    identifier_.emplace(config_.identification, config_.controller.geometry,
+                        config_.identify_revision, source_->read_only());
+    controller_->set_quiet(true);
+    controller_->set_identifying("identifying the chassis: listening");
+  }
   std::lock_guard<std::mutex> lock(mail_mutex_);
   opened_once_ = true;
   open_error_.clear();
@@ -278,13 +312,20 @@ void Driver::try_open(Timestamp now) {
 
 void Driver::handle_frame(const CanFrame& frame, Timestamp now) {
   if (frame_tap_) frame_tap_(frame);
+  const bool identifying = identifier_ && !identifier_->status().done();
+  if (identifying) identifier_->on_frame(frame, now);
   if (frame.is_error) {
     controller_->on_frame(frame, now);  // counts it
     return;
   }
-  Result<Message> message = decode(frame, config_.controller.profile);
+  Result<Message> message = decode(frame, profile_);
   frames_.record(frame.id, now, message.ok(), protocol::extra_bytes(frame));
+  // While listening, nothing reaches the controller: read under settings not decided yet, a
+  // counter would be phantom faults, and those would latch.
+  if (identifying && identifier_->status().phase == IdentificationPhase::kListening) return;
+  if (!identifying) monitor_.on_frame(frame, now);
   if (!message) {
+    if (!identifying) monitor_.on_rejected(frame, message.error().code, now);
     controller_->on_frame(frame, now);  // counts and records the decode error
     return;
   }
@@ -301,6 +342,7 @@ void Driver::apply_mail(Timestamp now) {
     std::swap(mail, *mail_);
   }
   if (mail.mode) controller_->request_motion_mode(*mail.mode, now);
+  if (mail.probe) probe_ = *mail.probe;
   if (mail.command) {
     if (mail.zero_seen && !is_zero(mail.command->twist)) {
       controller_->set_command(MotionRequest{}, now);  // its re-arm must not be lost
@@ -317,6 +359,13 @@ void Driver::apply_mail(Timestamp now) {
         st = controller_->set_ultrasonic(a.enable, now);
         break;
       case Mail::Action::kResume:
+        // The operator takes a plausibility stop on: the monitors start over (and trip again
+        // if the mismatch persists).
+        if (!applied_stop_.empty()) {
+          monitor_.reset();
+          applied_stop_.clear();
+          controller_->set_implausible("");
+        }
         st = controller_->resume(now);
         break;
     }
@@ -347,8 +396,7 @@ void Driver::update_requests(Timestamp now) {
       if (status && status->received >= r.sent + kAnswerDelay) {
         r.state = RequestOutcome::State::kAnswered;
         r.error_word = c.error_bits;
-        const auto names =
-            protocol::error_bit_names(c.error_bits, config_.controller.profile.error_word);
+        const auto names = protocol::error_bit_names(c.error_bits, profile_.error_word);
         r.message = names.empty() ? std::string("the chassis reports no error")
                                   : "the chassis still reports: " + join_names(names);
       } else if (now - r.sent > config_.request_answer_timeout) {
@@ -386,7 +434,10 @@ void Driver::publish(Timestamp now) {
   s->odometry = odometry_.state();
   s->joints = joints_.joints();
   s->frames = frames_;
-  s->profile = config_.controller.profile;
+  s->profile = profile_;
+  s->protocol = config_.protocol;
+  if (identifier_) s->identification = identifier_->status();
+  s->plausibility = monitor_.status();
   s->loop_iterations = loop_iterations_;
   {
     std::lock_guard<std::mutex> lock(mail_mutex_);
@@ -419,11 +470,87 @@ void Driver::step(Timestamp now) {
       handle_frame(*frame, now);
     }
     apply_mail(now);
+    run_identification(now);
+    run_standstill_probe();
     controller_->tick(now);
+    run_plausibility(now);
     update_requests(now);
   }
   publish(now);
   deliver_events();
+}
+
+void Driver::use_profile(const ProtocolProfile& profile, bool reset_odometry) {
+  if (profile == profile_) return;
+  profile_ = profile;
+  if (Status st = controller_->set_profile(profile); !st) return;
+  if (reset_odometry) {
+    OdometryConfig c = odometry_config(config_);
+    c.profile = profile;
+    odometry_ = Odometry(c);  // nothing has moved yet: the pose starts here
+  } else {
+    odometry_.set_profile(profile);
+  }
+  monitor_.set_profile(profile);
+}
+
+void Driver::run_identification(Timestamp now) {
+  if (!identifier_ || identifier_->status().done()) return;
+  identifier_->tick(now);
+  const IdentificationStatus& st = identifier_->status();
+  if (st.decided_ok()) {
+    use_profile(st.profile);
+    controller_->set_probe(std::nullopt, std::nullopt);
+    controller_->set_quiet(false);
+    controller_->set_identifying("");
+    return;
+  }
+  if (st.phase == IdentificationPhase::kFailed) {
+    // At rest, and saying why: the refusal stays, with the message naming what to set.
+    controller_->set_probe(std::nullopt, std::nullopt);
+    controller_->set_identifying(st.message);
+    return;
+  }
+  const IdentificationRequest r = identifier_->request();
+  if (r.profile) use_profile(*r.profile);
+  controller_->set_quiet(r.quiet);
+  controller_->set_probe(r.mode, r.probe);
+  controller_->set_identifying(st.message);
+}
+
+void Driver::run_standstill_probe() {
+  if (identifier_ && !identifier_->status().decided_ok()) return;  // the identification's
+  if (probe_) {
+    MotionCommand c;
+    c.steering_angle = interpretation::manual_from_rep103_command_steering(probe_->steering);
+    char what[96];
+    std::snprintf(what, sizeof what, "standstill probe: %s, %.1f deg",
+                  std::string(protocol::to_string(probe_->mode)).c_str(),
+                  probe_->steering * 180.0 / M_PI);
+    controller_->set_identifying(what);
+    controller_->set_probe(probe_->mode, c);
+    probe_active_ = true;
+  } else if (probe_active_) {
+    controller_->set_probe(std::nullopt, std::nullopt);
+    controller_->set_identifying("");
+    probe_active_ = false;
+  }
+}
+
+void Driver::run_plausibility(Timestamp now) {
+  if (identifier_ && !identifier_->status().decided_ok()) return;
+  monitor_.update(now, controller_->state(), controller_->feedback(), odometry_.state());
+  const auto stop = monitor_.status().stop;
+  if (!stop || !applied_stop_.empty()) return;
+  applied_stop_ = stop->text();
+  controller_->set_implausible(applied_stop_);  // the stop, latched
+  // Auto: a setting the identification could not decide at rest is learned here. The stop stays
+  // latched (a zero twist or resume re-arms); the cause itself is gone with the setting.
+  if (identifier_ && identifier_->adopt(stop->setting, stop->try_value, stop->detail)) {
+    use_profile(identifier_->status().profile, /*reset_odometry=*/false);
+    controller_->set_implausible("");
+    applied_stop_.clear();
+  }
 }
 
 // ---- the thread ------------------------------------------------------------------------------

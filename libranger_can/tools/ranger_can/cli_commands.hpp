@@ -21,12 +21,14 @@ using Args = std::vector<std::string>;
 
 struct CommandSpec;
 
-int run_decode(const Args& args, Io io);    // decode candump logs (text or --json)
-int run_odom(const Args& args, Io io);      // replay a candump log through the odometry
-int run_sim(const Args& args, Io io);       // run the virtual chassis on an interface
-int run_monitor(const Args& args, Io io);   // live terminal view of a chassis
-int run_send(const Args& args, Io io);      // one-shot commands: mode, control, motion...
-int run_scenario(const Args& args, Io io);  // a script: driver + virtual chassis, simulated time
+int run_decode(const Args& args, Io io);      // decode candump logs (text or --json)
+int run_odom(const Args& args, Io io);        // replay a candump log through the odometry
+int run_sim(const Args& args, Io io);         // run the virtual chassis on an interface
+int run_monitor(const Args& args, Io io);     // live terminal view of a chassis
+int run_send(const Args& args, Io io);        // one-shot commands: mode, control, motion...
+int run_scenario(const Args& args, Io io);    // a script: driver + virtual chassis, simulated time
+int run_identify(const Args& args, Io io);    // identify the protocol settings of a chassis
+int run_commission(const Args& args, Io io);  // guided first start on blocks: decide every setting
 
 // The option tables, for the top-level help and the tests.
 const CommandSpec& decode_command();
@@ -35,6 +37,8 @@ const CommandSpec& sim_command();
 const CommandSpec& monitor_command();
 const CommandSpec& send_command();
 const CommandSpec& scenario_command();
+const CommandSpec& identify_command();
+const CommandSpec& commission_command();
 
 // Every sub-command, in the order `ranger_can --help` lists them.
 const std::vector<const CommandSpec*>& all_commands();

@@ -15,8 +15,8 @@ namespace ranger::cli {
 
 const std::vector<const CommandSpec*>& all_commands() {
   static const std::vector<const CommandSpec*> commands = {
-      &decode_command(),  &odom_command(), &sim_command(),
-      &monitor_command(), &send_command(), &scenario_command(),
+      &decode_command(), &odom_command(),     &sim_command(),      &monitor_command(),
+      &send_command(),   &scenario_command(), &identify_command(), &commission_command(),
   };
   return commands;
 }

@@ -1,6 +1,9 @@
 #include "cli_profile.hpp"
 
+#include <sstream>
 #include <string>
+
+#include "ranger_can/wire/candump_log.hpp"
 
 namespace ranger::cli {
 
@@ -26,15 +29,23 @@ Status check_assignment(const std::string& text) {
 
 }  // namespace
 
+std::vector<std::string> protocol_choices() {
+  std::vector<std::string> choices = {"auto"};
+  for (const std::string& n : protocol_revision_names())
+    choices.push_back(n);
+  return choices;
+}
+
 OptionSpec protocol_option() {
   std::string names;
-  for (const std::string& n : protocol_revision_names())
+  for (const std::string& n : protocol_choices())
     names += (names.empty() ? "" : "|") + n;
   return option("--protocol", names,
-                "the protocol revision the chassis speaks: manual (the user manual, the default) "
-                "or agx_v2 (the vendor's current software); docs/PROTOCOL_INTERPRETATIONS.md lists "
-                "what each one sets",
-                one_of(protocol_revision_names()));
+                "the protocol revision the chassis speaks: auto (the default) identifies it from "
+                "the chassis's own frames (a log's frames when reading one); manual (the user "
+                "manual) or agx_v2 (the vendor's current software) force a preset; "
+                "docs/PROTOCOL_INTERPRETATIONS.md lists what each one sets and how auto decides",
+                one_of(protocol_choices()));
 }
 
 OptionSpec set_option() {
@@ -45,8 +56,62 @@ std::vector<OptionSpec> profile_options() {
   return {protocol_option(), set_option()};
 }
 
+bool protocol_is_auto(const ParsedArgs& args) {
+  return args.get_or("--protocol", "auto") == "auto";
+}
+
+std::optional<std::string> protocol_revision(const ParsedArgs& args) {
+  if (protocol_is_auto(args)) return std::nullopt;
+  return args.get_or("--protocol", "manual");
+}
+
+Status apply_set_options(ProtocolProfile& profile, const ParsedArgs& args) {
+  for (const std::string& assignment : args.all("--set")) {
+    if (Status st = apply_setting(profile, assignment); !st) {
+      return Error{st.error().code, "--set: " + st.error().message};
+    }
+  }
+  return ok_status();
+}
+
+bool slurp(std::istream& in, std::string& text) {
+  try {
+    std::string line;
+    while (std::getline(in, line)) {
+      text += line;
+      text += '\n';
+    }
+    return !in.bad();
+  } catch (...) {  // a filebuf may throw on a read error (e.g. EISDIR)
+    return false;
+  }
+}
+
+std::vector<CanFrame> frames_of_text(const std::string& text) {
+  std::vector<CanFrame> frames;
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (auto e = parse_candump_line(line)) frames.push_back(e->frame);
+  }
+  return frames;
+}
+
+Result<ProtocolProfile> profile_for_frames(const ParsedArgs& args,
+                                           const std::vector<CanFrame>& frames,
+                                           const VehicleGeometry& geometry,
+                                           IdentificationStatus* status) {
+  if (!protocol_is_auto(args)) return profile_from_args(args);
+  IdentificationStatus id = identify_log(frames, geometry);
+  ProtocolProfile profile = id.profile;  // the preset it reached, even when nothing was decided
+  if (Status st = apply_set_options(profile, args); !st) return st.error();
+  if (status) *status = std::move(id);
+  return profile;
+}
+
 Result<ProtocolProfile> profile_from_args(const ParsedArgs& args) {
-  Result<ProtocolProfile> profile = protocol_preset(args.get_or("--protocol", "manual"));
+  const std::string revision = args.get_or("--protocol", "auto");
+  Result<ProtocolProfile> profile = protocol_preset(revision == "auto" ? "manual" : revision);
   if (!profile) return Error{profile.error().code, "--protocol: " + profile.error().message};
   for (const std::string& assignment : args.all("--set")) {
     if (Status st = apply_setting(*profile, assignment); !st) {

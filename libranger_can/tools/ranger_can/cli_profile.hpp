@@ -1,7 +1,10 @@
 // The protocol profile on the command line: one place for the options every sub-command that
 // speaks the RANGER protocol takes, and for turning them into a ranger::ProtocolProfile.
 //
-//   --protocol manual|agx_v2   the revision's preset (default manual)
+//   --protocol auto|manual|agx_v2   auto (the default): identified from the chassis's frames
+//                              (control/identification.hpp: a log's frames for decode and odom,
+//                              the live chassis for identify and commission); or a revision's
+//                              preset
 //   --set NAME=VALUE           one interpretation changed after the preset (repeatable, applied in
 //                              order; NAME and VALUE as in docs/PROTOCOL_INTERPRETATIONS.md)
 //
@@ -13,10 +16,16 @@
 //                 if (!profile) return usage_error(spec, io, profile.error().message);
 #pragma once
 
+#include <istream>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "cli_options.hpp"
+#include "ranger_can/control/geometry.hpp"
+#include "ranger_can/control/identification.hpp"
 #include "ranger_can/result.hpp"
+#include "ranger_can/wire/frame.hpp"
 #include "ranger_can/wire/profile.hpp"
 
 namespace ranger::cli {
@@ -25,9 +34,27 @@ OptionSpec protocol_option();               // --protocol REVISION
 OptionSpec set_option();                    // --set NAME=VALUE, repeatable
 std::vector<OptionSpec> profile_options();  // both, in that order
 
-// The preset --protocol names (manual when absent), then every --set in order. The parser has
-// already checked each value against the same rules, so an error here is unexpected; it names the
-// option and lists the valid values all the same.
+// The preset --protocol names (manual for auto or when absent: the fallback), then every --set in
+// order. The parser has already checked each value against the same rules, so an error here is
+// unexpected; it names the option and lists the valid values all the same.
 Result<ProtocolProfile> profile_from_args(const ParsedArgs& args);
+
+// Whether --protocol is auto (given or by default).
+bool protocol_is_auto(const ParsedArgs& args);
+// The preset --protocol names; nullopt for auto.
+std::optional<std::string> protocol_revision(const ParsedArgs& args);
+// Every --set, in order, on `profile` (after an identification).
+Status apply_set_options(ProtocolProfile& profile, const ParsedArgs& args);
+// For a log: with auto, the identification of `frames` (identify_log) and then the --set values;
+// otherwise profile_from_args. `status` (if not null) receives the identification.
+Result<ProtocolProfile> profile_for_frames(const ParsedArgs& args,
+                                           const std::vector<CanFrame>& frames,
+                                           const VehicleGeometry& geometry = {},
+                                           IdentificationStatus* status = nullptr);
+// Reads the whole stream into `text`; false on a read error (an exception of the stream's buffer
+// included).
+bool slurp(std::istream& in, std::string& text);
+// The frames of a candump text (malformed lines skipped: the command's own reader reports them).
+std::vector<CanFrame> frames_of_text(const std::string& text);
 
 }  // namespace ranger::cli

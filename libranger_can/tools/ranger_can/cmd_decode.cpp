@@ -1,8 +1,10 @@
 // `ranger_can decode [FILE] [--json] [--protocol REV] [--set NAME=VALUE]...`: candump logs in, one
 // decoded line per frame out, under a protocol profile (cli_profile). Reading (bounded lines,
 // numbered errors, read errors reported) is cli_input's.
+#include <iterator>
 #include <optional>
 #include <ostream>
+#include <sstream>
 #include <string>
 
 #include "cli_commands.hpp"
@@ -39,6 +41,20 @@ int decode_stream(std::istream& in, bool json, const ProtocolProfile& profile, I
 
 int decode_main(const ParsedArgs& args, Io io) {
   const bool json = args.has("--json");
+  if (protocol_is_auto(args)) {
+    // Two passes: the whole log identifies the settings, then every frame is decoded under them.
+    return with_input(args.get("FILE"), "decode", io, [&](std::istream& in) {
+      std::string text;
+      if (!slurp(in, text)) {
+        io.err << "ranger_can decode: read error\n";
+        return 1;
+      }
+      const Result<ProtocolProfile> profile = profile_for_frames(args, frames_of_text(text));
+      if (!profile) return usage_error(decode_command(), io, profile.error().message);
+      std::istringstream again(text);
+      return decode_stream(again, json, *profile, io);
+    });
+  }
   const Result<ProtocolProfile> profile = profile_from_args(args);
   if (!profile) return usage_error(decode_command(), io, profile.error().message);
   return with_input(args.get("FILE"), "decode", io,
@@ -64,7 +80,11 @@ const CommandSpec& decode_command() {
       "  profile (a steering angle beyond 100 deg) or an error frame.\n"
       "\n"
       "Frames are read under a protocol profile: --protocol picks the revision (units, signs,\n"
-      "the error-word layout, mode numbering), --set changes one interpretation of it.\n"
+      "the error-word layout, mode numbering), --set changes one interpretation of it. With\n"
+      "--protocol auto (the default) the whole log is read first and identifies it: the IDs only\n"
+      "the vendor's revision sends, frame lengths, the 0x211 byte-7 counter, the BMS voltage\n"
+      "scale, and whether the rolling wheels form one rigid-body motion under a 0x271 reading\n"
+      "(`ranger_can identify replay:FILE` prints that decision with its evidence).\n"
       "\n"
       "Malformed lines are reported on stderr as 'line N: reason' (the first 20, then a count)\n"
       "and skipped; blank lines are ignored; frames with extended (29-bit) IDs belong to other\n"

@@ -3,18 +3,20 @@
 // under the protocol profile of --protocol/--set (cli_profile), so the odometry sees every
 // revision in the one convention of codec.hpp.
 #include <istream>
+#include <iterator>
 #include <limits>
 #include <optional>
 #include <ostream>
+#include <sstream>
 #include <string>
 
-#include "ranger_can/parse.hpp"
 #include "cli_commands.hpp"
 #include "cli_input.hpp"
 #include "cli_json.hpp"
 #include "cli_options.hpp"
 #include "cli_profile.hpp"
 #include "ranger_can/control/odometry.hpp"
+#include "ranger_can/parse.hpp"
 #include "ranger_can/wire/candump_log.hpp"
 
 namespace ranger::cli {
@@ -101,6 +103,23 @@ int odom_main(const ParsedArgs& args, Io io) {
   if (Status st = opt.config.validate(); !st) {
     return usage_error(odom_command(), io, st.error().message);
   }
+  if (protocol_is_auto(args)) {
+    // Two passes: the whole log identifies the settings, then the odometry replays it.
+    return with_input(opt.path, "odom", io, [&](std::istream& in) {
+      std::string text;
+      if (!slurp(in, text)) {
+        io.err << "ranger_can odom: read error\n";
+        return 1;
+      }
+      const Result<ProtocolProfile> identified =
+          profile_for_frames(args, frames_of_text(text), opt.config.geometry);
+      if (!identified) return usage_error(odom_command(), io, identified.error().message);
+      Options o = opt;
+      o.profile = *identified;
+      std::istringstream again(text);
+      return replay(again, o, io);
+    });
+  }
   return with_input(opt.path, "odom", io, [&](std::istream& in) { return replay(in, opt, io); });
 }
 
@@ -128,7 +147,8 @@ const CommandSpec& odom_command() {
       "The log needs timestamps (candump -L, or candump -ta): odometry integrates over the "
       "frames'\n"
       "own times. Steps longer than 0.5 s or going backwards are not integrated. Frames are\n"
-      "decoded under the protocol profile of --protocol and --set (units, signs, lengths).\n"
+      "decoded under the protocol profile of --protocol and --set (units, signs, lengths);\n"
+      "--protocol auto (the default) identifies it from the whole log first.\n"
       "Malformed lines are reported on stderr as 'line N: reason' (the first 20, then a count)\n"
       "and skipped; frames with extended (29-bit) IDs (other devices) are counted and skipped.",
       {optional_arg("FILE", "the candump log; standard input when absent or '-'", any_text())},

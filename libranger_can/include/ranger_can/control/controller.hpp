@@ -84,6 +84,11 @@ enum class MotionRefusal {
   kSwitching,         // motion-mode switch in progress (ours or the remote's)
   kCmdTimeout,        // no set_command within cmd_timeout
   kBelowMinimum,      // the twist is below what the chassis can express (1 mm/s)
+  // The protocol settings are not decided yet (DriverConfig::identification: `auto`): no speed is
+  // commanded; only the identification's zero-speed steering probe goes out. Comes after the
+  // stop causes, standby and an unknown mode (the probe needs CAN mode and a known motion mode);
+  // ControllerState::identifying says what is going on.
+  kIdentifying,
 };
 std::string_view to_string(MotionRefusal r);  // "none", "link_lost", "remote", ...
 
@@ -99,7 +104,9 @@ struct ControllerConfig {
   SpeedLimits limit_vy;
   SpeedLimits limit_wz;
 
-  bool auto_command_mode = true;           // request CAN command mode by itself (at start-up)
+  bool auto_command_mode = true;  // request CAN command mode by itself (at start-up)
+  // shutdown() also hands control back: 0x421 standby after the stop (`ranger_can commission`).
+  bool release_control_on_shutdown = false;
   bool auto_reclaim_after_remote = false;  // the old behaviour: reclaim after remote hands back
   bool listen_only = false;                // never send anything (monitoring, log replay)
   std::chrono::nanoseconds link_timeout = std::chrono::milliseconds(100);
@@ -184,6 +191,15 @@ struct ControllerState {
   std::optional<bool> ultrasonic_requested;  // pending set_ultrasonic target
   bool ultrasonic_failed = false;            // not confirmed after the attempts
 
+  // Identification (set_identifying): why motion waits, e.g. "identifying the chassis: listening
+  // (0.4 s of 1.0 s)"; empty when the settings are decided. quiet: nothing is sent at all.
+  std::string identifying;
+  bool quiet = false;
+  std::optional<MotionCommand> probe;  // the zero-speed steering probe being commanded
+  // Why the settings were found contradicted (set_implausible), naming the setting and the value
+  // to try; empty otherwise.
+  std::string implausible_reason;
+
   bool shut_down = false;
   ControllerCounters counters;
   std::string last_error;  // last send/decode error message, for diagnostics
@@ -261,6 +277,22 @@ class ChassisController {
   // faults list), or clears that mark (empty reason): a stop cause like any other.
   void set_implausible(std::string reason);
 
+  // ---- identification (control/identification.hpp; the driver calls these) ----
+  // While `reason` is not empty, motion is refused with kIdentifying ("identifying the chassis:
+  // ..." in state().identifying); an empty reason ends it. Idempotent.
+  void set_identifying(std::string reason);
+  // quiet = true: nothing at all is sent (no 0x421, no keep-alive): the identification listens
+  // before it speaks. The state machine goes on; quiet = false resumes at the next tick.
+  void set_quiet(bool quiet);
+  // While identifying: the zero-speed probe to command instead of a stop. `mode` is switched to
+  // first (at standstill, as any switch), then 0x111 goes out with zero speeds and the probe's
+  // steering (manual signs, as MotionCommand). nullopt: back to the plain stop.
+  void set_probe(std::optional<protocol::MotionMode> mode, std::optional<MotionCommand> command);
+  // The protocol settings from now on (decided by the identification): the codec, the kinematics
+  // and the error-word layout use them at once. Refused (kInvalidArgument) if they do not
+  // validate; the old ones stay then.
+  Status set_profile(const ProtocolProfile& profile);
+
   // Sends a zero 0x111 and stops commanding; later calls send nothing. Idempotent.
   void shutdown(Timestamp now);
 
@@ -307,6 +339,7 @@ class ChassisController {
   Timestamp ultrasonic_sent_{0};
   int ultrasonic_attempts_ = 0;
   std::string implausible_reason_;
+  std::optional<protocol::MotionMode> probe_mode_;
   bool faults_valid_ = false;  // state_.faults matches faults_signature_
   std::uint64_t faults_signature_ = 0;
 };

@@ -31,8 +31,10 @@
 #include "ranger_can/control/controller.hpp"
 #include "ranger_can/control/feedback.hpp"
 #include "ranger_can/control/frame_stats.hpp"
+#include "ranger_can/control/identification.hpp"
 #include "ranger_can/control/joint_tracker.hpp"
 #include "ranger_can/control/odometry.hpp"
+#include "ranger_can/control/plausibility.hpp"
 #include "ranger_can/result.hpp"
 #include "ranger_can/transport/bus.hpp"
 #include "ranger_can/transport/bus_source.hpp"
@@ -41,8 +43,29 @@
 
 namespace ranger {
 
+// Where the protocol settings come from.
+enum class ProtocolChoice {
+  kForced,  // controller.profile as it is (a preset, --set values, a commissioning file)
+  kAuto,    // identified from the chassis before anything moves (identification.hpp)
+};
+std::string_view to_string(ProtocolChoice c);  // "forced" / "auto"
+
 struct DriverConfig {
   ControllerConfig controller;  // geometry, limits, protocol profile, timeouts, ...
+  // kAuto: the driver listens before it sends anything, decides the settings from the chassis's
+  // frames and a zero-speed steering probe, and refuses speed (kIdentifying) until then; a
+  // chassis it cannot identify within identification.timeout stays at rest, the snapshot's
+  // identification.message saying what to set. controller.profile is then only the fallback
+  // for decoding nothing (it is replaced by the decision). kForced (the default) as before.
+  ProtocolChoice protocol = ProtocolChoice::kForced;
+  // kAuto only: start from this preset ("manual", "agx_v2") instead of deciding it.
+  std::optional<std::string> identify_revision;
+  IdentificationConfig identification;
+  // The plausibility monitors (plausibility.hpp), whatever the settings came from. kAuto: a
+  // mismatch of a setting the identification could not decide at rest (the spin sign, 0x221's
+  // speed reading, ...) stops the robot all the same (latched: a zero twist or resume re-arms),
+  // and the value the monitor names is adopted, so that the re-armed robot drives right.
+  PlausibilityConfig plausibility;
   // Source, timeouts and covariances; its geometry and profile are the controller's (one vehicle,
   // one reading: the driver copies them).
   OdometryConfig odometry;
@@ -52,7 +75,7 @@ struct DriverConfig {
   std::chrono::nanoseconds request_answer_timeout = std::chrono::milliseconds(500);
   std::string thread_name = "ranger_driver";  // for top -H and the performance script
 
-  Status validate() const;  // the controller's and the odometry's checks
+  Status validate() const;  // the controller's, odometry's, identification's, monitors' checks
 };
 
 // What became of a request posted through the mailbox.
@@ -67,6 +90,14 @@ struct RequestOutcome {
   Timestamp sent{0};  // driver clock
 };
 std::string_view to_string(RequestOutcome::State s);  // "pending", "sent", "answered", "failed"
+
+// A zero-speed probe at standstill (`ranger_can commission`): the wheels stand in `mode` at
+// `steering` (REP-103 rad: the front wheels' reference angle in Ackermann, the direction of travel
+// in oblique mode), nothing rolls.
+struct StandstillProbe {
+  protocol::MotionMode mode = protocol::MotionMode::kAckermann;
+  double steering = 0.0;
+};
 
 // A frame the driver sent, as the observer sees it.
 struct SentEvent {
@@ -93,7 +124,15 @@ struct DriverSnapshot {
   OdometryState odometry;
   WheelJoints joints;
   FrameStats frames;
-  ProtocolProfile profile;  // the settings in use
+  ProtocolProfile profile;  // the settings in use (the identification's proposal until decided)
+
+  // Where the settings came from, and (kAuto) the identification: phase, decided profile,
+  // evidence lines, confidence, and the failure message naming what to set.
+  ProtocolChoice protocol = ProtocolChoice::kForced;
+  std::optional<IdentificationStatus> identification;
+  // The plausibility monitors: persistent mismatches (WARN, with the value to try) and the one
+  // that stopped the robot (also ControllerState::implausible_reason).
+  PlausibilityStatus plausibility;
 
   std::vector<RequestOutcome> requests;  // the most recent ones, oldest first (at most 16)
   std::uint64_t loop_iterations = 0;
@@ -134,7 +173,11 @@ class Driver {
   // kInvalidArgument (nothing posted) for a code outside 0x00..0x10; else the request's id.
   Result<std::uint64_t> clear_errors(std::uint8_t code);
   std::uint64_t set_ultrasonic(bool enable);
+  // Also clears a plausibility stop (the operator takes it on): the monitors start over.
   std::uint64_t resume();
+  // While set (after the identification, if any): speed is refused (kIdentifying, "standstill
+  // probe ...") and the probe is commanded; nullopt ends it.
+  void standstill_probe(std::optional<StandstillProbe> probe);
 
   // Blocks the calling thread until request `id` is answered or failed, or `timeout` passes
   // (then the outcome as it stands). Only with start(); in lock-step read the snapshot instead.
@@ -157,6 +200,10 @@ class Driver {
   void try_open(Timestamp now);
   void apply_mail(Timestamp now);
   void handle_frame(const CanFrame& frame, Timestamp now);
+  void run_identification(Timestamp now);
+  void run_plausibility(Timestamp now);
+  void run_standstill_probe();
+  void use_profile(const ProtocolProfile& profile, bool reset_odometry = true);
   void update_requests(Timestamp now);
   void publish(Timestamp now);
   void deliver_events();
@@ -171,6 +218,12 @@ class Driver {
   // ---- owned by the driver thread (or the lock-step caller) ----
   std::unique_ptr<Bus> bus_;
   std::unique_ptr<ChassisController> controller_;
+  ProtocolProfile profile_;  // the settings in use (decoding, odometry, monitors)
+  std::optional<ChassisIdentifier> identifier_;
+  PlausibilityMonitor monitor_;
+  std::string applied_stop_;  // the monitor's stop passed to the controller
+  std::optional<StandstillProbe> probe_;
+  bool probe_active_ = false;
   Odometry odometry_;
   WheelJointTracker joints_;
   FrameStats frames_;

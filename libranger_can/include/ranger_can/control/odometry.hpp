@@ -117,6 +117,8 @@ class Odometry {
 
   // Back to `pose` with the initial covariance; twist, counters and time anchor cleared.
   void reset(const Pose2D& pose = {});
+  // Reads later frames under `profile` (a setting learned while driving); the pose stays.
+  void set_profile(const ProtocolProfile& profile) { config_.profile = profile; }
 
   const OdometryState& state() const { return state_; }
   const OdometryConfig& config() const { return config_; }

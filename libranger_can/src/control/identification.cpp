@@ -1,0 +1,860 @@
+#include "ranger_can/control/identification.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <utility>
+#include <variant>
+
+#include "ranger_can/control/kinematics.hpp"
+#include "ranger_can/control/odometry.hpp"
+#include "ranger_can/wire/interpretation.hpp"
+
+namespace ranger {
+namespace {
+
+using namespace std::chrono_literals;
+using protocol::MotionMode;
+
+constexpr double kDeg = M_PI / 180.0;
+// 0x271 counts as unchanged while every wheel stays within this (read in 0.01 deg: 2.5 units).
+constexpr double kSettleTolerance = 0.025 * kDeg;
+// Rolling wheels for a rigid-body sample, and the smallest angle (read in 0.01 deg) that makes
+// a sample tell the 0x271 readings apart.
+constexpr double kRollingSpeed = 0.05;  // m/s
+constexpr double kInformativeAngle = 0.3 * kDeg;
+constexpr int kMinRigidSamples = 10;
+constexpr int kMinByte7Steps = 10;
+constexpr int kMaxSteerProbes = 2;
+// The reference (inner vs mean) is judged only at angles where the two differ measurably.
+constexpr double kMinReferenceAngle = 3.0 * kDeg;
+
+std::string fmt(const char* format, double a) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, format, a);
+  return buf;
+}
+std::string deg(double rad) {
+  return fmt("%.2f", rad / kDeg) + " deg";
+}
+std::string secs(std::chrono::nanoseconds d) {
+  return fmt("%.2f", seconds(d)) + " s";
+}
+std::string hex_id(std::uint32_t id) {
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "0x%03X", static_cast<unsigned>(id));
+  return buf;
+}
+
+const std::array<AngleUnit, 2> kUnits = {AngleUnit::kCentidegree, AngleUnit::kMilliradian};
+const std::array<SteeringSign, 2> kSigns = {SteeringSign::kRightPositive,
+                                            SteeringSign::kLeftPositive};
+const std::array<SteeringReference, 2> kReferences = {SteeringReference::kMeanFront,
+                                                      SteeringReference::kInnerFront};
+
+// The best and second-best of a set of residuals (infinity for missing ones).
+struct Ranking {
+  int best = -1;
+  double best_residual = std::numeric_limits<double>::infinity();
+  double second_residual = std::numeric_limits<double>::infinity();
+  void add(int index, double residual) {
+    if (residual < best_residual) {
+      second_residual = best_residual;
+      best_residual = residual;
+      best = index;
+    } else if (residual < second_residual) {
+      second_residual = residual;
+    }
+  }
+  // Whether the best is within `tolerance` and the second at least `margin` times worse (a floor
+  // keeps an exact fit from asking for an infinite margin of nothing).
+  bool clear(double tolerance, double margin, double floor) const {
+    return best >= 0 && best_residual <= tolerance &&
+           second_residual >= margin * std::max(best_residual, floor);
+  }
+  double confidence() const {
+    if (!std::isfinite(second_residual) || second_residual <= 0.0) return 1.0;
+    return std::clamp(1.0 - best_residual / second_residual, 0.0, 1.0);
+  }
+};
+
+std::string values_text(const std::array<double, 4>& a) {
+  std::string out;
+  for (double v : a)
+    out += (out.empty() ? "" : " ") + fmt("%.2f", v / kDeg);
+  return out + " deg";
+}
+
+}  // namespace
+
+std::string_view to_string(IdentificationPhase p) {
+  switch (p) {
+    case IdentificationPhase::kListening:
+      return "listening";
+    case IdentificationPhase::kAwaitingControl:
+      return "awaiting_control";
+    case IdentificationPhase::kSpinCheck:
+      return "spin_check";
+    case IdentificationPhase::kSteerProbe:
+      return "steer_probe";
+    case IdentificationPhase::kReturning:
+      return "returning";
+    case IdentificationPhase::kDecided:
+      return "decided";
+    case IdentificationPhase::kFailed:
+      return "failed";
+  }
+  return "unknown";
+}
+
+Status IdentificationConfig::validate() const {
+  if (listen_time.count() <= 0 || timeout.count() <= 0 || step_timeout.count() <= 0 ||
+      settle_time.count() <= 0) {
+    return Error{Errc::kOutOfRange,
+                 "identification: listen_time, timeout, step_timeout and settle_time must be > 0"};
+  }
+  if (listen_time >= timeout) {
+    return Error{Errc::kOutOfRange, "identification: listen_time must be shorter than timeout"};
+  }
+  if (min_status_frames < 1) {
+    return Error{Errc::kOutOfRange, "identification: min_status_frames must be >= 1"};
+  }
+  if (!(probe_angle > 1.0 * kDeg && probe_angle <= 7.0 * kDeg)) {
+    return Error{Errc::kOutOfRange,
+                 "identification: probe_angle must be in (1, 7] deg (read 5.7 times larger in "
+                 "the other unit it must stay within the 40 deg Ackermann range)"};
+  }
+  if (!(angle_tolerance > 0.0) || !(margin > 1.0)) {
+    return Error{Errc::kOutOfRange, "identification: angle_tolerance must be > 0 and margin > 1"};
+  }
+  return ok_status();
+}
+
+std::string unidentified_message(const std::string& reason, std::chrono::nanoseconds timeout) {
+  return "the chassis could not be identified within " + secs(timeout) +
+         " (identify_timeout): " + reason +
+         ". The robot stays at rest. Set the protocol instead of `auto` (protocol: manual or "
+         "protocol: agx_v2, and single settings such as steering_unit_111: millirad), or "
+         "commission it once with the wheels off the ground: `ranger_can commission IFACE "
+         "--wheels-lifted --output FILE`, then load FILE with the parameter commissioning_file";
+}
+
+ChassisIdentifier::ChassisIdentifier(IdentificationConfig config, VehicleGeometry geometry,
+                                     std::optional<std::string> forced_revision, bool read_only)
+    : config_(std::move(config)),
+      geometry_(geometry),
+      forced_revision_(std::move(forced_revision)),
+      read_only_(read_only) {
+  status_.revision = forced_revision_.value_or("manual");
+  if (auto p = protocol_preset(status_.revision)) status_.profile = *p;
+  status_.message = "listening";
+}
+
+void ChassisIdentifier::start(Timestamp now) {
+  if (started_) return;
+  started_ = true;
+  status_.started = now;
+  status_.finished = now;
+}
+
+void ChassisIdentifier::note(std::string line) {
+  status_.evidence.push_back(std::move(line));
+}
+
+void ChassisIdentifier::set(std::string_view name, std::string_view value, std::string evidence) {
+  if (Status st = set_setting(status_.profile, name, value); !st) {
+    note("internal: " + st.error().message);
+    return;
+  }
+  for (IdentifiedSetting& s : status_.decided) {
+    if (s.name == name) {
+      s.value = std::string(value);
+      s.evidence = evidence;
+      note(evidence);
+      return;
+    }
+  }
+  status_.decided.push_back({std::string(name), std::string(value), evidence});
+  note(std::move(evidence));
+}
+
+std::optional<std::array<double, 4>> ChassisIdentifier::wheel_angles(const CanFrame& frame,
+                                                                     AngleUnit unit,
+                                                                     SteeringSign sign) const {
+  ProtocolProfile p = status_.profile;
+  p.steering_unit_271 = unit;
+  p.steering_sign_271 = sign;
+  Result<Message> m = decode(frame, p);
+  if (!m) return std::nullopt;  // e.g. beyond any model's reach under this reading
+  const auto* a = std::get_if<SteeringAnglesFeedback>(&*m);
+  if (a == nullptr) return std::nullopt;
+  std::array<double, 4> out{};
+  for (std::size_t i = 0; i < out.size(); ++i)
+    out[i] = interpretation::rep103_from_manual_wheel_angle(a->angles[i]);
+  return out;
+}
+
+// ---- frames
+// --------------------------------------------------------------------------------------
+
+void ChassisIdentifier::on_frame(const CanFrame& frame, Timestamp now) {
+  start(now);
+  if (frame.is_error || status_.done()) return;
+  observe_passive(frame);
+  observe_probe(frame, now);
+}
+
+void ChassisIdentifier::observe_passive(const CanFrame& frame) {
+  const std::uint32_t id = frame.id;
+  // IDs only the vendor's revision sends.
+  if (id == protocol::kLightStateId || id == protocol::kRemoteControlStateId ||
+      id == protocol::kOdometerId ||
+      (id == protocol::kVersionId && !protocol::is_version_request(frame))) {
+    const std::string what = hex_id(id) + " (" + std::string(protocol::frame_name(id)) + ")";
+    if (std::find(agx_signatures_.begin(), agx_signatures_.end(), what) == agx_signatures_.end()) {
+      agx_signatures_.push_back(what);
+    }
+  }
+  // Padding: a chassis frame longer than its layout (the host's own commands do not count).
+  const bool host_frame = id == protocol::kMotionCommandId || id == protocol::kLightCommandId ||
+                          id == protocol::kMotionModeCommandId ||
+                          id == protocol::kControlModeCommandId ||
+                          id == protocol::kErrorClearCommandId ||
+                          id == protocol::kUltrasonicSettingId || id == protocol::kVersionId;
+  if (!host_frame && protocol::extra_bytes(frame) > 0 &&
+      std::find(padded_ids_.begin(), padded_ids_.end(), id) == padded_ids_.end()) {
+    padded_ids_.push_back(id);
+  }
+
+  if (id == protocol::kSystemStatusId) {
+    // Read with the agx16 layout: byte 7 is then `counter`, whatever the chassis means by it.
+    ProtocolProfile agx = status_.profile;
+    agx.error_word = ErrorWordLayout::kAgxV2_16;
+    Result<Message> m = decode(frame, agx);
+    if (!m) return;
+    const auto& st = std::get<SystemStatus>(*m);
+    if (status_frames_++ == 0) first_status_ = status_.started;
+    status_voltage_ = st.battery_voltage;
+    if (st.control_mode_raw == static_cast<std::uint8_t>(protocol::ControlMode::kUart)) {
+      uart_seen_ = true;
+    }
+    const std::uint8_t b7 = st.counter.value_or(0);
+    if (last_byte7_) {
+      ++byte7_steps_;
+      if (b7 != *last_byte7_) ++byte7_changes_;
+      if (b7 == static_cast<std::uint8_t>(*last_byte7_ + 1)) ++byte7_increments_;
+    }
+    last_byte7_ = b7;
+    return;
+  }
+  if (id == protocol::kMotionModeFeedbackId) {
+    Result<Message> m = decode(frame, status_.profile);
+    if (m) max_mode_raw_ = std::max<int>(max_mode_raw_, std::get<MotionModeFeedback>(*m).mode_raw);
+    return;
+  }
+  if (id == protocol::kBmsBaseId) {  // the whole pack
+    ProtocolProfile p = status_.profile;
+    p.bms_voltage_scale = 0.01;
+    Result<Message> m = decode(frame, p);
+    if (!m || !status_voltage_) return;
+    const double v001 = std::get<BmsData>(*m).voltage;
+    const double v01 = v001 * 10.0;
+    const double ref = *status_voltage_;
+    const double tol = std::max(2.0, 0.05 * ref);
+    ++bms_frames_;
+    if (std::fabs(v001 - ref) <= tol) ++bms_agree_001_;
+    if (std::fabs(v01 - ref) <= tol) ++bms_agree_01_;
+    return;
+  }
+  if (id == protocol::kSteeringAnglesId) {
+    last_angles_frame_ = frame;
+    last_angles_time_ = frame.stamp;
+    return;
+  }
+  if (id == protocol::kWheelSpeedsId && last_angles_frame_ &&
+      frame.stamp - last_angles_time_ <= 60ms && frame.stamp >= last_angles_time_) {
+    Result<Message> m = decode(frame, status_.profile);
+    if (!m) return;
+    const auto& speeds = std::get<WheelSpeedsFeedback>(*m).speeds;
+    double fastest = 0.0;
+    for (double s : speeds)
+      fastest = std::max(fastest, std::fabs(s));
+    if (fastest < kRollingSpeed) return;
+    // Informative only when the wheels are steered (straight wheels fit every reading).
+    const auto plain =
+        wheel_angles(*last_angles_frame_, AngleUnit::kCentidegree, SteeringSign::kRightPositive);
+    if (plain) {
+      double widest = 0.0;
+      for (double a : *plain)
+        widest = std::max(widest, std::fabs(a));
+      if (widest < kInformativeAngle) return;
+    }
+    double norm = 0.0;
+    for (double s : speeds)
+      norm += s * s;
+    ++rigid_samples_;
+    for (int h = 0; h < 4; ++h) {
+      const auto angles = wheel_angles(*last_angles_frame_, kUnits[h / 2], kSigns[h % 2]);
+      if (!angles) {
+        ++rigid_impossible_[h];
+        continue;
+      }
+      std::array<WheelMeasurement, kWheelCount> wheels{};
+      for (int i = 0; i < kWheelCount; ++i)
+        wheels[i] = {(*angles)[i], speeds[i]};
+      const BodyTwist t = fit_body_twist(wheels, geometry_);
+      double r = 0.0;
+      for (int i = 0; i < kWheelCount; ++i) {
+        const WheelPosition p = geometry_.wheel_position(i);
+        const double ex = t.vx - t.wz * p.y - speeds[i] * std::cos((*angles)[i]);
+        const double ey = t.vy + t.wz * p.x - speeds[i] * std::sin((*angles)[i]);
+        r += ex * ex + ey * ey;
+      }
+      rigid_residual_[h] += r / norm;
+    }
+  }
+}
+
+void ChassisIdentifier::observe_probe(const CanFrame& frame, Timestamp now) {
+  if (frame.id == protocol::kSystemStatusId) {
+    Result<Message> m = decode(frame, status_.profile);
+    if (m) control_mode_raw_ = std::get<SystemStatus>(*m).control_mode_raw;
+  } else if (frame.id == protocol::kMotionModeFeedbackId) {
+    Result<Message> m = decode(frame, status_.profile);
+    if (!m) return;
+    const auto& mm = std::get<MotionModeFeedback>(*m);
+    mode_ = mm.mode_known ? std::optional<MotionMode>(mm.mode) : std::nullopt;
+    switching_ = mm.switching;
+  } else if (frame.id == protocol::kSteeringAnglesId) {
+    const auto before =
+        angles_ ? wheel_angles(*angles_, AngleUnit::kCentidegree, SteeringSign::kRightPositive)
+                : std::nullopt;
+    const auto after = wheel_angles(frame, AngleUnit::kCentidegree, SteeringSign::kRightPositive);
+    bool changed = !angles_;
+    if (!changed) {
+      if (before && after) {
+        for (std::size_t i = 0; i < 4; ++i)
+          changed = changed || std::fabs((*before)[i] - (*after)[i]) > kSettleTolerance;
+      } else {
+        changed = !std::equal(frame.data.begin(), frame.data.begin() + frame.dlc,
+                              angles_->data.begin()) ||
+                  frame.dlc != angles_->dlc;
+      }
+    }
+    if (changed) angles_changed_ = now;
+    angles_ = frame;
+  } else if (frame.id == protocol::kMotionFeedbackId) {
+    motion_ = frame;
+  }
+}
+
+// ---- phases
+// --------------------------------------------------------------------------------------
+
+void ChassisIdentifier::tick(Timestamp now) {
+  start(now);
+  if (status_.done()) return;
+  status_.finished = now;
+  if (now - status_.started >= config_.timeout) {
+    std::string why;
+    switch (status_.phase) {
+      case IdentificationPhase::kListening:
+        why = status_frames_ == 0 ? "no system status (0x211) heard: is the chassis on and the bus "
+                                    "at 500 kbit/s?"
+                                  : "too few system status frames (0x211) heard";
+        break;
+      case IdentificationPhase::kAwaitingControl:
+        why = !control_mode_raw_ ? "no system status (0x211) heard"
+              : *control_mode_raw_ != static_cast<std::uint8_t>(protocol::ControlMode::kCan)
+                  ? "CAN command mode was not granted (0x211 control mode " +
+                        std::to_string(*control_mode_raw_) + "): is the remote control in charge?"
+                  : "no known motion mode (0x291) reported";
+        break;
+      default:
+        why = "the steering probe did not finish (" + std::string(to_string(status_.phase)) + ")";
+        break;
+    }
+    fail(why, now);
+    return;
+  }
+  switch (status_.phase) {
+    case IdentificationPhase::kListening:
+      if (status_frames_ >= static_cast<std::uint64_t>(config_.min_status_frames) &&
+          now - status_.started >= config_.listen_time) {
+        decide_passive(now);
+        if (read_only_) {
+          decide(now);
+        } else {
+          status_.phase = IdentificationPhase::kAwaitingControl;
+          status_.message = "identifying the chassis: waiting for CAN command mode";
+        }
+      } else {
+        status_.message = "identifying the chassis: listening (" + secs(now - status_.started) +
+                          " of " + secs(config_.listen_time) + ")";
+      }
+      break;
+    case IdentificationPhase::kAwaitingControl:
+      if (control_mode_raw_ == static_cast<std::uint8_t>(protocol::ControlMode::kCan) && mode_ &&
+          !switching_) {
+        begin_step(config_.spin_check && !verdict_271_ ? IdentificationPhase::kSpinCheck
+                                                       : IdentificationPhase::kSteerProbe,
+                   now);
+      }
+      break;
+    case IdentificationPhase::kSpinCheck:
+      if (settled(now)) {
+        evaluate_spin(now);
+      } else if (now - step_started_ >= config_.step_timeout) {
+        note("spin check: no settled answer within " + secs(config_.step_timeout) + " (mode " +
+             (mode_ ? std::string(protocol::to_string(*mode_)) : std::string("unknown")) +
+             "); the steering probe decides the 0x271 reading alone");
+        begin_step(IdentificationPhase::kSteerProbe, now);
+      }
+      break;
+    case IdentificationPhase::kSteerProbe:
+      if (settled(now)) {
+        evaluate_steer(now);
+      } else if (now - step_started_ >= config_.step_timeout) {
+        fail(
+            "the steering probe got no settled answer (0x271) within " + secs(config_.step_timeout),
+            now);
+      }
+      break;
+    case IdentificationPhase::kReturning:
+      if (settled(now) || now - step_started_ >= config_.step_timeout) decide(now);
+      break;
+    default:
+      break;
+  }
+}
+
+void ChassisIdentifier::begin_step(IdentificationPhase phase, Timestamp now) {
+  status_.phase = phase;
+  step_started_ = now;
+  angles_changed_ = now;
+  switch (phase) {
+    case IdentificationPhase::kSpinCheck:
+      status_.message = "identifying the chassis: spin position at standstill";
+      break;
+    case IdentificationPhase::kSteerProbe: {
+      ++steer_probes_;
+      // The probe: probe_angle to the left (REP-103) under the proposal, as the codec will send
+      // it (rounded to the wire's unit).
+      MotionCommand c;
+      c.steering_angle = interpretation::manual_from_rep103_command_steering(config_.probe_angle);
+      Result<CanFrame> f = encode(c, status_.profile);
+      Result<Message> back = f ? decode(*f, status_.profile) : Result<Message>(f.error());
+      probe_wire_angle_ = back ? std::get<MotionCommand>(*back).steering_angle : c.steering_angle;
+      status_.message =
+          "identifying the chassis: steering probe " + deg(config_.probe_angle) + " at standstill";
+      break;
+    }
+    case IdentificationPhase::kReturning:
+      status_.message = "identifying the chassis: wheels back to straight";
+      break;
+    default:
+      break;
+  }
+}
+
+bool ChassisIdentifier::settled(Timestamp now) const {
+  MotionMode wanted = MotionMode::kAckermann;
+  if (status_.phase == IdentificationPhase::kSpinCheck) wanted = MotionMode::kSpin;
+  if (mode_ != wanted || switching_ || !angles_) return false;
+  // At least a settle time after the step began (the command needs a moment to arrive), and the
+  // wheels unchanged for one.
+  return now - step_started_ >= 2 * config_.settle_time &&
+         now - angles_changed_ >= config_.settle_time;
+}
+
+void ChassisIdentifier::evaluate_spin(Timestamp now) {
+  const auto expected =
+      wheel_angles_for_command(MotionCommand{}, MotionMode::kSpin, geometry_, status_.profile);
+  Ranking rank;
+  std::string seen;
+  for (int h = 0; h < 4; ++h) {
+    const auto angles = wheel_angles(*angles_, kUnits[h / 2], kSigns[h % 2]);
+    if (!angles) continue;
+    double r = 0.0;
+    for (std::size_t i = 0; i < 4; ++i)
+      r = std::max(r, std::fabs((*angles)[i] - expected[i]));
+    rank.add(h, r);
+  }
+  const auto plain = wheel_angles(*angles_, AngleUnit::kCentidegree, SteeringSign::kRightPositive);
+  const double tol = config_.angle_tolerance + 0.1 * std::fabs(expected[0]);
+  if (rank.clear(tol, config_.margin, 0.2 * kDeg)) {
+    const Hypothesis271 v{kUnits[rank.best / 2], kSigns[rank.best % 2]};
+    verdict_271_ = v;
+    min_margin_ = std::min(min_margin_, rank.confidence());
+    const std::string read = std::string("spin position at standstill: 0x271 read ") +
+                             (plain ? values_text(*plain) + " in 0.01 deg" : "beyond 100 deg") +
+                             ", expected +-" + deg(std::fabs(expected[0])) +
+                             " (atan(wheelbase/track), RF +, RR -, LR +, LF - in REP-103)";
+    set("steering_unit_271", to_string(v.unit),
+        read + ": the unit is " + std::string(to_string(v.unit)));
+    set("steering_sign_271", to_string(v.sign),
+        "spin position sign pattern: " + std::string(to_string(v.sign)));
+  } else {
+    note("spin check inconclusive: 0x271 " + (plain ? values_text(*plain) : std::string("?")) +
+         " fits no reading of the spin position " + deg(std::fabs(expected[0])) +
+         " (best residual " + deg(rank.best_residual) + ")");
+  }
+  begin_step(IdentificationPhase::kSteerProbe, now);
+}
+
+void ChassisIdentifier::evaluate_steer(Timestamp now) {
+  // Every combination of the 0x111 reading (unit, sign, reference) and the 0x271 reading (the
+  // spin check's verdict, or all four): the predicted wheel angles against the measured ones.
+  struct Combo {
+    AngleUnit u111;
+    SteeringSign s111;
+    SteeringReference ref;
+    AngleUnit u271;
+    SteeringSign s271;
+    double commanded;  // REP-103 angle the chassis reads
+  };
+  std::vector<Combo> combos;
+  std::vector<double> residuals;
+  const std::vector<Hypothesis271> h271 = verdict_271_
+                                              ? std::vector<Hypothesis271>{*verdict_271_}
+                                              : std::vector<Hypothesis271>{{kUnits[0], kSigns[0]},
+                                                                           {kUnits[0], kSigns[1]},
+                                                                           {kUnits[1], kSigns[0]},
+                                                                           {kUnits[1], kSigns[1]}};
+  // The wire value the probe went out as, read under each 0x111 hypothesis.
+  MotionCommand sent;
+  sent.steering_angle = probe_wire_angle_;
+  const Result<CanFrame> wire = encode(sent, status_.profile);
+  for (AngleUnit u111 : kUnits) {
+    for (SteeringSign s111 : kSigns) {
+      ProtocolProfile p = status_.profile;
+      p.steering_unit_111 = u111;
+      p.steering_sign_111 = s111;
+      Result<Message> read = wire ? decode(*wire, p) : Result<Message>(wire.error());
+      if (!read) continue;
+      const MotionCommand as_read = std::get<MotionCommand>(*read);
+      for (SteeringReference ref : kReferences) {
+        p.steering_reference = ref;
+        const auto predicted =
+            wheel_angles_for_command(as_read, MotionMode::kAckermann, geometry_, p);
+        for (const Hypothesis271& h : h271) {
+          const auto measured = wheel_angles(*angles_, h.unit, h.sign);
+          if (!measured) continue;
+          double r = 0.0;
+          for (std::size_t i = 0; i < 4; ++i)
+            r = std::max(r, std::fabs((*measured)[i] - predicted[i]));
+          combos.push_back(
+              {u111, s111, ref, h.unit, h.sign,
+               interpretation::rep103_from_manual_command_steering(as_read.steering_angle)});
+          residuals.push_back(r);
+        }
+      }
+    }
+  }
+  const auto plain = wheel_angles(*angles_, AngleUnit::kCentidegree, SteeringSign::kRightPositive);
+  const std::string seen = plain ? values_text(*plain) + " (read in 0.01 deg)" : "beyond 100 deg";
+  // Units and signs first (the reference set aside: it is a 6 % effect).
+  Ranking gross;
+  for (std::size_t c = 0; c < combos.size(); ++c) {
+    bool dominated = false;  // keep one entry per (u111, s111, u271, s271): its best reference
+    for (std::size_t d = 0; d < combos.size(); ++d) {
+      if (d != c && combos[d].u111 == combos[c].u111 && combos[d].s111 == combos[c].s111 &&
+          combos[d].u271 == combos[c].u271 && combos[d].s271 == combos[c].s271 &&
+          (residuals[d] < residuals[c] || (residuals[d] == residuals[c] && d < c))) {
+        dominated = true;
+      }
+    }
+    if (!dominated) gross.add(static_cast<int>(c), residuals[c]);
+  }
+  const double probe_tol = config_.angle_tolerance + 0.1 * 6.0 * config_.probe_angle;
+  // An answer too small to tell the readings apart: probe again in the unit the best fit names.
+  if (!gross.clear(probe_tol, config_.margin, 0.1 * kDeg) && gross.best >= 0 &&
+      gross.best_residual <= probe_tol && steer_probes_ < kMaxSteerProbes) {
+    const Combo& b = combos[static_cast<std::size_t>(gross.best)];
+    if (std::fabs(b.commanded) < kMinReferenceAngle &&
+        b.u111 != status_.profile.steering_unit_111) {
+      note("steering probe 1: 0x271 came back " + (plain ? values_text(*plain) : std::string("?")) +
+           ", too small to judge: probing again in " + std::string(to_string(b.u111)));
+      status_.profile.steering_unit_111 = b.u111;
+      begin_step(IdentificationPhase::kSteerProbe, now);
+      return;
+    }
+  }
+  if (!gross.clear(probe_tol, config_.margin, 0.1 * kDeg)) {
+    fail("the steering probe's answer fits no reading of the protocol: 0x111 steering " +
+             deg(config_.probe_angle) + " to the left (as " +
+             std::string(to_string(status_.profile.steering_unit_111)) + ", " +
+             std::string(to_string(status_.profile.steering_sign_111)) + "), 0x271 came back " +
+             seen + (gross.best >= 0 ? ", best fit off by " + deg(gross.best_residual) : ""),
+         now);
+    return;
+  }
+  const Combo g = combos[static_cast<std::size_t>(gross.best)];
+  const double actual = std::fabs(g.commanded);
+  // 5.7 times smaller than asked: probe again in the corrected unit, so that the reference is
+  // judged at a useful angle.
+  if (actual < kMinReferenceAngle && steer_probes_ < kMaxSteerProbes &&
+      g.u111 != status_.profile.steering_unit_111) {
+    note("steering probe 1: 0x271 came back " + seen + ", " + deg(actual) + " where " +
+         deg(config_.probe_angle) + " was asked: 0x111 reads " + std::string(to_string(g.u111)) +
+         "; probing again in that unit");
+    status_.profile.steering_unit_111 = g.u111;
+    status_.profile.steering_sign_111 = g.s111;
+    begin_step(IdentificationPhase::kSteerProbe, now);
+    return;
+  }
+  min_margin_ = std::min(min_margin_, gross.confidence());
+  if (!verdict_271_) {
+    set("steering_unit_271", to_string(g.u271),
+        "steering probe: 0x271 came back " + seen + ": the four wheels fit 0x271 in " +
+            std::string(to_string(g.u271)));
+    set("steering_sign_271", to_string(g.s271),
+        "steering probe: the wheels' pattern fits 0x271 " + std::string(to_string(g.s271)));
+    verdict_271_ = Hypothesis271{g.u271, g.s271};
+  }
+  const std::string asked = "steering probe: " + deg(config_.probe_angle) +
+                            " to the left asked at standstill, the wheels stand at " + seen;
+  set("steering_unit_111", to_string(g.u111),
+      asked + ": 0x111 reads " + std::string(to_string(g.u111)) + " (" + deg(actual) + " steered)");
+  set("steering_sign_111", to_string(g.s111),
+      std::string("steering probe: the wheels turned ") + (g.commanded > 0 ? "left" : "right") +
+          ": 0x111 is " + std::string(to_string(g.s111)));
+  // The reference: the two entries of the winning units and signs.
+  double r_ref[2] = {std::numeric_limits<double>::infinity(),
+                     std::numeric_limits<double>::infinity()};
+  for (std::size_t c = 0; c < combos.size(); ++c) {
+    const Combo& k = combos[c];
+    if (k.u111 == g.u111 && k.s111 == g.s111 && k.u271 == g.u271 && k.s271 == g.s271) {
+      r_ref[k.ref == SteeringReference::kInnerFront ? 1 : 0] = residuals[c];
+    }
+  }
+  const int best_ref = r_ref[1] < r_ref[0] ? 1 : 0;
+  const double lo = r_ref[best_ref], hi = r_ref[1 - best_ref];
+  if (actual >= kMinReferenceAngle && hi >= config_.margin * std::max(lo, 0.05 * kDeg)) {
+    min_margin_ = std::min(min_margin_, hi > 0 ? 1.0 - lo / hi : 1.0);
+    set("steering_reference", to_string(kReferences[static_cast<std::size_t>(best_ref)]),
+        std::string("steering probe: ") +
+            (best_ref == 1 ? "the inner front wheel" : "the front wheels' mean") +
+            " stands at the commanded " + deg(actual) + " (off by " + deg(lo) + "; the " +
+            (best_ref == 1 ? "mean" : "inner wheel") + " is off by " + deg(hi) + ")");
+  } else {
+    note("steering probe: the reference (inner or mean front wheel) is not decidable at " +
+         deg(actual) + " (residuals " + deg(r_ref[0]) + " mean, " + deg(r_ref[1]) +
+         " inner): kept " + std::string(to_string(status_.profile.steering_reference)));
+  }
+  // 0x221: its angle against what the chassis should report for the wheels as they stand.
+  if (motion_) {
+    const auto measured = wheel_angles(*angles_, g.u271, g.s271);
+    const auto& m = *measured;
+    const double mean_front = (m[kRightFront] + m[kLeftFront]) / 2.0;
+    const double inner_front =
+        std::fabs(m[kRightFront]) > std::fabs(m[kLeftFront]) ? m[kRightFront] : m[kLeftFront];
+    const double expected = status_.profile.steering_reference == SteeringReference::kInnerFront
+                                ? inner_front
+                                : mean_front;
+    Ranking r221;
+    for (int h = 0; h < 4; ++h) {
+      ProtocolProfile p = status_.profile;
+      p.steering_unit_221 = kUnits[h / 2];
+      p.steering_sign_221 = kSigns[h % 2];
+      Result<Message> fb = decode(*motion_, p);
+      if (!fb) continue;
+      const double a =
+          interpretation::rep103_from_manual_steering(std::get<MotionFeedback>(*fb).steering_angle);
+      r221.add(h, std::fabs(a - expected));
+    }
+    if (std::fabs(expected) >= 1.0 * kDeg &&
+        r221.clear(config_.angle_tolerance + 0.1 * std::fabs(expected), config_.margin,
+                   0.1 * kDeg)) {
+      min_margin_ = std::min(min_margin_, r221.confidence());
+      set("steering_unit_221", to_string(kUnits[r221.best / 2]),
+          "steering probe: 0x221 reports " + deg(expected) + " in " +
+              std::string(to_string(kUnits[r221.best / 2])));
+      set("steering_sign_221", to_string(kSigns[r221.best % 2]),
+          "steering probe: 0x221's angle is " + std::string(to_string(kSigns[r221.best % 2])));
+    } else {
+      note("steering probe: 0x221's angle fits no reading clearly: kept its preset");
+    }
+  } else {
+    note("steering probe: no 0x221 heard: its steering unit and sign kept from the preset");
+  }
+  begin_step(IdentificationPhase::kReturning, now);
+}
+
+void ChassisIdentifier::decide_passive(Timestamp now) {
+  const std::string listened = secs(now - status_.started);
+  if (!forced_revision_) {
+    if (!agx_signatures_.empty() || uart_seen_) {
+      status_.revision = "agx_v2";
+      std::string what;
+      for (const auto& s : agx_signatures_)
+        what += (what.empty() ? "" : ", ") + s;
+      if (uart_seen_) what += std::string(what.empty() ? "" : ", ") + "0x211 control mode 2 (UART)";
+      note("heard " + what + ": only the vendor's revision sends it: preset agx_v2");
+    } else {
+      status_.revision = "manual";
+      note(
+          "no frame only the vendor's revision sends (0x231, 0x241, 0x311, 0x4A1 answers, "
+          "control mode UART) in " +
+          listened + ": preset manual");
+    }
+  } else {
+    note("preset " + status_.revision + " given (not identified)");
+  }
+  if (auto p = protocol_preset(status_.revision)) status_.profile = *p;
+  // Frame lengths.
+  if (!padded_ids_.empty()) {
+    std::string ids;
+    for (std::uint32_t id : padded_ids_)
+      ids += (ids.empty() ? "" : ", ") + hex_id(id);
+    set("tx_dlc", "8",
+        "the chassis pads its frames (" + ids +
+            " longer than their layout): commands padded to 8 bytes");
+  } else {
+    note("no chassis frame longer than its layout: tx_dlc kept at the preset's " +
+         std::to_string(status_.profile.tx_dlc));
+  }
+  // 0x211 byte 7.
+  if (byte7_steps_ >= kMinByte7Steps && byte7_increments_ * 10 >= byte7_steps_ * 9) {
+    set("error_word", "agx16",
+        "0x211 byte 7 rose by one in " + std::to_string(byte7_increments_) + " of " +
+            std::to_string(byte7_steps_) + " frames: a counter, so bytes 4-5 are the error word");
+  } else if (byte7_steps_ >= kMinByte7Steps && byte7_changes_ == 0) {
+    set("error_word", to_string(status_.profile.error_word),
+        "0x211 byte 7 constant over " + std::to_string(byte7_steps_ + 1) +
+            " frames: no counter; the preset's layout stands");
+  } else {
+    note("0x211 byte 7 neither counts nor stays constant (" + std::to_string(byte7_changes_) +
+         " changes in " + std::to_string(byte7_steps_) + " frames): error_word kept");
+  }
+  // Motion-mode numbering.
+  if (max_mode_raw_ > 2 && status_.profile.mode_numbering == ModeNumbering::kManual) {
+    set("mode_numbering", "agx_v2",
+        "0x291 reported mode " + std::to_string(max_mode_raw_) +
+            ": beyond the manual's 0-2, so the vendor's numbering");
+  }
+  // BMS voltage scale.
+  if (bms_frames_ > 0 && bms_agree_01_ != bms_agree_001_) {
+    const bool tenth = bms_agree_01_ > bms_agree_001_;
+    set("bms_voltage_scale", tenth ? "0.1" : "0.01",
+        "0x361 voltage agrees with 0x211's " + fmt("%.1f", status_voltage_.value_or(0.0)) +
+            " V in " + (tenth ? "0.1 V" : "0.01 V") + " (" +
+            std::to_string(std::max(bms_agree_01_, bms_agree_001_)) + " of " +
+            std::to_string(bms_frames_) + " frames)");
+  } else if (bms_frames_ == 0) {
+    note("no BMS frame (0x361) with a battery voltage to compare: bms_voltage_scale kept");
+  }
+  // Rigid-body fits while the wheels rolled.
+  if (rigid_samples_ >= kMinRigidSamples) {
+    Ranking rank;
+    for (int h = 0; h < 4; ++h) {
+      if (rigid_impossible_[h] > 0) continue;
+      rank.add(h, std::sqrt(rigid_residual_[h] / rigid_samples_));
+    }
+    if (rank.clear(0.1, config_.margin, 0.005)) {
+      verdict_271_ = Hypothesis271{kUnits[rank.best / 2], kSigns[rank.best % 2]};
+      min_margin_ = std::min(min_margin_, rank.confidence());
+      const std::string why = "the rolling wheels (" + std::to_string(rigid_samples_) +
+                              " samples) form one rigid-body motion only under 0x271 " +
+                              std::string(to_string(verdict_271_->unit)) + ", " +
+                              std::string(to_string(verdict_271_->sign)) + " (relative residual " +
+                              fmt("%.3f", rank.best_residual) + ", next " +
+                              fmt("%.3f", rank.second_residual) + ")";
+      set("steering_unit_271", to_string(verdict_271_->unit), why);
+      set("steering_sign_271", to_string(verdict_271_->sign), why);
+    } else {
+      note("rolling wheels seen (" + std::to_string(rigid_samples_) +
+           " samples) but no 0x271 reading fits them clearly");
+    }
+  }
+}
+
+void ChassisIdentifier::fail(std::string why, Timestamp now) {
+  status_.phase = IdentificationPhase::kFailed;
+  status_.finished = now;
+  note("failed: " + why);
+  status_.message = unidentified_message(why, config_.timeout);
+  status_.confidence = 0.0;
+}
+
+void ChassisIdentifier::decide(Timestamp now) {
+  status_.phase = IdentificationPhase::kDecided;
+  status_.finished = now;
+  status_.profile.revision = status_.revision;
+  status_.undecided.clear();
+  for (const ProfileSetting& s : profile_settings()) {
+    const bool known = std::any_of(status_.decided.begin(), status_.decided.end(),
+                                   [&](const IdentifiedSetting& d) { return d.name == s.name; });
+    if (!known) status_.undecided.emplace_back(s.name);
+  }
+  status_.confidence = min_margin_;
+  status_.message =
+      "identified in " + secs(now - status_.started) + ": " + describe(status_.profile);
+}
+
+void ChassisIdentifier::finish(Timestamp now) {
+  start(now);
+  if (status_.done()) return;
+  status_.finished = now;
+  if (status_frames_ == 0) {
+    fail("no system status (0x211) in the input", now);
+    return;
+  }
+  decide_passive(now);
+  decide(now);
+}
+
+bool ChassisIdentifier::adopt(std::string_view name, std::string_view value, std::string evidence) {
+  auto it = std::find(status_.undecided.begin(), status_.undecided.end(), name);
+  if (!status_.decided_ok() || it == status_.undecided.end()) return false;
+  ProtocolProfile p = status_.profile;
+  if (!set_setting(p, name, value)) return false;
+  status_.undecided.erase(it);
+  set(name, value, "learned while driving: " + evidence);
+  status_.message = "identified: " + describe(status_.profile);
+  return true;
+}
+
+IdentificationRequest ChassisIdentifier::request() const {
+  IdentificationRequest r;
+  if (status_.phase == IdentificationPhase::kListening || read_only_) return r;
+  r.quiet = false;
+  r.profile = status_.profile;
+  switch (status_.phase) {
+    case IdentificationPhase::kSpinCheck:
+      r.mode = MotionMode::kSpin;
+      r.probe = MotionCommand{};
+      break;
+    case IdentificationPhase::kSteerProbe: {
+      r.mode = MotionMode::kAckermann;
+      MotionCommand c;
+      c.steering_angle = probe_wire_angle_;
+      r.probe = c;
+      break;
+    }
+    case IdentificationPhase::kReturning:
+      r.mode = MotionMode::kAckermann;
+      r.probe = MotionCommand{};
+      break;
+    default:
+      break;
+  }
+  return r;
+}
+
+IdentificationStatus identify_log(const std::vector<CanFrame>& frames,
+                                  const VehicleGeometry& geometry,
+                                  const IdentificationConfig& config,
+                                  std::optional<std::string> forced_revision) {
+  ChassisIdentifier id(config, geometry, std::move(forced_revision), /*read_only=*/true);
+  Timestamp last{0};
+  for (const CanFrame& f : frames) {
+    id.on_frame(f, f.stamp);
+    last = std::max(last, f.stamp);
+  }
+  id.finish(last);
+  return id.status();
+}
+
+}  // namespace ranger

@@ -1,0 +1,131 @@
+// `ranger_can identify IFACE`: runs the driver with `--protocol auto` until the identification
+// ends (control/identification.hpp) and prints the decision with its evidence.
+#include <cstdio>
+#include <ostream>
+#include <string>
+
+#include "cli_commands.hpp"
+#include "cli_options.hpp"
+#include "cli_profile.hpp"
+#include "cli_session.hpp"
+#include "cli_signals.hpp"
+
+namespace ranger::cli {
+
+namespace {
+
+using namespace std::chrono_literals;
+
+std::string seconds_text(std::chrono::nanoseconds d) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.2f s", seconds(d));
+  return buf;
+}
+
+// The identification as text: the decision, every setting (decided or kept), the evidence.
+void print_identification(const IdentificationStatus& s, const ProtocolProfile& profile,
+                          bool simulated, std::ostream& out) {
+  if (s.decided_ok()) {
+    out << "identified in " << seconds_text(s.elapsed()) << (simulated ? " (simulated time)" : "")
+        << ": " << describe(profile) << "\n";
+    char conf[32];
+    std::snprintf(conf, sizeof conf, "%.3f", s.confidence);
+    out << "confidence: " << conf << "\n";
+  } else {
+    out << "not identified after " << seconds_text(s.elapsed())
+        << (simulated ? " (simulated time)" : "") << "\n";
+  }
+  out << "settings:\n";
+  std::size_t width = 0;
+  for (const ProfileSetting& p : profile_settings())
+    width = std::max(width, p.name.size());
+  for (const ProfileSetting& p : profile_settings()) {
+    const auto value = get_setting(profile, p.name);
+    std::string how = "kept (the " + s.revision + " preset's)";
+    for (const IdentifiedSetting& d : s.decided) {
+      if (d.name == p.name) how = "decided";
+    }
+    const std::string v = value ? *value : "?";
+    out << "  " << p.name << std::string(width + 2 - p.name.size(), ' ') << v
+        << std::string(v.size() < 16 ? 16 - v.size() : 1, ' ') << how << "\n";
+  }
+  out << "evidence:\n";
+  for (const std::string& e : s.evidence)
+    out << "  - " << e << "\n";
+}
+
+int identify_main(const ParsedArgs& args, Io io) {
+  const std::string iface = *args.get("IFACE");
+  DriverConfig config;
+  config.protocol = ProtocolChoice::kAuto;
+  config.identify_revision = protocol_revision(args);
+  config.identification.timeout = from_seconds(args.number("--timeout", 10.0));
+  config.identification.spin_check = !args.has("--no-spin-check");
+  if (Status st = config.validate(); !st)
+    return usage_error(identify_command(), io, st.error().message);
+  StopSignals signals;
+  auto session = DriverSession::open(iface, config);
+  if (!session) {
+    io.err << "ranger_can identify: " << session.error().message << "\n";
+    return 1;
+  }
+  DriverSession& s = **session;
+  const bool finished = s.run_until(
+      [](const DriverSnapshot& snap) { return snap.identification && snap.identification->done(); },
+      config.identification.timeout + 2s);
+  s.stop();
+  const auto snap = s.snapshot();
+  if (!finished || !snap->identification) {
+    io.err << "ranger_can identify: "
+           << (s.interrupted() ? "interrupted" : "the identification did not end") << "\n";
+    return 1;
+  }
+  const IdentificationStatus& id = *snap->identification;
+  ProtocolProfile profile = id.profile;
+  if (Status st = apply_set_options(profile, args); !st) {
+    return usage_error(identify_command(), io, st.error().message);
+  }
+  print_identification(id, profile, s.simulated(), io.out);
+  if (!id.decided_ok()) {
+    io.err << "ranger_can identify: " << id.message << "\n";
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace
+
+const CommandSpec& identify_command() {
+  static const CommandSpec spec{
+      "identify",
+      "identify which protocol settings a chassis speaks, before anything moves",
+      "Runs the driver with --protocol auto until it has identified the chassis, then prints the\n"
+      "decision: every protocol setting (decided from evidence, or kept at the preset's value),\n"
+      "the confidence and the evidence, one line each.\n"
+      "\n"
+      "The driver first listens without sending anything (the IDs only the vendor's revision\n"
+      "sends, frame lengths, the 0x211 byte-7 counter, the BMS voltage scale), then takes CAN\n"
+      "command mode and checks the steering at standstill: a switch to spin mode (every wheel at\n"
+      "+-atan(wheelbase/track)) and a few degrees of steering at zero speed, read back from\n"
+      "0x271 and 0x221. No wheel rolls. IFACE is any bus: can0, sim, sim:VARIANT (simulated\n"
+      "time, deterministic), replay:FILE (a log: the frames alone decide).",
+      {required_arg("IFACE", "the bus: a SocketCAN interface, sim, sim:VARIANT or replay:FILE",
+                    "can0")},
+      {protocol_option(), set_option(),
+       option("--timeout", "S", "give up after S seconds (default 10): the node's identify_timeout",
+              number_in(2.0, 600.0)),
+       flag("--no-spin-check", "skip the spin-mode check of the 0x271 unit and sign")},
+      "With --protocol manual or agx_v2 the identification starts from that preset instead of\n"
+      "deciding it; --set values are applied after it.\n"
+      "Exit status: 0 identified; 1 not identified (the message says what to set instead), the\n"
+      "bus could not be opened, or interrupted; 2 on a usage error.",
+      identify_main,
+  };
+  return spec;
+}
+
+int run_identify(const Args& args, Io io) {
+  return run_command(identify_command(), args, io);
+}
+
+}  // namespace ranger::cli
