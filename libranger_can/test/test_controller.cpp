@@ -982,3 +982,67 @@ TEST(ControllerConfig, Validation) {
 
 }  // namespace
 }  // namespace ranger
+
+// ---- the vendor's revision on the wire (issue 14) ----------------------------------------------
+
+namespace ranger {
+namespace {
+
+TEST(ControllerProfile, SendsAndReadsTheProfilesWire) {
+  ControllerConfig cfg;
+  cfg.profile = *protocol_preset("agx_v2");
+  test::FakeBus bus;
+  ChassisController ctl(bus, cfg);
+  Timestamp now{0};
+  auto feed = [&](const Message& m) {
+    auto f = encode(m, cfg.profile);
+    ASSERT_TRUE(f.ok()) << f.error().message;
+    ctl.on_frame(*f, now);
+  };
+  SystemStatus st;
+  st.control_mode_raw = 1;
+  st.control_mode = protocol::ControlMode::kCan;
+  st.battery_voltage = 48.0;
+  MotionModeFeedback mm;
+  mm.mode = MotionMode::kAckermann;
+  mm.mode_known = true;
+  for (int i = 0; i < 5; ++i, now += 20ms) {
+    st.counter = static_cast<std::uint8_t>(i);  // the agx_v2 counter: never a fault
+    feed(st);
+    feed(mm);
+    ctl.tick(now);
+  }
+  ASSERT_TRUE(ctl.set_command(BodyTwist{0.3, 0, 0.1}, now).ok());
+  ctl.tick(now);
+  ASSERT_FALSE(bus.sent.empty());
+  const CanFrame& f = bus.sent.back();
+  EXPECT_EQ(f.id, protocol::kMotionCommandId);
+  EXPECT_EQ(f.dlc, 8);
+  auto m = decode(f, cfg.profile);
+  ASSERT_TRUE(m.ok());
+  EXPECT_NEAR(std::get<MotionCommand>(*m).linear_speed, 0.3, 1e-3);
+  EXPECT_TRUE(ctl.state().faults.empty()) << "the counter in byte 7 is no fault";
+  EXPECT_EQ(ctl.state().refusal, MotionRefusal::kNone);
+
+  // A 16-bit error word: motor 1 communication is critical; its name is the agx_v2 table's.
+  st.error_bits =
+      protocol::fault_bit(protocol::Fault::kMotorCommunication, ErrorWordLayout::kAgxV2_16, 1);
+  ASSERT_NE(st.error_bits, 0u);
+  feed(st);
+  ctl.tick(now);
+  EXPECT_EQ(ctl.state().refusal, MotionRefusal::kCriticalError);
+  EXPECT_FALSE(ctl.state().faults.empty());
+
+  // Park mode (agx_v2 mode 3) is known to the protocol but cannot be driven in: no motion.
+  st.error_bits = 0;
+  feed(st);
+  ASSERT_TRUE(ctl.set_command(BodyTwist{}, now).ok());  // the re-arm after the critical error
+  ASSERT_TRUE(ctl.set_command(BodyTwist{0.3, 0, 0.1}, now).ok());
+  mm.mode = MotionMode::kPark;
+  feed(mm);
+  ctl.tick(now);
+  EXPECT_EQ(ctl.state().refusal, MotionRefusal::kModeUnknown);
+}
+
+}  // namespace
+}  // namespace ranger

@@ -472,3 +472,64 @@ TEST(ModeSelector, ObliqueSideIsForgottenOnResetAndInOtherModes) {
 
 }  // namespace
 }  // namespace ranger
+
+// ---- protocol profiles: the chassis's readings of 0x111 (issue 14) ---------------------------
+
+namespace ranger {
+namespace {
+
+TEST(KinematicsProfile, TheInnerWheelReferenceSteersTheInnerWheelToTheTurn) {
+  const VehicleGeometry g;
+  ProtocolProfile inner = manual_profile();
+  inner.steering_reference = SteeringReference::kInnerFront;
+  const BodyTwist turn{0.5, 0.0, 0.25};  // radius 2 m, to the left
+  auto mean = solve_kinematics(turn, MotionMode::kAckermann, g, KinematicsLimits{});
+  auto in = solve_kinematics(turn, MotionMode::kAckermann, g, KinematicsLimits{}, {}, inner);
+  ASSERT_TRUE(mean.ok() && in.ok());
+  const double k = 0.5;
+  const double inner_angle = std::atan2(g.wheelbase / 2 * k, 1 - g.track / 2 * k);
+  EXPECT_NEAR(interpretation::rep103_from_manual_command_steering(in->command.steering_angle),
+              inner_angle, 1e-9);
+  EXPECT_GT(std::fabs(in->command.steering_angle), std::fabs(mean->command.steering_angle));
+  // Each reading inverts itself: the command realises the twist asked for.
+  const BodyTwist back = twist_from_command(in->command, MotionMode::kAckermann, g, inner);
+  EXPECT_NEAR(back.wz, 0.25, 1e-9);
+  EXPECT_NEAR(back.vx, 0.5, 1e-9);
+  // The wheels 0x271 should show are the same whatever the reading (one vehicle, one turn).
+  const auto a = wheel_angles_for_command(mean->command, MotionMode::kAckermann, g);
+  const auto b = wheel_angles_for_command(in->command, MotionMode::kAckermann, g, inner);
+  for (int i = 0; i < kWheelCount; ++i)
+    EXPECT_NEAR(a[i], b[i], 1e-9) << "wheel " << i;
+  // And the steering limit applies to the angle that reading names.
+  inner.steering_reference = SteeringReference::kInnerFront;
+  EXPECT_LT(max_ackermann_curvature(0.5, g, inner), max_ackermann_curvature(0.5, g));
+}
+
+TEST(KinematicsProfile, SpinGoesOutInTheChassisFieldAndSign) {
+  const VehicleGeometry g;
+  const BodyTwist spin{0.0, 0.0, 0.5};
+  const double wheel = 0.5 * std::hypot(g.wheelbase / 2, g.track / 2);
+  auto manual = solve_kinematics(spin, MotionMode::kSpin, g, KinematicsLimits{});
+  ASSERT_TRUE(manual.ok());
+  EXPECT_NEAR(manual->command.spin_speed, wheel, 1e-12);
+  EXPECT_EQ(manual->command.yaw_rate, 0.0);
+
+  ProtocolProfile yaw = manual_profile();
+  yaw.spin_field = SpinField::kYawRate;
+  auto v2 = solve_kinematics(spin, MotionMode::kSpin, g, KinematicsLimits{}, {}, yaw);
+  ASSERT_TRUE(v2.ok());
+  EXPECT_EQ(v2->command.spin_speed, 0.0) << "a yaw-rate chassis must not see a wheel speed";
+  EXPECT_NEAR(v2->command.yaw_rate, 0.5, 1e-12);
+  EXPECT_NEAR(twist_from_command(v2->command, MotionMode::kSpin, g, yaw).wz, 0.5, 1e-12);
+
+  ProtocolProfile cw = manual_profile();
+  cw.spin_sign = -1;
+  auto reversed = solve_kinematics(spin, MotionMode::kSpin, g, KinematicsLimits{}, {}, cw);
+  ASSERT_TRUE(reversed.ok());
+  EXPECT_NEAR(reversed->command.spin_speed, -wheel, 1e-12);
+  EXPECT_NEAR(reversed->achieved.wz, 0.5, 1e-12) << "the body still turns the way asked";
+  EXPECT_NEAR(twist_from_command(reversed->command, MotionMode::kSpin, g, cw).wz, 0.5, 1e-12);
+}
+
+}  // namespace
+}  // namespace ranger

@@ -6,10 +6,10 @@
 #include <chrono>
 #include <cmath>
 
-#include "ranger_can/wire/codec.hpp"
-#include "ranger_can/wire/interpretation.hpp"
 #include "ranger_can/control/kinematics.hpp"
 #include "ranger_can/control/odometry.hpp"
+#include "ranger_can/wire/codec.hpp"
+#include "ranger_can/wire/interpretation.hpp"
 #include "support/synthetic_feedback.hpp"
 
 namespace ranger {
@@ -321,6 +321,60 @@ TEST(OdometryConfig, ValidationAndSourceNames) {
   EXPECT_EQ(*parse_odometry_source("motion"), OdometrySource::kMotion);
   EXPECT_EQ(*parse_odometry_source("wheels"), OdometrySource::kWheels);
   EXPECT_FALSE(parse_odometry_source("imu").ok());
+}
+
+}  // namespace
+}  // namespace ranger
+
+// ---- protocol profiles: the chassis's readings of 0x221 (issue 14) ---------------------------
+
+namespace ranger {
+namespace {
+
+TEST(OdometryProfile, TheFallbackReadsTheFeedbackInTheProfilesReadings) {
+  const VehicleGeometry g;
+  const double k = 0.5;  // a 2 m turn to the left at 0.5 m/s (body centre)
+  const double vx = 0.5;
+  const double mean_speed =
+      interpretation::ackermann_feedback_speed_from_body_speed(vx, k, g.wheelbase, g.track);
+  MotionFeedback fb;
+  // Mean-wheel speed and mean angle (the manual preset).
+  fb.speed = mean_speed;
+  fb.steering_angle = interpretation::manual_from_rep103_steering(
+      interpretation::ackermann_mean_front_angle(k, g.wheelbase, g.track));
+  BodyTwist t = twist_from_motion_feedback(fb, protocol::MotionMode::kAckermann, g);
+  EXPECT_NEAR(t.vx, vx, 1e-9);
+  EXPECT_NEAR(t.wz, k * vx, 1e-9);
+  // Body-centre speed and the inner wheel's angle.
+  ProtocolProfile p = manual_profile();
+  p.steering_reference = SteeringReference::kInnerFront;
+  p.feedback_speed = FeedbackSpeed::kBodyCentre;
+  fb.speed = vx;
+  fb.steering_angle = interpretation::manual_from_rep103_steering(
+      interpretation::ackermann_inner_front_angle(k, g.wheelbase, g.track));
+  t = twist_from_motion_feedback(fb, protocol::MotionMode::kAckermann, g, p);
+  EXPECT_NEAR(t.vx, vx, 1e-9);
+  EXPECT_NEAR(t.wz, k * vx, 1e-9);
+  // The same frame read the manual's way would be wrong: the readings matter.
+  t = twist_from_motion_feedback(fb, protocol::MotionMode::kAckermann, g);
+  EXPECT_GT(std::fabs(t.wz - k * vx), 0.01);
+}
+
+TEST(OdometryProfile, SpinFeedbackFromTheYawRateFieldAndTheSign) {
+  const VehicleGeometry g;
+  MotionFeedback fb;
+  fb.yaw_rate = 0.4;
+  ProtocolProfile yaw = manual_profile();
+  yaw.spin_field = SpinField::kYawRate;
+  EXPECT_NEAR(twist_from_motion_feedback(fb, protocol::MotionMode::kSpin, g, yaw).wz, 0.4, 1e-12);
+  yaw.spin_sign = -1;
+  EXPECT_NEAR(twist_from_motion_feedback(fb, protocol::MotionMode::kSpin, g, yaw).wz, -0.4, 1e-12);
+  MotionFeedback wheel;
+  wheel.speed = 0.3;
+  ProtocolProfile cw = manual_profile();
+  cw.spin_sign = -1;
+  EXPECT_NEAR(twist_from_motion_feedback(wheel, protocol::MotionMode::kSpin, g, cw).wz,
+              -0.3 / std::hypot(g.wheelbase / 2, g.track / 2), 1e-12);
 }
 
 }  // namespace

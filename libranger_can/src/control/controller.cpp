@@ -19,6 +19,7 @@ using protocol::MotionMode;
 bool known_control_mode(std::uint8_t raw) {
   return raw == static_cast<std::uint8_t>(ControlMode::kStandby) ||
          raw == static_cast<std::uint8_t>(ControlMode::kCan) ||
+         raw == static_cast<std::uint8_t>(ControlMode::kUart) ||
          raw == static_cast<std::uint8_t>(ControlMode::kRemote);
 }
 
@@ -163,7 +164,7 @@ void ChassisController::on_frame(const CanFrame& frame, Timestamp now) {
     return;
   }
   ++state_.counters.frames_received;
-  Result<Message> message = decode(frame);
+  Result<Message> message = decode(frame, config_.profile);
   if (!message) {
     ++state_.counters.decode_errors;
     state_.last_error = message.error().message;
@@ -219,8 +220,7 @@ void ChassisController::on_system_status(const SystemStatus& m, Timestamp now) {
 }
 
 void ChassisController::on_motion_mode(const MotionModeFeedback& m) {
-  const bool known = m.mode_raw <= static_cast<std::uint8_t>(MotionMode::kSpin);
-  if (!known || !drivable_mode(m.mode)) {
+  if (!m.mode_known || !drivable_mode(m.mode)) {
     // A mode this driver cannot command in (unknown value, park, side slip): the meaning of
     // 0x111 is unknown, so nothing moves (kModeUnknown). The switching bit still counts.
     state_.motion_mode.reset();
@@ -415,7 +415,7 @@ void ChassisController::update_causes() {
     if (state_.vehicle_status == protocol::VehicleStatus::kEmergencyStop) {
       active = active | StopCause::kEstop;
     }
-    if (protocol::is_critical_error(state_.error_bits)) {
+    if (protocol::is_critical_error(state_.error_bits, config_.profile.error_word)) {
       active = active | StopCause::kCriticalError;
     }
   }
@@ -491,7 +491,8 @@ double ChassisController::steer_first_factor(const KinematicsSolution& solution,
   const double threshold = config_.steer_first_threshold;
   if (threshold <= 0.0 || solution.mode == MotionMode::kSpin) return 1.0;
   if (!is_fresh(feedback_.steering_angles, now, config_.link_timeout)) return 1.0;
-  const auto wanted = wheel_angles_for_command(solution.command, solution.mode, config_.geometry);
+  const auto wanted =
+      wheel_angles_for_command(solution.command, solution.mode, config_.geometry, config_.profile);
   double worst = 0.0;
   for (std::size_t i = 0; i < wanted.size(); ++i) {
     const double measured =
@@ -562,8 +563,8 @@ void ChassisController::run_motion(Timestamp now) {
     state_.limited = BodyTwist{limiter_vx_.limit(target.vx, previous.vx, dt),
                                limiter_vy_.limit(target.vy, previous.vy, dt),
                                limiter_wz_.limit(target.wz, previous.wz, dt)};
-    Result<KinematicsSolution> solved =
-        selector_.solve(state_.limited, *state_.motion_mode, config_.geometry, config_.limits);
+    Result<KinematicsSolution> solved = selector_.solve(
+        state_.limited, *state_.motion_mode, config_.geometry, config_.limits, config_.profile);
     if (solved) {
       // Steer first: hold the speed back while the wheels are far from the commanded angle.
       const double factor = steer_first_factor(*solved, now);
@@ -620,7 +621,7 @@ void ChassisController::run_motion(Timestamp now) {
 bool ChassisController::send(const Message& message, Timestamp now,
                              const KinematicsSolution* solution, bool shutdown) {
   if (config_.listen_only) return false;
-  Result<CanFrame> frame = encode(message);
+  Result<CanFrame> frame = encode(message, config_.profile);
   if (!frame) {
     ++state_.counters.send_failures;
     state_.last_error = frame.error().message;
@@ -678,7 +679,8 @@ void ChassisController::update_faults() {
   if (feedback_.system_status && !state_.vehicle_status) {
     faults.emplace_back("vehicle_status_unknown");
   }
-  for (std::string& name : protocol::error_bit_names(state_.error_bits)) {
+  for (std::string& name :
+       protocol::error_bit_names(state_.error_bits, config_.profile.error_word)) {
     faults.push_back(std::move(name));
   }
   if (has(active, StopCause::kLowBattery)) faults.emplace_back("low_battery");

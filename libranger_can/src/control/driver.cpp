@@ -33,6 +33,21 @@ bool is_zero(const BodyTwist& t) {
   return t.vx == 0.0 && t.vy == 0.0 && t.wz == 0.0;
 }
 
+// The odometry shares the controller's geometry and protocol profile: one vehicle, one reading.
+OdometryConfig odometry_config(const DriverConfig& config) {
+  OdometryConfig c = config.odometry;
+  c.geometry = config.controller.geometry;
+  c.profile = config.controller.profile;
+  return c;
+}
+
+std::string join_names(const std::vector<std::string>& names) {
+  std::string out;
+  for (const auto& n : names)
+    out += (out.empty() ? "" : ", ") + n;
+  return out;
+}
+
 std::string hex2(std::uint8_t v) {
   static const char* digits = "0123456789ABCDEF";
   return std::string("0x") + digits[v >> 4] + digits[v & 0xF];
@@ -89,8 +104,8 @@ Driver::Driver(DriverConfig config, std::shared_ptr<BusSource> source, const Clo
     : config_(std::move(config)),
       source_(std::move(source)),
       clock_(clock),
-      odometry_(config_.odometry),
-      joints_(config_.odometry.geometry.wheel_radius),
+      odometry_(odometry_config(config_)),
+      joints_(config_.controller.geometry.wheel_radius),
       mail_(std::make_unique<Mail>()),
       snapshot_(std::make_shared<DriverSnapshot>()) {
   wake_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
@@ -267,9 +282,8 @@ void Driver::handle_frame(const CanFrame& frame, Timestamp now) {
     controller_->on_frame(frame, now);  // counts it
     return;
   }
-  Result<Message> message = decode(frame);
-  const int layout = protocol::expected_dlc(frame.id);
-  frames_.record(frame.id, now, message.ok(), layout >= 0 ? frame.dlc - layout : 0);
+  Result<Message> message = decode(frame, config_.controller.profile);
+  frames_.record(frame.id, now, message.ok(), protocol::extra_bytes(frame));
   if (!message) {
     controller_->on_frame(frame, now);  // counts and records the decode error
     return;
@@ -333,9 +347,10 @@ void Driver::update_requests(Timestamp now) {
       if (status && status->received >= r.sent + kAnswerDelay) {
         r.state = RequestOutcome::State::kAnswered;
         r.error_word = c.error_bits;
-        r.message = "the chassis reports " +
-                    std::to_string(protocol::error_bit_names(c.error_bits).size()) +
-                    " error bit(s) set";
+        const auto names =
+            protocol::error_bit_names(c.error_bits, config_.controller.profile.error_word);
+        r.message = names.empty() ? std::string("the chassis reports no error")
+                                  : "the chassis still reports: " + join_names(names);
       } else if (now - r.sent > config_.request_answer_timeout) {
         r.state = RequestOutcome::State::kFailed;
         r.message = "the chassis did not answer (no 0x211) within " +

@@ -36,6 +36,16 @@ bool ChassisFeedback::record(const Message& message, Timestamp stamp, Timestamp 
           ultrasonic[m.first_sensor == 5 ? 1 : 0] = s;
         } else if constexpr (std::is_same_v<T, UltrasonicSettingFeedback>) {
           ultrasonic_setting = s;
+        } else if constexpr (std::is_same_v<T, LightState>) {
+          light_state = s;
+        } else if constexpr (std::is_same_v<T, RemoteControlState>) {
+          remote_control_state = s;
+        } else if constexpr (std::is_same_v<T, OdometerFeedback>) {
+          odometer = s;
+        } else if constexpr (std::is_same_v<T, VersionResponse>) {
+          constexpr std::size_t kMaxVersion = 64;
+          const std::string_view text = m.view();
+          version.append(text.substr(0, kMaxVersion - std::min(kMaxVersion, version.size())));
         } else {
           return false;  // host -> chassis
         }

@@ -60,7 +60,7 @@ double saturate_speed(double speed, double limit, std::uint32_t& flags) {
 }
 
 void solve_ackermann(const BodyTwist& t, const VehicleGeometry& g, const KinematicsLimits& limits,
-                     KinematicsSolution& s) {
+                     const ProtocolProfile& profile, KinematicsSolution& s) {
   if (std::fabs(t.vy) > kEps) s.flags |= kLateralDropped;
   const double max_steer = limits.max_ackermann_steering;
   double steering = 0.0;       // REP-103: positive = left
@@ -75,13 +75,15 @@ void solve_ackermann(const BodyTwist& t, const VehicleGeometry& g, const Kinemat
     }
   } else {
     curvature = t.wz / t.vx;
-    const double max_curvature = max_ackermann_curvature(max_steer, g);
+    const double max_curvature = max_ackermann_curvature(max_steer, g, profile);
     if (std::fabs(curvature) > max_curvature) {
       curvature = sign(curvature) * max_curvature;  // sign kept: the turn is only wider
       s.flags |= kSteeringSaturated;
     }
-    steering = std::clamp(interp::ackermann_mean_front_angle(curvature, g.wheelbase, g.track),
-                          -max_steer, max_steer);
+    // The angle 0x111 carries: the front wheels' mean or the inner wheel (steering_reference).
+    steering = std::clamp(
+        interp::ackermann_front_angle(curvature, g.wheelbase, g.track, profile.steering_reference),
+        -max_steer, max_steer);
     // The speed limits bound the value on the wire; interpretation point 7 relates it to vx.
     command_speed =
         saturate_speed(interp::command_speed_from_body_speed(t.vx, curvature, g.wheelbase, g.track),
@@ -126,16 +128,21 @@ void solve_oblique(const BodyTwist& t, const VehicleGeometry& g, const Kinematic
 }
 
 void solve_spin(const BodyTwist& t, const VehicleGeometry& g, const KinematicsLimits& limits,
-                KinematicsSolution& s) {
+                const ProtocolProfile& profile, KinematicsSolution& s) {
   if (std::fabs(t.vx) > kEps || std::fabs(t.vy) > kEps) s.flags |= kTranslationDropped;
   double wheel_speed = interp::spin_wheel_speed_from_yaw_rate(t.wz, g.wheelbase, g.track);
   if (std::fabs(wheel_speed) > limits.max_spin_wheel_speed) {
     wheel_speed = sign(wheel_speed) * limits.max_spin_wheel_speed;
     s.flags |= kSpinSaturated;
   }
-  s.command.spin_speed = wheel_speed;  // 0x111 spin speed is counter-clockwise positive too
-  s.achieved = BodyTwist{0.0, 0.0,
-                         interp::spin_yaw_rate_from_wheel_speed(wheel_speed, g.wheelbase, g.track)};
+  const double wz = interp::spin_yaw_rate_from_wheel_speed(wheel_speed, g.wheelbase, g.track);
+  // The field the chassis reads spin from (spin_field), in its sign (spin_sign).
+  if (profile.spin_field == SpinField::kYawRate) {
+    s.command.yaw_rate = interp::spin_wire_from_ccw(wz, profile);
+  } else {
+    s.command.spin_speed = interp::spin_wire_from_ccw(wheel_speed, profile);
+  }
+  s.achieved = BodyTwist{0.0, 0.0, wz};
 }
 
 }  // namespace
@@ -178,15 +185,17 @@ std::string kinematics_flags_to_string(std::uint32_t flags) {
   return out.empty() ? "unknown_flags" : out;
 }
 
-double max_ackermann_curvature(double max_steering, const VehicleGeometry& geometry) {
-  return std::fabs(interp::ackermann_curvature_from_mean_angle(std::fabs(max_steering),
-                                                               geometry.wheelbase, geometry.track));
+double max_ackermann_curvature(double max_steering, const VehicleGeometry& geometry,
+                               const ProtocolProfile& profile) {
+  return std::fabs(interp::ackermann_curvature_from_front_angle(
+      std::fabs(max_steering), geometry.wheelbase, geometry.track, profile.steering_reference));
 }
 
 Result<KinematicsSolution> solve_kinematics(const BodyTwist& twist, MotionMode mode,
                                             const VehicleGeometry& geometry,
                                             const KinematicsLimits& limits,
-                                            const ObliqueSideHint& oblique_hint) {
+                                            const ObliqueSideHint& oblique_hint,
+                                            const ProtocolProfile& profile) {
   const struct {
     const char* name;
     double value;
@@ -205,13 +214,13 @@ Result<KinematicsSolution> solve_kinematics(const BodyTwist& twist, MotionMode m
   s.mode = mode;
   switch (mode) {
     case MotionMode::kAckermann:
-      solve_ackermann(twist, geometry, limits, s);
+      solve_ackermann(twist, geometry, limits, profile, s);
       break;
     case MotionMode::kOblique:
       solve_oblique(twist, geometry, limits, oblique_hint, s);
       break;
     case MotionMode::kSpin:
-      solve_spin(twist, geometry, limits, s);
+      solve_spin(twist, geometry, limits, profile, s);
       break;
     default:
       return Error{Errc::kInvalidArgument,
@@ -221,12 +230,12 @@ Result<KinematicsSolution> solve_kinematics(const BodyTwist& twist, MotionMode m
 }
 
 BodyTwist twist_from_command(const MotionCommand& command, MotionMode mode,
-                             const VehicleGeometry& geometry) {
+                             const VehicleGeometry& geometry, const ProtocolProfile& profile) {
   switch (mode) {
     case MotionMode::kAckermann: {
       const double steering = interp::rep103_from_manual_command_steering(command.steering_angle);
-      const double curvature =
-          interp::ackermann_curvature_from_mean_angle(steering, geometry.wheelbase, geometry.track);
+      const double curvature = interp::ackermann_curvature_from_front_angle(
+          steering, geometry.wheelbase, geometry.track, profile.steering_reference);
       // A steering of +-90 deg or more (far outside the 0x111 range) has an infinite curvature:
       // no defined twist, and never a NaN.
       if (!std::isfinite(curvature)) return BodyTwist{};
@@ -240,10 +249,14 @@ BodyTwist twist_from_command(const MotionCommand& command, MotionMode mode,
           command.linear_speed, 0.0, geometry.wheelbase, geometry.track);
       return BodyTwist{speed * std::cos(direction), speed * std::sin(direction), 0.0};
     }
-    case MotionMode::kSpin:
-      return BodyTwist{0.0, 0.0,
-                       interp::spin_yaw_rate_from_wheel_speed(command.spin_speed,
-                                                              geometry.wheelbase, geometry.track)};
+    case MotionMode::kSpin: {
+      const double wz = profile.spin_field == SpinField::kYawRate
+                            ? interp::spin_ccw_from_wire(command.yaw_rate, profile)
+                            : interp::spin_yaw_rate_from_wheel_speed(
+                                  interp::spin_ccw_from_wire(command.spin_speed, profile),
+                                  geometry.wheelbase, geometry.track);
+      return BodyTwist{0.0, 0.0, wz};
+    }
     case MotionMode::kPark:  // no motion: the zero twist below
     case MotionMode::kSideSlip:
       break;
@@ -253,7 +266,8 @@ BodyTwist twist_from_command(const MotionCommand& command, MotionMode mode,
 
 std::array<double, kWheelCount> wheel_angles_for_command(const MotionCommand& command,
                                                          MotionMode mode,
-                                                         const VehicleGeometry& geometry) {
+                                                         const VehicleGeometry& geometry,
+                                                         const ProtocolProfile& profile) {
   std::array<double, kWheelCount> angles{};
   const double steering = interp::rep103_from_manual_command_steering(command.steering_angle);
   for (int i = 0; i < kWheelCount; ++i) {
@@ -261,8 +275,8 @@ std::array<double, kWheelCount> wheel_angles_for_command(const MotionCommand& co
     double angle = 0.0;
     switch (mode) {
       case MotionMode::kAckermann: {
-        const double k = interp::ackermann_curvature_from_mean_angle(steering, geometry.wheelbase,
-                                                                     geometry.track);
+        const double k = interp::ackermann_curvature_from_front_angle(
+            steering, geometry.wheelbase, geometry.track, profile.steering_reference);
         // Wheel i rolls along (1 - k y_i, k x_i) for a forward body motion; at |k| = inf (a
         // corrupt angle) the wheels stand tangent to the circle about the body centre.
         angle = std::isfinite(k) ? std::atan2(k * p.x, 1.0 - k * p.y)
@@ -280,6 +294,33 @@ std::array<double, kWheelCount> wheel_angles_for_command(const MotionCommand& co
     angles[static_cast<std::size_t>(i)] = angle;
   }
   return angles;
+}
+
+BodyTwist fit_body_twist(const std::array<WheelMeasurement, kWheelCount>& wheels,
+                         const VehicleGeometry& geometry) {
+  // Rows per wheel: [1 0 -y_i] and [0 1 x_i]; normal matrix N = A^T A and right side A^T r.
+  double sx = 0.0, sy = 0.0, sr2 = 0.0;
+  double bu = 0.0, bw = 0.0, bt = 0.0;
+  for (int i = 0; i < kWheelCount; ++i) {
+    const WheelPosition p = geometry.wheel_position(i);
+    const WheelMeasurement& m = wheels[static_cast<std::size_t>(i)];
+    const double u = m.speed * std::cos(m.angle);
+    const double w = m.speed * std::sin(m.angle);
+    sx += p.x;
+    sy += p.y;
+    sr2 += p.x * p.x + p.y * p.y;
+    bu += u;
+    bw += w;
+    bt += p.x * w - p.y * u;
+  }
+  const double n = kWheelCount;
+  // N = [[n, 0, -sy], [0, n, sx], [-sy, sx, sr2]]. Rows 1 and 2 give vx = (bu + sy*wz)/n and
+  // vy = (bw - sx*wz)/n; row 3 (-sy*vx + sx*vy + sr2*wz = bt) then yields wz. The denominator is
+  // the wheels' spread about their centroid: positive unless all wheels sit on one point.
+  const double spread = sr2 - (sx * sx + sy * sy) / n;
+  if (!(spread > 1e-12)) return BodyTwist{};
+  const double wz = (bt + sy * bu / n - sx * bw / n) / spread;
+  return BodyTwist{(bu + sy * wz) / n, (bw - sx * wz) / n, wz};
 }
 
 WheelStates wheel_states_from_twist(const BodyTwist& twist, const VehicleGeometry& geometry,

@@ -103,9 +103,11 @@ MotionMode ModeSelector::select(const BodyTwist& twist, MotionMode current, Time
 
 Result<KinematicsSolution> ModeSelector::solve(const BodyTwist& twist, MotionMode mode,
                                                const VehicleGeometry& geometry,
-                                               const KinematicsLimits& limits) {
-  Result<KinematicsSolution> solution = solve_kinematics(
-      twist, mode, geometry, limits, ObliqueSideHint{oblique_side_, config_.oblique_side_band});
+                                               const KinematicsLimits& limits,
+                                               const ProtocolProfile& profile) {
+  Result<KinematicsSolution> solution =
+      solve_kinematics(twist, mode, geometry, limits,
+                       ObliqueSideHint{oblique_side_, config_.oblique_side_band}, profile);
   if (!solution) return solution;
   if (solution->mode != MotionMode::kOblique) {
     oblique_side_ = 0.0;

@@ -13,12 +13,6 @@ namespace {
 namespace interp = ranger::interpretation;
 using protocol::MotionMode;
 
-bool known_motion_mode(std::uint8_t raw) {
-  return raw == static_cast<std::uint8_t>(MotionMode::kAckermann) ||
-         raw == static_cast<std::uint8_t>(MotionMode::kOblique) ||
-         raw == static_cast<std::uint8_t>(MotionMode::kSpin);
-}
-
 }  // namespace
 
 std::string_view to_string(OdometrySource s) {
@@ -57,40 +51,22 @@ Status OdometryConfig::validate() const {
   return ok_status();
 }
 
-BodyTwist fit_body_twist(const std::array<WheelMeasurement, kWheelCount>& wheels,
-                         const VehicleGeometry& geometry) {
-  // Rows per wheel: [1 0 -y_i] and [0 1 x_i]; normal matrix N = A^T A and right side A^T r.
-  double sx = 0.0, sy = 0.0, sr2 = 0.0;
-  double bu = 0.0, bw = 0.0, bt = 0.0;
-  for (int i = 0; i < kWheelCount; ++i) {
-    const WheelPosition p = geometry.wheel_position(i);
-    const WheelMeasurement& m = wheels[static_cast<std::size_t>(i)];
-    const double u = m.speed * std::cos(m.angle);
-    const double w = m.speed * std::sin(m.angle);
-    sx += p.x;
-    sy += p.y;
-    sr2 += p.x * p.x + p.y * p.y;
-    bu += u;
-    bw += w;
-    bt += p.x * w - p.y * u;
-  }
-  const double n = kWheelCount;
-  // N = [[n, 0, -sy], [0, n, sx], [-sy, sx, sr2]]. Rows 1 and 2 give vx = (bu + sy*wz)/n and
-  // vy = (bw - sx*wz)/n; row 3 (-sy*vx + sx*vy + sr2*wz = bt) then yields wz. The denominator is
-  // the wheels' spread about their centroid: positive unless all wheels sit on one point.
-  const double spread = sr2 - (sx * sx + sy * sy) / n;
-  if (!(spread > 1e-12)) return BodyTwist{};
-  const double wz = (bt + sy * bu / n - sx * bw / n) / spread;
-  return BodyTwist{(bu + sy * wz) / n, (bw - sx * wz) / n, wz};
-}
-
 BodyTwist twist_from_motion_feedback(const MotionFeedback& feedback, MotionMode mode,
-                                     const VehicleGeometry& geometry) {
+                                     const VehicleGeometry& geometry,
+                                     const ProtocolProfile& profile) {
+  // The spin rate as the profile reads 0x221 in spin mode.
+  auto spin_rate = [&] {
+    return profile.spin_field == SpinField::kYawRate
+               ? interp::spin_ccw_from_wire(feedback.yaw_rate, profile)
+               : interp::spin_yaw_rate_from_feedback_speed(
+                     interp::spin_ccw_from_wire(feedback.speed, profile), geometry.wheelbase,
+                     geometry.track);
+  };
   switch (mode) {
     case MotionMode::kAckermann: {
       const double steering = interp::rep103_from_manual_steering(feedback.steering_angle);
-      const double k =
-          interp::ackermann_curvature_from_mean_angle(steering, geometry.wheelbase, geometry.track);
+      const double k = interp::ackermann_curvature_from_front_angle(
+          steering, geometry.wheelbase, geometry.track, profile.steering_reference);
       if (std::isinf(k)) {
         // A reported angle of 90 deg or more (a corrupt frame): the limit of the formula below
         // as k grows, a rotation about the body centre at the wheels' speed; inf * 0 would make
@@ -101,7 +77,7 @@ BodyTwist twist_from_motion_feedback(const MotionFeedback& feedback, MotionMode 
                                         feedback.speed, geometry.wheelbase, geometry.track)};
       }
       const double vx = interp::ackermann_body_speed_from_feedback_speed(
-          feedback.speed, k, geometry.wheelbase, geometry.track);
+          feedback.speed, k, geometry.wheelbase, geometry.track, profile.feedback_speed);
       return BodyTwist{vx, 0.0, k * vx};
     }
     case MotionMode::kOblique: {
@@ -110,9 +86,7 @@ BodyTwist twist_from_motion_feedback(const MotionFeedback& feedback, MotionMode 
                        0.0};
     }
     case MotionMode::kSpin:
-      return BodyTwist{0.0, 0.0,
-                       interp::spin_yaw_rate_from_feedback_speed(feedback.speed, geometry.wheelbase,
-                                                                 geometry.track)};
+      return BodyTwist{0.0, 0.0, spin_rate()};
     case MotionMode::kPark:  // no motion: the zero twist below
     case MotionMode::kSideSlip:
       break;
@@ -165,7 +139,7 @@ bool Odometry::on_frame(const CanFrame& frame) {
     default:
       return false;  // not odometry input: skip the decoding
   }
-  Result<Message> message = decode(frame);
+  Result<Message> message = decode(frame, config_.profile);
   if (!message) return false;
   return on_message(*message, frame.stamp);
 }
@@ -197,7 +171,7 @@ bool Odometry::on_steering_angles(const SteeringAnglesFeedback& m, Timestamp sta
 }
 
 bool Odometry::on_motion_mode(const MotionModeFeedback& m, Timestamp) {
-  if (known_motion_mode(m.mode_raw)) mode_ = m.mode;
+  if (m.mode_known) mode_ = m.mode;
   return false;
 }
 
@@ -225,7 +199,8 @@ bool Odometry::on_motion_feedback(const MotionFeedback& m, Timestamp stamp) {
   const bool fallback = config_.source == OdometrySource::kWheels;
   if (fallback && wheels_fresh(stamp)) return false;  // the per-wheel fit drives the pose
   const bool advanced =
-      step(twist_from_motion_feedback(m, mode_, config_.geometry), stamp, OdometrySource::kMotion);
+      step(twist_from_motion_feedback(m, mode_, config_.geometry, config_.profile), stamp,
+           OdometrySource::kMotion);
   if (advanced && fallback) ++state_.fallback_steps;
   return advanced;
 }

@@ -171,7 +171,6 @@ void ChassisModel::sub_step(double h) {
         std::abs(delta) <= max_step ? target_.steering : steering_ + std::copysign(max_step, delta);
   }
 
-  const double old_speed = speed_;
   const double goal = switching() ? 0.0 : target_.speed;
   const bool speeding_up =
       std::abs(goal) > std::abs(speed_) && (speed_ == 0.0 || (speed_ > 0) == (goal > 0));
@@ -187,7 +186,6 @@ void ChassisModel::sub_step(double h) {
     // Slowing down through zero: stop exactly at zero first, then speed up the other way.
     speed_ = (!speeding_up && speed_ != 0.0 && (next > 0) != (speed_ > 0)) ? 0.0 : next;
   }
-  last_acceleration_ = (speed_ - old_speed) / h;
 
   // Trapezoidal twist over the sub-step, integrated along the exact arc.
   const BodyTwist after = twist();

@@ -57,6 +57,7 @@
 #include "ranger_can/wire/frame.hpp"
 #include "ranger_can/wire/profile.hpp"
 #include "ranger_can/wire/protocol.hpp"
+#include "ranger_can/wire/vehicle_spec.hpp"
 
 namespace ranger {
 
@@ -77,7 +78,8 @@ enum class MotionRefusal {
   kModeSwitchFailed,  // a motion-mode switch was never confirmed
   kImplausible,       // the chassis's feedback contradicts the protocol settings
   kRearmRequired,     // an involuntary stop happened: a zero twist or resume() re-arms
-  kStandby,           // chassis in standby (CAN mode requested, or auto_command_mode = false)
+  kStandby,           // not in CAN mode: standby (CAN mode requested, or auto_command_mode =
+                      // false) or UART control (agx_v2)
   kModeUnknown,       // no valid 0x291 yet: the meaning of 0x111 depends on the motion mode
   kSwitching,         // motion-mode switch in progress (ours or the remote's)
   kCmdTimeout,        // no set_command within cmd_timeout
@@ -113,7 +115,7 @@ struct ControllerConfig {
   double steer_first_threshold = 10.0 * M_PI / 180.0;
   std::chrono::nanoseconds ultrasonic_confirm_timeout = std::chrono::milliseconds(500);
   int ultrasonic_max_attempts = 3;
-  double low_battery_soc = 10.0;  // %, manual: below 10 % the chassis cuts the drives
+  double low_battery_soc = vehicle_spec::kLowBatteryCutoffSoc;  // %: the chassis cuts the drives
 
   // Checks every field (durations positive, keep_alive_period < 500 ms, attempts >= 1, the
   // nested configs); the message names the field.

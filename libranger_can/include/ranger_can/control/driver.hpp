@@ -36,12 +36,16 @@
 #include "ranger_can/result.hpp"
 #include "ranger_can/transport/bus.hpp"
 #include "ranger_can/transport/bus_source.hpp"
+// The pack's facts (chemistry, voltage range), for programs that include nothing from wire/.
+#include "ranger_can/wire/vehicle_spec.hpp"
 
 namespace ranger {
 
 struct DriverConfig {
   ControllerConfig controller;  // geometry, limits, protocol profile, timeouts, ...
-  OdometryConfig odometry;      // should share the controller's geometry
+  // Source, timeouts and covariances; its geometry and profile are the controller's (one vehicle,
+  // one reading: the driver copies them).
+  OdometryConfig odometry;
   // Retry period while the bus cannot be opened (an adapter not plugged in yet).
   std::chrono::nanoseconds reconnect_interval = std::chrono::seconds(1);
   // How long clear_errors waits for the chassis's answer (a 0x211 sent after the 0x441 arrived).

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cstdint>
 #include <optional>
+#include <string>
 
 #include "ranger_can/types.hpp"
 #include "ranger_can/wire/codec.hpp"
@@ -44,6 +45,11 @@ struct ChassisFeedback {
   std::array<std::optional<Stamped<BmsAlarm>>, protocol::kBatteryCount + 1> bms_alarm;
   std::array<std::optional<Stamped<UltrasonicFeedback>>, 2> ultrasonic;  // 0x342, 0x343
   std::optional<Stamped<UltrasonicSettingFeedback>> ultrasonic_setting;  // 0x45A
+  // The vendor's revision only (agx_v2): what a manual chassis never sends.
+  std::optional<Stamped<LightState>> light_state;                   // 0x231
+  std::optional<Stamped<RemoteControlState>> remote_control_state;  // 0x241
+  std::optional<Stamped<OdometerFeedback>> odometer;                // 0x311
+  std::string version;         // 0x4A1 answers, concatenated (at most 64 characters kept)
   std::uint64_t messages = 0;  // chassis -> host messages recorded
 
   // Records a chassis -> host message received at `now` from a frame stamped `stamp`. Host ->

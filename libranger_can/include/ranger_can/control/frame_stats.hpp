@@ -41,7 +41,7 @@ class FrameStats {
   struct Entry {
     FrameIdCounts counts;
     std::array<std::uint32_t, kBuckets + 1> buckets{};  // ten whole ones and the current one
-    std::int64_t last_bucket = 0;  // absolute bucket index of the newest count
+    std::int64_t last_bucket = 0;                       // absolute bucket index of the newest count
   };
   // Bucket k holds the frames of (k b, (k+1) b]: a frame at `now` is in the current bucket, the
   // one exactly a window ago is not (a steady stream then counts exactly window / period).

@@ -24,6 +24,7 @@
 #include "ranger_can/types.hpp"
 #include "ranger_can/wire/codec.hpp"
 #include "ranger_can/wire/frame.hpp"
+#include "ranger_can/wire/profile.hpp"
 #include "ranger_can/wire/protocol.hpp"
 
 namespace ranger {
@@ -73,40 +74,58 @@ struct ObliqueSideHint {
 };
 
 // Computes the 0x111 command that realises `twist` as closely as `mode` allows, clamped to
-// `limits` (saturate, never wrap). Errors: kNotFinite when a twist component is NaN/inf (the
-// message names it). Pure function.
+// `limits` (saturate, never wrap), in the chassis's protocol readings `profile`. Errors:
+// kNotFinite when a twist component is NaN/inf (the message names it). Pure function.
 //  * Ackermann: linear_speed = vx (0x111 is read as the body-centre speed: interpretation point
-//    7), steering = the mean front-wheel angle for curvature wz/vx
-//    (interpretation::ackermann_mean_front_angle). A turn tighter than the
-//    steering limit is clamped to the limit with the curvature's sign kept (kSteeringSaturated);
+//    7), steering = the front angle for curvature wz/vx that the profile's steering_reference
+//    names (the mean of the two front wheels, or the inner one:
+//    interpretation::ackermann_front_angle); the steering limit applies to that angle. A turn
+//    tighter than the limit is clamped to it with the curvature's sign kept (kSteeringSaturated);
 //    vx = 0 with wz != 0 gives zero speed and full lock towards wz (kRotationDropped).
 //  * Oblique: linear_speed = +-|(vx, vy)|, steering = direction of travel folded into
 //    [-90, 90] deg (a reverse crab is a negative speed); wz is dropped. Within `oblique_hint.band`
 //    of +-90 deg the steering takes the hinted side instead (the same wheel line, the speed
 //    negated; clamped to the oblique steering limit, kSteeringSaturated).
-//  * Spin: spin_speed = wz * hypot(L/2, W/2) (interpretation open point 5); vx, vy dropped.
+//  * Spin: the wheels' tangential speed wz * hypot(L/2, W/2) (open point 5), limited to
+//    max_spin_wheel_speed, goes out in the profile's spin_field (spin_speed, bytes 4-5, or
+//    yaw_rate, bytes 2-3) with its spin_sign; vx, vy dropped.
 Result<KinematicsSolution> solve_kinematics(const BodyTwist& twist, protocol::MotionMode mode,
                                             const VehicleGeometry& geometry,
                                             const KinematicsLimits& limits,
-                                            const ObliqueSideHint& oblique_hint = {});
+                                            const ObliqueSideHint& oblique_hint = {},
+                                            const ProtocolProfile& profile = manual_profile());
 
 // The body twist a 0x111 command produces in `mode` (the inverse of solve_kinematics for
 // commands within the limits): what the simulator applies and what tests compare against.
 BodyTwist twist_from_command(const MotionCommand& command, protocol::MotionMode mode,
-                             const VehicleGeometry& geometry);
+                             const VehicleGeometry& geometry,
+                             const ProtocolProfile& profile = manual_profile());
 
 // The REP-103 angle of each wheel (geometry.hpp order) that a 0x111 command in `mode` steers
 // to, folded into [-90, 90] deg: what 0x271 should report once the wheels have turned. In
 // Ackermann mode from the command's steering (the curvature, whatever the speed), in oblique
 // mode the direction of travel for every wheel, in spin mode the tangent of the spin circle.
-std::array<double, kWheelCount> wheel_angles_for_command(const MotionCommand& command,
-                                                         protocol::MotionMode mode,
-                                                         const VehicleGeometry& geometry);
+std::array<double, kWheelCount> wheel_angles_for_command(
+    const MotionCommand& command, protocol::MotionMode mode, const VehicleGeometry& geometry,
+    const ProtocolProfile& profile = manual_profile());
 
-// Largest |curvature| (1/m) dual Ackermann reaches at the mean front-wheel angle `max_steering`.
-double max_ackermann_curvature(double max_steering, const VehicleGeometry& geometry);
+// Largest |curvature| (1/m) dual Ackermann reaches at the steering limit `max_steering` (the
+// angle the profile's steering_reference names).
+double max_ackermann_curvature(double max_steering, const VehicleGeometry& geometry,
+                               const ProtocolProfile& profile = manual_profile());
 
 // ---- Per-wheel rigid-body relations (shared by odometry, simulator and tests) ----------------
+
+// Per-wheel measurement in REP-103 terms (angle from 0x271, speed from 0x281).
+using WheelMeasurement = WheelState;
+
+// Forward kinematics: the least-squares body twist (vx, vy, wz) of four measured wheels at
+// `geometry`'s positions (pure function). Each wheel i at (x_i, y_i) with heading th_i and signed
+// speed s_i gives vx - wz*y_i = s_i*cos(th_i) and vy + wz*x_i = s_i*sin(th_i): eight equations
+// for three unknowns, solved in closed form through the 3x3 normal equations. One formula for
+// every motion mode; a wheel turned by 180 deg with a negated speed gives the same fit.
+BodyTwist fit_body_twist(const std::array<WheelMeasurement, kWheelCount>& wheels,
+                         const VehicleGeometry& geometry);
 
 // Wheel states that realise `twist`: wheel i at (x_i, y_i) moves with
 // v_i = (vx - wz*y_i, vy + wz*x_i); its angle is that direction folded into [-90, 90] deg with the

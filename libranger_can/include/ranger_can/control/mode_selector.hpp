@@ -67,7 +67,8 @@ class ModeSelector {
   // oblique command; beyond the band the pure solution (and its side) is taken. A non-oblique
   // solution forgets the side (a mode switch turns the wheels to the new mode's neutral).
   Result<KinematicsSolution> solve(const BodyTwist& twist, protocol::MotionMode mode,
-                                   const VehicleGeometry& geometry, const KinematicsLimits& limits);
+                                   const VehicleGeometry& geometry, const KinematicsLimits& limits,
+                                   const ProtocolProfile& profile = manual_profile());
 
   // Forgets pending candidates, dwell timing and the oblique side (e.g. after the link was lost).
   void reset();

@@ -27,6 +27,7 @@
 #include "ranger_can/types.hpp"
 #include "ranger_can/wire/codec.hpp"
 #include "ranger_can/wire/frame.hpp"
+#include "ranger_can/wire/profile.hpp"
 #include "ranger_can/wire/protocol.hpp"
 
 namespace ranger {
@@ -60,6 +61,9 @@ struct OdometryConfig {
   double yaw_variance_per_radian = 1e-3;    // rad^2 per rad turned
   double yaw_variance_per_meter = 1e-4;     // rad^2 per m travelled
 
+  // Decoding, and 0x221's readings (steering reference, speed meaning, spin field and sign).
+  ProtocolProfile profile;
+
   Status validate() const;  // geometry valid, durations positive, variances finite and >= 0
 };
 
@@ -76,23 +80,20 @@ struct OdometryState {
   std::uint64_t fallback_steps = 0;  // steps from 0x221 while the configured source was kWheels
 };
 
-// Per-wheel measurement in REP-103 terms (angle from 0x271 via interpretation.hpp, speed 0x281).
-using WheelMeasurement = WheelState;
+// The forward kinematics the primary source uses, fit_body_twist (the least-squares body twist
+// of four measured wheels), sits beside the inverse ones in kinematics.hpp.
 
-// The least-squares body twist for the four wheels at `geometry`'s positions (pure function).
-BodyTwist fit_body_twist(const std::array<WheelMeasurement, kWheelCount>& wheels,
-                         const VehicleGeometry& geometry);
-
-// The body twist from 0x221 in `mode` (pure function):
-//  * Ackermann: the steering is the mean front-wheel angle -> curvature k
-//    (interpretation::ackermann_curvature_from_mean_angle); 0x221's speed is read as the mean of
-//    the four wheel speeds (interpretation point 8), so vx = speed / mean_i |(1 - k*y_i, k*x_i)|
-//    (interpretation::ackermann_body_speed_from_feedback_speed) and wz = k * vx.
+// The body twist from 0x221 in `mode`, in the profile's readings (pure function):
+//  * Ackermann: the steering angle (the front wheels' mean or the inner one: steering_reference)
+//    -> curvature k (interpretation::ackermann_curvature_from_front_angle); 0x221's speed is the
+//    mean of the four wheel speeds or the body centre's (feedback_speed:
+//    interpretation::ackermann_body_speed_from_feedback_speed); wz = k * vx.
 //  * Oblique: vx = speed*cos(angle), vy = speed*sin(angle) (angle in REP-103 signs).
-//  * Spin: 0x221's speed is read as the wheels' tangential speed, counter-clockwise positive
-//    (point 9): wz = interpretation::spin_yaw_rate_from_feedback_speed(speed).
+//  * Spin: the wheels' tangential speed in bytes 0-1 (point 9) or the yaw rate in bytes 2-3
+//    (spin_field), in the profile's spin_sign.
 BodyTwist twist_from_motion_feedback(const MotionFeedback& feedback, protocol::MotionMode mode,
-                                     const VehicleGeometry& geometry);
+                                     const VehicleGeometry& geometry,
+                                     const ProtocolProfile& profile = manual_profile());
 
 // Advances `pose` by the constant body twist `twist` for `dt` seconds along the exact arc.
 Pose2D integrate_pose(const Pose2D& pose, const BodyTwist& twist, double dt);

@@ -76,7 +76,6 @@ class ChassisModel {
   protocol::MotionMode switch_target() const { return switch_target_; }
   double speed() const { return speed_; }
   double steering() const { return steering_; }
-  double acceleration() const { return last_acceleration_; }  // m/s^2 over the last sub-step
   const MotionTarget& target() const { return target_; }
   BodyTwist twist() const;
   WheelStates wheels() const;
@@ -108,7 +107,6 @@ class ChassisModel {
   bool emergency_ = false;
   double speed_ = 0.0;
   double steering_ = 0.0;
-  double last_acceleration_ = 0.0;
 
   SwitchPhase switch_phase_ = SwitchPhase::kNone;
   protocol::MotionMode switch_target_ = protocol::MotionMode::kAckermann;

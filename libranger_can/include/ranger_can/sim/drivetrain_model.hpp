@@ -77,7 +77,6 @@ class DrivetrainModel {
   BatteryTelemetry pack() const;
   BatteryTelemetry battery(int slot) const;  // 1..batteries: the pack's share
   int batteries() const { return config_.batteries; }
-  double pack_current_draw() const { return pack_current_; }  // A, positive = drawn
 
  private:
   double open_circuit_voltage() const;
