@@ -57,6 +57,9 @@ struct Case {
   std::string variant;
   OdometrySource source;
 };
+void PrintTo(const Case& c, std::ostream* os) {
+  *os << c.variant << " (" << to_string(c.source) << " odometry)";
+}
 
 class Variants : public ::testing::TestWithParam<Case> {};
 

@@ -20,11 +20,9 @@ std::string join(const std::vector<std::string>& names) {
 const std::vector<VariantInfo>& variants() {
   static const std::vector<VariantInfo> kVariants = {
       {"manual", "the user manual's chassis (the plain `sim`)", ""},
-      {"agx_v2", "the vendor's revision (agx_v2 preset), sending 0x231, 0x241 and answering 0x4A1",
+      {"agx_v2", "the vendor's revision (agx_v2), also sending 0x231, 0x241 and 0x4A1 answers",
        "--protocol agx_v2"},
-      {"padded",
-       "the manual's layout, every frame it sends padded to 8 bytes (a manual driver reads it)",
-       "--set tx_dlc=8"},
+      {"padded", "the manual's layout, every frame it sends padded to 8 bytes", "--set tx_dlc=8"},
       {"spin_cw", "spin values (0x111 bytes 4-5, 0x221 in spin mode) clockwise positive",
        "--set spin_sign=cw"},
       {"steer_left_positive", "0x111, 0x221 and 0x271 steering angles positive to the left",
@@ -34,13 +32,9 @@ const std::vector<VariantInfo>& variants() {
        "--set feedback_speed=body_centre"},
       {"inner_angle", "0x111 steers and 0x221 reports the inner front wheel's angle",
        "--set steering_reference=inner_front"},
-      {"mini_v1",
-       "the RANGER MINI V1: its geometry and limits, steering in 0.01 deg right positive, spin "
-       "as a negated wheel speed, side slip = mode 3",
+      {"mini_v1", "the RANGER MINI V1: geometry, limits and protocol of model ranger_mini_v1",
        "--model ranger_mini_v1"},
-      {"undecidable",
-       "looks like neither revision: the manual's IDs and lengths with the vendor's units and "
-       "0x211 counter, no 0x271, no 0x221 angle in spin mode",
+      {"undecidable", "neither revision: the manual's IDs and lengths, agx_v2 values, no 0x271",
        "--protocol agx_v2 --set tx_dlc=0 --set mode_numbering=manual"},
   };
   return kVariants;

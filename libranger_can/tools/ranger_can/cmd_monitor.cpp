@@ -9,13 +9,14 @@
 #include <optional>
 #include <string>
 
-#include "ranger_can/parse.hpp"
 #include "cli_bus.hpp"
 #include "cli_commands.hpp"
 #include "cli_monitor_view.hpp"
 #include "cli_options.hpp"
+#include "cli_profile.hpp"
 #include "cli_signals.hpp"
 #include "ranger_can/clock.hpp"
+#include "ranger_can/parse.hpp"
 
 namespace ranger::cli {
 
@@ -53,6 +54,8 @@ std::chrono::nanoseconds seconds(double s) {
 
 int monitor_main(const ParsedArgs& args, Io io) {
   const MonitorOptions o = options_from(args);
+  const Result<Vehicle> vehicle = vehicle_from_args(args);
+  if (!vehicle) return usage_error(monitor_command(), io, vehicle.error().message);
 
   auto bus = open_interface(o.iface);
   if (!bus) {
@@ -66,7 +69,7 @@ int monitor_main(const ParsedArgs& args, Io io) {
 
   StopSignals signals;
   SteadyClock clock;
-  ChassisMonitor monitor(seconds(o.window));
+  ChassisMonitor monitor(seconds(o.window), vehicle->profile);
   const Timestamp start = clock.now();
   const auto period = seconds(1.0 / o.rate);
   Timestamp next_view = start + (o.once ? seconds(o.window) : period);
@@ -119,7 +122,8 @@ const CommandSpec& monitor_command() {
       "motion mode, speed and steering (with 'left'/'right' spelled out), per-wheel angle/speed\n"
       "and motor rpm/current/temperature, battery and BMS alarms, 0x211 errors by name,\n"
       "ultrasonic distances, the commands the host sends (0x111 age and rate), frame rates per\n"
-      "ID against the manual's periods, and the bus state.",
+      "ID against the manual's periods, and the bus state. Frames are read under the protocol\n"
+      "profile of --model, --protocol and --set (docs/PROTOCOL_INTERPRETATIONS.md).",
       {required_arg("IFACE", "the CAN interface of the chassis", "can0")},
       {
           flag("--once",
@@ -134,6 +138,9 @@ const CommandSpec& monitor_command() {
                "no ANSI colours (default: colours on a terminal unless NO_COLOR is set)"),
           flag("--no-clear",
                "do not clear the screen between views (default: clear on a terminal)"),
+          model_option(),
+          protocol_option(),
+          set_option(),
       },
       "",
       monitor_main,
