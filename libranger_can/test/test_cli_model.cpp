@@ -5,9 +5,12 @@
 
 #include <string>
 
+#include "cli_bus.hpp"
 #include "cli_commands.hpp"
 #include "ranger_can/control/model.hpp"
 #include "ranger_can/sim/sim_bus_source.hpp"
+#include "ranger_can/transport/loopback_bus.hpp"
+#include "ranger_can/wire/protocol.hpp"
 #include "support/cli_run.hpp"
 
 namespace ranger::cli {
@@ -93,6 +96,26 @@ TEST(CliModel, SendEncodesInTheVehiclesProtocol) {
   const auto ccw = test::run_cli(run_send, {"can0", "motion", "0", "0", "0.3", "-n", "--model",
                                             "ranger_mini_v1", "--set", "spin_sign=ccw"});
   EXPECT_TRUE(contains(ccw.out, "111#00000000012C0000")) << ccw.out;
+}
+
+TEST(CliModel, SimRunsTheVariantOnAnInterface) {
+  LoopbackOptions options;
+  options.interface = "vsim_model0";
+  auto network = std::make_shared<LoopbackNetwork>(options);
+  register_loopback_interface(network);
+  auto listener = network->connect();
+  const auto r = test::run_cli(
+      run_sim, {"vsim_model0", "--chassis-variant", "agx_v2", "--duration", "0.2", "--no-stdin"});
+  unregister_loopback_interface("vsim_model0");
+  EXPECT_EQ(r.rc, 0) << r.err;
+  EXPECT_TRUE(contains(r.out, "variant agx_v2, protocol agx_v2")) << r.out;
+  int remote_state = 0;
+  for (auto f = listener->receive(std::chrono::nanoseconds(0)); f;
+       f = listener->receive(std::chrono::nanoseconds(0))) {
+    EXPECT_EQ(f->dlc, 8) << std::hex << f->id;
+    if (f->id == protocol::kRemoteControlStateId) ++remote_state;
+  }
+  EXPECT_GT(remote_state, 0);
 }
 
 TEST(CliModel, ScenarioDrivesAModelsChassisWithTheModelsDriver) {
