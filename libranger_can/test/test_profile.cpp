@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "ranger_can/control/model.hpp"
 #include "ranger_can/wire/profile.hpp"
 
 namespace ranger {
@@ -330,7 +331,18 @@ TEST(ProfileDocs, TheSettingsTableMatchesTheCode) {
       EXPECT_NE(c[2].find("`" + std::string(v) + "`"), std::string::npos) << c[2];
     EXPECT_EQ(c[3], "`" + *get_setting(preset("manual"), s.name) + "`");
     EXPECT_EQ(c[4], "`" + *get_setting(preset("agx_v2"), s.name) + "`");
-    EXPECT_EQ(c[5], "see models");
+    // Per model: "ranger_mini_v1 `centideg`" for every model whose preset differs from its
+    // revision's there, "—" when none does.
+    bool any = false;
+    for (const std::string& name : model_names()) {
+      const ModelPreset model = *model_preset(name);
+      const std::string value = *get_setting(model.profile, s.name);
+      const bool differs = value != *get_setting(preset(model.protocol.c_str()), s.name);
+      any = any || differs;
+      EXPECT_EQ(c[5].find(name + " `" + value + "`") != std::string::npos, differs)
+          << name << ": " << c[5];
+    }
+    if (!any) EXPECT_EQ(c[5], "—");
     EXPECT_FALSE(c[6].empty()) << "evidence";
   }
 }

@@ -405,14 +405,15 @@ test::CliOutcome cli(const cli::Args& args, const std::string& input = "") {
 }
 
 TEST(CliScenario, RunsAScriptFromStandardInput) {
-  const std::string script = "cmd 0.5 0 0\nwait 1.5\nexpect moving\n";
+  // (the driver identifies the chassis first: --protocol auto, the default, about 3.6 s)
+  const std::string script = "cmd 0.5 0 0\nwait 5\nexpect moving\n";
   const test::CliOutcome r = cli({"--every", "0.5"}, script);
   EXPECT_EQ(r.rc, 0) << r.err;
   EXPECT_EQ(r.err, "");
   const auto lines = test::lines_of(r.out);
-  ASSERT_EQ(lines.size(), 4u);
+  ASSERT_EQ(lines.size(), 11u);
   EXPECT_EQ(lines[0].rfind("{\"t\":0.000,\"truth\":{", 0), 0u) << lines[0];
-  EXPECT_EQ(lines[3].rfind("{\"t\":1.500,", 0), 0u) << lines[3];
+  EXPECT_EQ(lines[10].rfind("{\"t\":5.000,", 0), 0u) << lines[10];
   EXPECT_EQ(cli({"-", "--every", "0.5"}, script).out, r.out);
 }
 

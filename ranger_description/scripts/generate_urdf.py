@@ -1,23 +1,35 @@
 #!/usr/bin/python3
-"""Generates the RANGER URDF from config/geometry.yaml (Debian's ROS has no xacro).
+"""Generates a RANGER URDF from a geometry file (Debian's ROS has no xacro).
 
-The build runs it to produce urdf/ranger.urdf, and the launch files run it to fill
-robot_description, so the URDF and ranger_base_node's parameters always come from the same file:
+The build runs it to produce urdf/ranger.urdf (and urdf/<model>.urdf for every model), and the
+launch files run it to fill robot_description, so the URDF and ranger_base_node's parameters
+always come from the same file:
 
     generate_urdf.py [GEOMETRY_YAML] [-o OUTPUT]     (default: this package's geometry.yaml, stdout)
+    generate_urdf.py --model MODEL [--models-dir DIR] [-o OUTPUT]
+
+A geometry file is either config/geometry.yaml's form (the node's parameters, a nested
+`description:` block) or a model file, libranger_can/models/<model>.yaml: flat `key: value` lines,
+`description/<key>` for the URDF's figures and `description/ultrasonic_<n>: [x, y, yaw]` for the
+sensors (the same files libranger_can embeds as its model presets).
 """
 
 import argparse
 import math
 import os
+import re
 import sys
 import xml.dom.minidom
 import xml.etree.ElementTree as ET
 
 import yaml
 
-DEFAULT_GEOMETRY = os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, "config",
-                                "geometry.yaml")
+SCRIPT_DIR = os.path.dirname(os.path.abspath(__file__))
+DEFAULT_GEOMETRY = os.path.join(SCRIPT_DIR, os.pardir, "config", "geometry.yaml")
+# Where --model looks for <model>.yaml, first to last: --models-dir, $RANGER_MODELS_DIR, the copy
+# this package installs (share/ranger_description/config/models), the source tree's.
+MODELS_DIRS = (os.path.join(SCRIPT_DIR, os.pardir, "config", "models"),
+               os.path.join(SCRIPT_DIR, os.pardir, os.pardir, "libranger_can", "models"))
 
 # Wheel order and joint names: libranger_can's geometry.hpp (kWheelNames, kSteeringJointNames,
 # kWheelJointNames). test/test_urdf.py checks that both lists agree.
@@ -26,7 +38,7 @@ STEERING_JOINTS = tuple(w + "_steering_joint" for w in WHEELS)
 WHEEL_JOINTS = tuple(w + "_wheel_joint" for w in WHEELS)
 ULTRASONIC_COUNT = 8
 
-TOTAL_MASS = 135.0  # kg with one battery (manual 1.1)
+TOTAL_MASS = 135.0  # kg with one battery (manual 1.1): the default of description/total_mass
 COLOURS = {
     "ranger_body": (0.93, 0.55, 0.10, 1.0),  # orange: the screenshot test looks for this colour
     "ranger_tyre": (0.12, 0.12, 0.12, 1.0),
@@ -53,16 +65,64 @@ def _number(table, key, where, positive=True):
     return value
 
 
+def unflatten(raw):
+    """A model file's flat `description/<key>` and `description/ultrasonic_<n>` keys in
+    geometry.yaml's nested form (a geometry.yaml comes back unchanged)."""
+    out = {k: v for k, v in raw.items() if "/" not in k}
+    flat = {k: v for k, v in raw.items() if "/" in k}
+    if not flat:
+        return out
+    desc = out.setdefault("description", {})
+    if not isinstance(desc, dict):
+        raise GeometryError("description: both a value and description/... keys")
+    sensors = {}
+    for key, value in flat.items():
+        prefix, _, name = key.partition("/")
+        if prefix != "description" or not name or "/" in name:
+            raise GeometryError(f"{key}: only description/<key> may contain a '/'")
+        m = re.fullmatch(r"ultrasonic_(\d+)", name)
+        if m:
+            sensors[int(m.group(1))] = value
+        else:
+            desc[name] = value
+    if sensors:
+        if sorted(sensors) != list(range(1, len(sensors) + 1)):
+            raise GeometryError("description/ultrasonic_<n>: expected ultrasonic_1 to "
+                                f"ultrasonic_{ULTRASONIC_COUNT}, got {sorted(sensors)}")
+        desc["ultrasonic"] = [sensors[n] for n in sorted(sensors)]
+    return out
+
+
+def model_path(model, models_dir=None):
+    """The model file of `model`: the first <dir>/<model>.yaml that exists; the error lists the
+    models found."""
+    dirs = [d for d in (models_dir, os.environ.get("RANGER_MODELS_DIR")) if d] + list(MODELS_DIRS)
+    for d in dirs:
+        path = os.path.join(d, model + ".yaml")
+        if os.path.isfile(path):
+            return path
+    names = sorted({f[:-5] for d in dirs if os.path.isdir(d) for f in os.listdir(d)
+                    if f.endswith(".yaml")})
+    raise GeometryError(f"unknown model '{model}' (valid: {', '.join(names) or 'none found'}; "
+                        f"looked in {', '.join(dirs)})")
+
+
 def load_geometry(path):
-    """Reads and validates a geometry file; returns a flat dict of floats (+ 'ultrasonic' list)."""
+    """Reads and validates a geometry file (geometry.yaml or a model file); returns a flat dict of
+    floats (+ 'ultrasonic' list, 'model' name or None)."""
     with open(path, encoding="utf-8") as f:
         raw = yaml.safe_load(f)
     if not isinstance(raw, dict):
         raise GeometryError(f"{path}: expected a mapping at the top level")
+    raw = unflatten(raw)
     desc = raw.get("description")
     if not isinstance(desc, dict):
         raise GeometryError("description: missing or not a mapping")
     g = {k: _number(raw, k, "") for k in ("wheelbase", "track", "wheel_radius")}
+    g["model"] = raw.get("model")
+    g["source"] = os.path.basename(path)
+    g["total_mass"] = (_number(desc, "total_mass", "description/") if "total_mass" in desc
+                       else TOTAL_MASS)
     for key in ("body_length", "body_width", "body_height", "body_clearance", "wheel_width",
                 "wheel_mass", "steering_module_mass", "steering_limit", "steering_velocity",
                 "steering_effort", "wheel_velocity", "wheel_effort", "ultrasonic_height"):
@@ -73,7 +133,7 @@ def load_geometry(path):
         raise GeometryError("wheel_radius: the wheel does not fit under body_height")
     if g["steering_limit"] > math.pi:
         raise GeometryError("description/steering_limit: must be <= pi")
-    if 4 * (g["wheel_mass"] + g["steering_module_mass"]) >= TOTAL_MASS:
+    if 4 * (g["wheel_mass"] + g["steering_module_mass"]) >= g["total_mass"]:
         raise GeometryError(
             "description/wheel_mass + steering_module_mass: exceed the vehicle mass")
     sensors = desc.get("ultrasonic")
@@ -157,8 +217,10 @@ def _joint(robot, name, kind, parent, child, xyz, rpy=(0, 0, 0), axis=None, limi
 def build_urdf(g):
     """Returns the URDF as an ElementTree root element."""
     robot = ET.Element("robot", name="ranger")
+    source = "config/geometry.yaml" if g.get("source", "geometry.yaml") == "geometry.yaml" else (
+        "libranger_can/models/" + g["source"])
     robot.append(ET.Comment(" Generated by ranger_description/scripts/generate_urdf.py from "
-                            "config/geometry.yaml: edit that file, not this one. "))
+                            f"{source}: edit that file, not this one. "))
     for name, rgba in COLOURS.items():
         material = ET.SubElement(robot, "material", name=name)
         ET.SubElement(material, "color", rgba=_fmt(*rgba))
@@ -172,7 +234,7 @@ def build_urdf(g):
     shell_z = g["body_clearance"] + shell_h / 2.0 - half_h
     _shape(base, "visual", _box(length, width, shell_h), "ranger_body", xyz=(0, 0, shell_z))
     _shape(base, "collision", _box(length, width, height))
-    body_mass = TOTAL_MASS - 4 * (g["wheel_mass"] + g["steering_module_mass"])
+    body_mass = g.get("total_mass", TOTAL_MASS) - 4 * (g["wheel_mass"] + g["steering_module_mass"])
     _inertial(base, body_mass, _box_inertia(body_mass, length, width, shell_h), (0, 0, shell_z))
     _joint(robot, "base_footprint_joint", "fixed", "base_footprint", "base_link", (0, 0, half_h))
 
@@ -226,15 +288,28 @@ def to_xml(robot):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.strip().splitlines()[0])
-    parser.add_argument("geometry", nargs="?", default=DEFAULT_GEOMETRY,
+    parser.add_argument("geometry", nargs="?", default=None,
                         help="geometry YAML (default: this package's config/geometry.yaml)")
+    parser.add_argument("--model", help="a model's file instead: libranger_can/models/MODEL.yaml "
+                        "(ranger, ranger_mini_v1, ranger_mini_v2, ranger_mini_v3)")
+    parser.add_argument("--models-dir", help="where the model files are (default: "
+                        "$RANGER_MODELS_DIR, this package's config/models, the source tree's)")
     parser.add_argument("-o", "--output", help="write the URDF here instead of stdout")
     # roslaunch's <param command=...> may append remapping-like arguments; ignore those.
     args, _ = parser.parse_known_args(argv)
+    if args.model and args.geometry:
+        print("generate_urdf.py: give a GEOMETRY_YAML or --model, not both", file=sys.stderr)
+        return 2
+    where = args.geometry or (f"--model {args.model}" if args.model else DEFAULT_GEOMETRY)
     try:
-        text = to_xml(build_urdf(load_geometry(args.geometry)))
+        path = model_path(args.model, args.models_dir) if args.model else (
+            args.geometry or DEFAULT_GEOMETRY)
+        g = load_geometry(path)
+        if args.model and g["model"] != args.model:
+            raise GeometryError(f"model: '{g['model']}' is not the file's name '{args.model}'")
+        text = to_xml(build_urdf(g))
     except (OSError, yaml.YAMLError, GeometryError) as e:
-        print(f"generate_urdf.py: {args.geometry}: {e}", file=sys.stderr)
+        print(f"generate_urdf.py: {where}: {e}", file=sys.stderr)
         return 1
     if args.output:
         os.makedirs(os.path.dirname(os.path.abspath(args.output)), exist_ok=True)

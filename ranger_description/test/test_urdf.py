@@ -276,3 +276,103 @@ def test_a_different_geometry_moves_the_joints(tmp_path, geometry):
     robot = generate_urdf.build_urdf(generate_urdf.load_geometry(path))
     x, y, _ = floats(joint(robot, "rear_left_steering_joint").find("origin").get("xyz"))
     assert (x, y) == pytest.approx((-0.6, 0.35))
+
+
+# ---- the models (libranger_can/models/*.yaml: one file per model, flat) ------------------------
+MODELS_DIR = os.environ.get("RANGER_MODELS_DIR", os.path.join(
+    PACKAGE_DIR, os.pardir, "libranger_can", "models"))
+MODEL_URDF_DIR = os.environ.get("RANGER_MODEL_URDF_DIR")
+MODELS = ("ranger", "ranger_mini_v1", "ranger_mini_v2", "ranger_mini_v3")
+
+
+def model_geometry(model):
+    return generate_urdf.load_geometry(generate_urdf.model_path(model, MODELS_DIR))
+
+
+def model_robot(model):
+    return ET.fromstring(generate_urdf.to_xml(generate_urdf.build_urdf(model_geometry(model))))
+
+
+def test_every_model_has_a_file():
+    found = sorted(f[:-5] for f in os.listdir(MODELS_DIR) if f.endswith(".yaml"))
+    assert found == list(MODELS)
+
+
+def test_geometry_yaml_is_the_ranger_model():
+    """config/geometry.yaml (the node's parameters) and models/ranger.yaml say the same."""
+    node_file = generate_urdf.load_geometry(GEOMETRY_YAML)
+    model_file = model_geometry("ranger")
+    for key in set(node_file) | set(model_file):
+        if key in ("model", "source"):
+            continue
+        assert node_file.get(key) == pytest.approx(model_file.get(key)), key
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_model_urdf_parses_and_puts_the_wheels_where_the_model_says(tmp_path, model, hpp):
+    g = model_geometry(model)
+    assert g["model"] == model
+    robot = model_robot(model)
+    path = tmp_path / f"{model}.urdf"
+    path.write_text(generate_urdf.to_xml(generate_urdf.build_urdf(g)))
+    result = subprocess.run([shutil.which("check_urdf") or "check_urdf", str(path)],
+                            capture_output=True, text=True, timeout=60)
+    assert result.returncode == 0, result.stdout + result.stderr
+    for i, name in enumerate(hpp["steering_joints"]):
+        x, y, _ = floats(joint(robot, name).find("origin").get("xyz"))
+        sx, sy = hpp["signs"][i]
+        assert (x, y) == pytest.approx((sx * g["wheelbase"] / 2, sy * g["track"] / 2), abs=TOL)
+    for wheel in hpp["wheel_joints"]:
+        link = joint(robot, wheel).find("child").get("link")
+        assert world_origin(robot, link)[2] == pytest.approx(g["wheel_radius"], abs=TOL)
+    total = sum(float(link.find("inertial/mass").get("value"))
+                for link in robot.findall("link") if link.find("inertial") is not None)
+    assert total == pytest.approx(g["total_mass"])
+    # The spin position (atan(L/W)) is within the steering joints' limits.
+    limit = joint(robot, hpp["steering_joints"][0]).find("limit")
+    assert float(limit.get("upper")) >= math.atan2(g["wheelbase"], g["track"])
+
+
+def test_models_have_their_geometry():
+    assert (model_geometry("ranger_mini_v1")["wheelbase"], model_geometry("ranger_mini_v1")[
+        "track"]) == (0.36, 0.36)
+    for model in ("ranger_mini_v2", "ranger_mini_v3"):
+        g = model_geometry(model)
+        assert (g["wheelbase"], g["track"]) == (0.494, 0.364)
+
+
+@pytest.mark.skipif(not MODEL_URDF_DIR, reason="RANGER_MODEL_URDF_DIR not set (run through CTest)")
+@pytest.mark.parametrize("model", MODELS)
+def test_the_built_model_urdfs_are_the_generator_output(model):
+    with open(os.path.join(MODEL_URDF_DIR, model + ".urdf"), encoding="utf-8") as f:
+        built = f.read()
+    assert built == generate_urdf.to_xml(generate_urdf.build_urdf(model_geometry(model))), (
+        f"{model}.urdf is stale: rebuild ranger_description")
+
+
+def test_the_command_line_takes_a_model():
+    script = os.path.join(PACKAGE_DIR, "scripts", "generate_urdf.py")
+    out = subprocess.run([sys.executable, script, "--model", "ranger_mini_v2", "--models-dir",
+                          MODELS_DIR], check=True, capture_output=True, text=True,
+                         timeout=60).stdout
+    assert out == generate_urdf.to_xml(generate_urdf.build_urdf(model_geometry("ranger_mini_v2")))
+    assert "libranger_can/models/ranger_mini_v2.yaml" in out
+    bad = subprocess.run([sys.executable, script, "--model", "ranger_maxi", "--models-dir",
+                          MODELS_DIR], capture_output=True, text=True, timeout=60)
+    assert bad.returncode == 1 and bad.stdout == ""
+    assert "unknown model 'ranger_maxi' (valid: ranger, ranger_mini_v1" in bad.stderr
+    both = subprocess.run([sys.executable, script, GEOMETRY_YAML, "--model", "ranger"],
+                          capture_output=True, text=True, timeout=60)
+    assert both.returncode == 2 and "not both" in both.stderr
+
+
+def test_a_flat_file_with_a_gap_in_the_sensors_is_refused(tmp_path):
+    with open(generate_urdf.model_path("ranger_mini_v3", MODELS_DIR), encoding="utf-8") as f:
+        text = f.read()
+    path = tmp_path / "ranger_mini_v3.yaml"
+    path.write_text(text.replace("description/ultrasonic_4:", "description/ultrasonic_9:"))
+    with pytest.raises(generate_urdf.GeometryError, match="ultrasonic_1 to ultrasonic_8"):
+        generate_urdf.load_geometry(str(path))
+    path.write_text(text + "protocol/extra: 1\n")
+    with pytest.raises(generate_urdf.GeometryError, match="only description/<key>"):
+        generate_urdf.load_geometry(str(path))

@@ -576,7 +576,7 @@ Status apply_scenario_param(DriverConfig& config, std::string_view assignment) {
 }
 
 Status validate(const ScenarioOptions& options) {
-  if (auto v = apply_variant(options.variant, VirtualChassisConfig{}); !v) return v.error();
+  if (auto v = apply_variant(options.variant, options.chassis); !v) return v.error();
   if (options.every < 1ms) {
     return Error{Errc::kInvalidArgument, "the output period must be at least 1 ms"};
   }
@@ -842,6 +842,7 @@ Result<std::unique_ptr<ScenarioRunner>> ScenarioRunner::create(const ScenarioOpt
   impl->options = options;
   SimSourceOptions sim;
   sim.lock_step = true;
+  sim.chassis = options.chassis;
   auto source = open_bus_source("sim:" + options.variant, impl->clock, sim);
   if (!source) return source.error();
   impl->sim = std::static_pointer_cast<SimBusSource>(*source);

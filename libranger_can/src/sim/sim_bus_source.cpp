@@ -1,5 +1,6 @@
 #include "ranger_can/sim/sim_bus_source.hpp"
 
+#include <algorithm>
 #include <utility>
 
 namespace ranger::sim {
@@ -16,15 +17,114 @@ std::string join(const std::vector<std::string>& names) {
 
 }  // namespace
 
+const std::vector<VariantInfo>& variants() {
+  static const std::vector<VariantInfo> kVariants = {
+      {"manual", "the user manual's chassis (the plain `sim`)", ""},
+      {"agx_v2", "the vendor's revision (agx_v2), also sending 0x231, 0x241 and 0x4A1 answers",
+       "--protocol agx_v2"},
+      {"padded", "the manual's layout, every frame it sends padded to 8 bytes", "--set tx_dlc=8"},
+      {"spin_cw", "spin values (0x111 bytes 4-5, 0x221 in spin mode) clockwise positive",
+       "--set spin_sign=cw"},
+      {"steer_left_positive", "0x111, 0x221 and 0x271 steering angles positive to the left",
+       "--set steering_sign_111=left_positive --set steering_sign_221=left_positive "
+       "--set steering_sign_271=left_positive"},
+      {"speed221_body", "0x221 reports the body centre's speed in Ackermann mode",
+       "--set feedback_speed=body_centre"},
+      {"inner_angle", "0x111 steers and 0x221 reports the inner front wheel's angle",
+       "--set steering_reference=inner_front"},
+      {"mini_v1", "the RANGER MINI V1: geometry, limits and protocol of model ranger_mini_v1",
+       "--model ranger_mini_v1"},
+      {"undecidable", "neither revision: the manual's IDs and lengths, agx_v2 values, no 0x271",
+       "--protocol agx_v2 --set tx_dlc=0 --set mode_numbering=manual"},
+  };
+  return kVariants;
+}
+
 const std::vector<std::string>& variant_names() {
-  static const std::vector<std::string> names = {"manual"};
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> out;
+    for (const VariantInfo& v : variants())
+      out.push_back(v.name);
+    return out;
+  }();
   return names;
 }
 
+std::string variants_help() {
+  std::string out;
+  for (const VariantInfo& v : variants()) {
+    std::string name = "  " + v.name;
+    name.resize(std::max<std::size_t>(name.size() + 2, 23), ' ');
+    out += name + v.description + "\n";
+  }
+  return out;
+}
+
+VirtualChassisConfig chassis_for_model(const ModelPreset& model, VirtualChassisConfig config) {
+  config.geometry = model.geometry;
+  config.limits.max_linear_speed = model.limits.max_linear_speed;
+  config.limits.max_spin_speed = model.limits.max_spin_wheel_speed;
+  config.limits.max_ackermann_angle = model.limits.max_ackermann_steering;
+  config.limits.max_oblique_angle = model.limits.max_oblique_steering;
+  config.profile = model.profile;
+  return config;
+}
+
+namespace {
+
+// The preset of a revision or a model the variant table names (both exist: the tests say so).
+ProtocolProfile preset(std::string_view revision) {
+  auto p = protocol_preset(revision);
+  return p ? *p : manual_profile();
+}
+
+void set(ProtocolProfile& profile, std::string_view name, std::string_view value) {
+  const Status st = set_setting(profile, name, value);
+  (void)st;  // the names and values below are the settings table's (checked by the tests)
+}
+
+}  // namespace
+
 Result<VirtualChassisConfig> apply_variant(std::string_view variant, VirtualChassisConfig config) {
+  ProtocolProfile& p = config.profile;
   if (variant == "manual") return config;
-  return Error{Errc::kInvalidArgument, "unknown virtual chassis variant '" + std::string(variant) +
-                                           "' (valid: " + join(variant_names()) + ")"};
+  if (variant == "agx_v2") {
+    p = preset("agx_v2");
+    config.vendor_frames = true;
+  } else if (variant == "padded") {
+    set(p, "tx_dlc", "8");
+  } else if (variant == "spin_cw") {
+    set(p, "spin_sign", "cw");
+  } else if (variant == "steer_left_positive") {
+    for (const char* s : {"steering_sign_111", "steering_sign_221", "steering_sign_271"})
+      set(p, s, "left_positive");
+  } else if (variant == "speed221_body") {
+    set(p, "feedback_speed", "body_centre");
+  } else if (variant == "inner_angle") {
+    set(p, "steering_reference", "inner_front");
+  } else if (variant == "mini_v1") {
+    auto model = model_preset("ranger_mini_v1");
+    if (!model) return model.error();
+    config = chassis_for_model(*model, config);
+    config.vendor_frames = true;  // the vendor's protocol family
+  } else if (variant == "undecidable") {
+    // Built so that no passive evidence settles the revision, and the steering unit cannot be
+    // read at rest: the vendor's units, signs, spin field, error word (byte 7 a counter), BMS
+    // scale and driver bit, on the manual's identifiers (no 0x231/0x241, no 0x4A1 answer) with
+    // the manual's lengths and mode numbers; no 0x271 (no wheel angle whose value geometry
+    // fixes), and 0x221 reports angle 0 in spin mode (its spin position would tell the unit).
+    p = preset("agx_v2");
+    set(p, "tx_dlc", "0");
+    set(p, "mode_numbering", "manual");
+    config.vendor_frames = false;
+    config.steering_angles_frame = false;
+    config.spin_angle_reported = false;
+  } else {
+    return Error{Errc::kInvalidArgument, "unknown virtual chassis variant '" +
+                                             std::string(variant) +
+                                             "' (valid: " + join(variant_names()) + ")"};
+  }
+  return config;
 }
 
 SimBusSource::SimBusSource(std::string spec, VirtualChassisConfig config,

@@ -16,26 +16,9 @@ using namespace std::chrono_literals;
 using protocol::ControlMode;
 using protocol::MotionMode;
 
-// 0x211 error bits the chassis itself drives (named in protocol.hpp, the manual's layout).
-std::uint32_t fault(protocol::Fault f, int motor = 0) {
-  return protocol::fault_bit(f, ErrorWordLayout::kManual32, motor);
-}
-const std::uint32_t kBatteryUnderVoltage = fault(protocol::Fault::kBatteryUnderVoltage);
-const std::uint32_t kUltrasonicTriggered = fault(protocol::Fault::kUltrasonicTriggered);
-const std::uint32_t kRemoteLost = fault(protocol::Fault::kRemoteSignalLost);
-const std::uint32_t kHostCommLost = fault(protocol::Fault::kHostCommunicationLost);
-const std::uint32_t kDriverStatusError = fault(protocol::Fault::kDriverStatusError);
-const std::uint32_t kOverTemperature = fault(protocol::Fault::kOverTemperature);
-const std::uint32_t kOverCurrent = fault(protocol::Fault::kOverCurrent);
-
-// Communication fault bit of motor driver n = 1..8.
-std::uint32_t motor_comm_bit(int n) {
-  return fault(protocol::Fault::kMotorCommunication, n);
-}
-// Steering calibration fault of steering motor n = 5..8.
-std::uint32_t steering_calib_bit(int n) {
-  return fault(protocol::Fault::kSteeringCalibration, n);
-}
+using protocol::Fault;
+// The 0x211 error bits the chassis drives itself, by meaning (VirtualChassis::bit gives each one's
+// position in the profile's layout; 0 where the layout has no such bit).
 
 // Driver status bits of 0x261-0x268 byte 5 (protocol.hpp).
 constexpr std::uint8_t kDriverSupplyLow = protocol::driver_status::kSupplyVoltageLow;
@@ -51,11 +34,19 @@ constexpr double kLowBatteryCutoffSoc = 10.0;   // manual: under 10 % the driver
 constexpr double kLowBatteryWarningSoc = 15.0;  // manual: under 15 % the lights flash
 constexpr std::size_t kMaxEvents = 1000;
 
-std::string names_of(std::uint32_t bits) {
+std::string names_of(std::uint32_t bits, ErrorWordLayout layout) {
   std::string out;
-  for (const auto& n : protocol::error_bit_names(bits))
+  for (const auto& n : protocol::error_bit_names(bits, layout))
     out += (out.empty() ? "" : ",") + n;
   return out;
+}
+
+// The 0x221 / 0x111 Ackermann angle of the profile's reading, from the mean front angle the model
+// keeps (REP-103 signs).
+double front_angle_from_mean(double mean, const VehicleGeometry& g, SteeringReference reference) {
+  if (reference == SteeringReference::kMeanFront) return mean;
+  const double k = interpretation::ackermann_curvature_from_mean_angle(mean, g.wheelbase, g.track);
+  return interpretation::ackermann_front_angle(k, g.wheelbase, g.track, reference);
 }
 
 std::string format_pct(double v) {
@@ -176,7 +167,7 @@ void VirtualChassis::integrate(Timestamp t) {
   if (t <= now_) return;
   const double dt = seconds(t - now_);
   const bool was_switching = motion_.switching();
-  const bool powered = !emergency_stop_ && (error_word() & kBatteryUnderVoltage) == 0;
+  const bool powered = !emergency_stop_ && (error_word() & bit(Fault::kBatteryUnderVoltage)) == 0;
   motion_.advance(dt);
   drivetrain_.advance(dt, motion_, powered);
   now_ = t;
@@ -195,15 +186,19 @@ bool VirtualChassis::ultrasonic_triggered() const {
   });
 }
 
+std::uint32_t VirtualChassis::bit(Fault fault, int motor) const {
+  return protocol::fault_bit(fault, config_.profile.error_word, motor);
+}
+
 std::uint32_t VirtualChassis::error_word() const {
-  return latched_errors_ | (host_link_lost_ ? kHostCommLost : 0u) |
-         (ultrasonic_triggered() ? kUltrasonicTriggered : 0u);
+  return latched_errors_ | (host_link_lost_ ? bit(Fault::kHostCommunicationLost) : 0u) |
+         (ultrasonic_triggered() ? bit(Fault::kUltrasonicTriggered) : 0u);
 }
 
 protocol::VehicleStatus VirtualChassis::vehicle_status() const {
   if (emergency_stop_) {
-    return interpretation::kVehicleStatus1IsEmergencyStop ? protocol::VehicleStatus::kEmergencyStop
-                                                          : protocol::VehicleStatus::kAbnormal;
+    return config_.profile.vehicle_status_1_is_estop ? protocol::VehicleStatus::kEmergencyStop
+                                                     : protocol::VehicleStatus::kAbnormal;
   }
   return error_word() != 0 ? protocol::VehicleStatus::kAbnormal : protocol::VehicleStatus::kNormal;
 }
@@ -214,30 +209,38 @@ std::string VirtualChassis::refusal_reason() const {
   }
   if (emergency_stop_) return "emergency stop";
   const std::uint32_t errors = error_word();
-  if (errors & kBatteryUnderVoltage) return "battery under-voltage: drive power cut";
-  if (errors & kUltrasonicTriggered) return "ultrasonic obstacle avoidance triggered";
+  const ErrorWordLayout layout = config_.profile.error_word;
+  if (errors & bit(Fault::kBatteryUnderVoltage)) return "battery under-voltage: drive power cut";
+  if (ultrasonic_triggered()) return "ultrasonic obstacle avoidance triggered";
   if (host_link_lost_) return "host communication lost";
-  if (protocol::is_critical_error(errors)) return "critical error: " + names_of(errors);
+  if (protocol::is_critical_error(errors, layout)) {
+    return "critical error: " + names_of(errors, layout);
+  }
   if (motion_.switching()) return "switching motion mode";
   return {};
 }
 
 void VirtualChassis::update_conditions(Timestamp) {
-  if (drivetrain_.soc() < kLowBatteryCutoffSoc && (latched_errors_ & kBatteryUnderVoltage) == 0) {
-    latched_errors_ |= kBatteryUnderVoltage;
+  const std::uint32_t under_voltage = bit(Fault::kBatteryUnderVoltage);
+  if (drivetrain_.soc() < kLowBatteryCutoffSoc && (latched_errors_ & under_voltage) == 0) {
+    latched_errors_ |= under_voltage;
     event("battery at " + format_pct(drivetrain_.soc()) + " (< 10%): drive power cut");
   }
   const std::uint32_t errors = error_word();
   if (errors != last_reported_errors_) {
     const std::uint32_t raised = errors & ~last_reported_errors_;
     const std::uint32_t cleared = last_reported_errors_ & ~errors;
+    const ErrorWordLayout layout = config_.profile.error_word;
     std::string text = "error bits 0x" + [&] {
       char buf[16];
-      std::snprintf(buf, sizeof buf, "%08X", errors);
+      std::snprintf(buf, sizeof buf, protocol::error_word_bits(layout) == 16 ? "%04X" : "%08X",
+                    errors);
       return std::string(buf);
     }();
-    if (raised) text += " raised: " + names_of(raised);
-    if (cleared) text += std::string(raised ? ";" : "") + " cleared: " + names_of(cleared);
+    if (raised) text += " raised: " + names_of(raised, layout);
+    if (cleared) {
+      text += std::string(raised ? ";" : "") + " cleared: " + names_of(cleared, layout);
+    }
     event(text);
     last_reported_errors_ = errors;
   }
@@ -251,7 +254,8 @@ void VirtualChassis::apply_motion_policy() {
   }
   if (!reason.empty()) {
     commanded_.speed = 0.0;
-    const bool power_cut = emergency_stop_ || (error_word() & kBatteryUnderVoltage) != 0;
+    const bool power_cut =
+        emergency_stop_ || (error_word() & bit(Fault::kBatteryUnderVoltage)) != 0;
     motion_.stop(power_cut);
   } else {
     motion_.set_target(commanded_);
@@ -279,19 +283,27 @@ void VirtualChassis::on_frame(const CanFrame& frame, Timestamp now) {
     ++counters_.frames_rejected;
     return;
   }
-  auto decoded = decode(frame);
+  auto decoded = decode(frame, config_.profile);
   if (!decoded) {
     ++counters_.frames_rejected;
     return;
   }
   const Message& msg = *decoded;
+  const bool vendor_command =
+      std::holds_alternative<LightCommand>(msg) || std::holds_alternative<VersionRequest>(msg);
   const bool is_command = std::holds_alternative<MotionCommand>(msg) ||
                           std::holds_alternative<MotionModeCommand>(msg) ||
                           std::holds_alternative<ControlModeCommand>(msg) ||
                           std::holds_alternative<ErrorClearCommand>(msg) ||
-                          std::holds_alternative<UltrasonicSettingCommand>(msg);
-  if (!is_command) {  // feedback from another node (or our own echo): not for us
+                          std::holds_alternative<UltrasonicSettingCommand>(msg) ||
+                          (vendor_command && config_.vendor_frames);
+  if (!is_command) {  // feedback from another node (or our own echo), or not this chassis's
     ++counters_.frames_rejected;
+    return;
+  }
+  // A version request is a question, not a command: answered in every control mode.
+  if (std::holds_alternative<VersionRequest>(msg)) {
+    answer_version_request();
     return;
   }
   // Standby answers control-mode frames only; in remote mode the remote blocks CAN entirely.
@@ -309,6 +321,7 @@ void VirtualChassis::on_frame(const CanFrame& frame, Timestamp now) {
     if (!clear_errors(m->code)) ++counters_.frames_ignored;
   }
   if (auto* m = std::get_if<UltrasonicSettingCommand>(&msg)) handle_ultrasonic_setting(*m);
+  if (auto* m = std::get_if<LightCommand>(&msg)) lights_ = *m;
   update_conditions(now_);
   apply_motion_policy();
 }
@@ -325,31 +338,50 @@ void VirtualChassis::handle_motion_command(const MotionCommand& cmd) {
     return;
   }
   const MotionMode mode = motion_.mode();
+  const ProtocolProfile& p = config_.profile;
+  const VehicleGeometry& g = motion_.geometry();
   if (mode == MotionMode::kSpin) {
-    commanded_ = {cmd.spin_speed, 0.0};
-  } else {
-    const double steering = interpretation::rep103_from_manual_command_steering(cmd.steering_angle);
-    const VehicleGeometry& g = motion_.geometry();
-    // Oblique: all wheels parallel, curvature 0. Ackermann: the curvature the model will steer
-    // (its angle limit applied), which relates the wire's speed to the body centre's.
+    // Only the profile's spin field moves the chassis; the other one is ignored.
+    const double wheel_speed =
+        p.spin_field == SpinField::kYawRate
+            ? interpretation::spin_wheel_speed_from_yaw_rate(
+                  interpretation::spin_ccw_from_wire(cmd.yaw_rate, p), g.wheelbase, g.track)
+            : interpretation::spin_ccw_from_wire(cmd.spin_speed, p);
+    commanded_ = {wheel_speed, 0.0};
+  } else if (mode == MotionMode::kAckermann) {
+    // The angle of the profile's steering_reference, within the chassis's limit; the model keeps
+    // the mean front angle of the same curvature. The curvature relates the wire's speed to the
+    // body centre's.
     const double max_angle = motion_.limits().max_ackermann_angle;
-    const double curvature =
-        mode == MotionMode::kAckermann
-            ? interpretation::ackermann_curvature_from_mean_angle(
-                  std::clamp(steering, -max_angle, max_angle), g.wheelbase, g.track)
-            : 0.0;
+    const double angle =
+        std::clamp(interpretation::rep103_from_manual_command_steering(cmd.steering_angle),
+                   -max_angle, max_angle);
+    const double curvature = interpretation::ackermann_curvature_from_front_angle(
+        angle, g.wheelbase, g.track, p.steering_reference);
     commanded_ = {interpretation::body_speed_from_command_speed(cmd.linear_speed, curvature,
                                                                 g.wheelbase, g.track),
-                  steering};
+                  interpretation::ackermann_mean_front_angle(curvature, g.wheelbase, g.track)};
+  } else {
+    // Oblique: all wheels parallel, curvature 0.
+    const double steering = interpretation::rep103_from_manual_command_steering(cmd.steering_angle);
+    commanded_ = {
+        interpretation::body_speed_from_command_speed(cmd.linear_speed, 0.0, g.wheelbase, g.track),
+        steering};
   }
   ++counters_.motion_commands;
 }
 
 void VirtualChassis::handle_motion_mode(const MotionModeCommand& cmd) {
-  const auto raw = static_cast<std::uint8_t>(cmd.mode);
-  if (raw > static_cast<std::uint8_t>(MotionMode::kSpin)) {
+  if (!cmd.mode_known) {
     ++counters_.frames_ignored;
-    event("0x141 with unknown motion mode " + std::to_string(raw) + " ignored");
+    event("0x141 with unknown motion mode " + std::to_string(cmd.mode_raw) + " ignored");
+    return;
+  }
+  if (cmd.mode != MotionMode::kAckermann && cmd.mode != MotionMode::kOblique &&
+      cmd.mode != MotionMode::kSpin) {
+    ++counters_.frames_ignored;
+    event("0x141 motion mode " + std::string(protocol::to_string(cmd.mode)) +
+          " is not simulated: ignored");
     return;
   }
   if (motion_.begin_mode_switch(cmd.mode, seconds(config_.mode_switch_duration))) {
@@ -402,7 +434,7 @@ void VirtualChassis::remote_hand_back(bool to_standby) {
 }
 
 void VirtualChassis::remote_signal_lost() {
-  latched_errors_ |= kRemoteLost;
+  latched_errors_ |= bit(Fault::kRemoteSignalLost);
   if (control_mode_ == ControlMode::kRemote) {
     set_control_mode(ControlMode::kStandby, "remote signal lost");
   }
@@ -419,11 +451,11 @@ void VirtualChassis::set_emergency_stop(bool on) {
 }
 
 void VirtualChassis::set_error_bit(int index, bool on) {
-  if (index < 0 || index > 31) return;
+  if (index < 0 || index >= protocol::error_word_bits(config_.profile.error_word)) return;
   const std::uint32_t b = 1u << index;
-  if (b == kHostCommLost) {
+  if (b == bit(Fault::kHostCommunicationLost)) {
     host_link_lost_ = on;
-  } else if (b == kUltrasonicTriggered) {
+  } else if (b == bit(Fault::kUltrasonicTriggered)) {
     // A condition, not a latch: injected by placing an obstacle in front of sensor 1.
     if (on) {
       ultrasonic_enabled_ = true;
@@ -441,8 +473,17 @@ void VirtualChassis::set_error_bit(int index, bool on) {
   apply_motion_policy();
 }
 
-void VirtualChassis::set_error_bits(std::uint32_t bits) {
+bool VirtualChassis::set_fault(Fault fault, bool on, int motor) {
+  const std::uint32_t b = bit(fault, motor);
+  if (b == 0) return false;
   for (int i = 0; i < 32; ++i) {
+    if (b == (1u << i)) set_error_bit(i, on);
+  }
+  return true;
+}
+
+void VirtualChassis::set_error_bits(std::uint32_t bits) {
+  for (int i = 0; i < protocol::error_word_bits(config_.profile.error_word); ++i) {
     const bool want = (bits >> i) & 1u;
     if (want != (((error_word() >> i) & 1u) != 0)) set_error_bit(i, want);
   }
@@ -480,11 +521,12 @@ void VirtualChassis::set_mode_switch_stuck(bool stuck) {
 }
 
 bool VirtualChassis::clear_errors(std::uint8_t code) {
+  const ErrorWordLayout layout = config_.profile.error_word;
   std::uint32_t clear = 0;
   if (code == 0x00) {
-    for (int i = 0; i < 32; ++i) {
+    for (int i = 0; i < protocol::error_word_bits(layout); ++i) {
       const std::uint32_t b = 1u << i;
-      if (!protocol::is_critical_error(b)) clear |= b;
+      if (!protocol::is_critical_error(b, layout)) clear |= b;
     }
     // The host link flag describes the link; 0x00 resets it and waits for the next 0x111.
     if (host_link_lost_) {
@@ -492,17 +534,17 @@ bool VirtualChassis::clear_errors(std::uint8_t code) {
       watchdog_armed_ = false;
     }
   } else if (code <= 0x08) {
-    clear = motor_comm_bit(code);
+    clear = bit(Fault::kMotorCommunication, code);
   } else if (code == 0x09) {
-    clear = kBatteryUnderVoltage;
+    clear = bit(Fault::kBatteryUnderVoltage);
   } else if (code == 0x0A) {
-    clear = kRemoteLost;
+    clear = bit(Fault::kRemoteSignalLost);
   } else if (code <= 0x0E) {
-    clear = steering_calib_bit(code - 0x0B + 5);
+    clear = bit(Fault::kSteeringCalibration, code - 0x0B + 5);
   } else if (code == 0x0F) {
-    clear = kOverCurrent;
+    clear = bit(Fault::kOverCurrent);
   } else if (code == 0x10) {
-    clear = kOverTemperature;
+    clear = bit(Fault::kOverTemperature);
   } else {
     return false;
   }
@@ -551,7 +593,7 @@ void VirtualChassis::send_raw(CanFrame frame, Timestamp t) {
 
 void VirtualChassis::send(const Message& message, Timestamp t) {
   if (silent_) return;
-  auto frame = encode(message);
+  auto frame = encode(message, config_.profile);
   if (!frame) {
     ++counters_.send_failures;
     return;
@@ -562,16 +604,20 @@ void VirtualChassis::send(const Message& message, Timestamp t) {
 Message VirtualChassis::motion_feedback() const {
   const WheelStates w = motion_.wheels();
   const VehicleGeometry& g = motion_.geometry();
+  const ProtocolProfile& p = config_.profile;
+  const BodyTwist twist = motion_.twist();
   MotionFeedback fb;
   switch (motion_.mode()) {
     case MotionMode::kAckermann: {
-      // 0x221 reports the front wheels' mean angle and (point 8) the mean wheel speed.
+      // The front angle of the profile's reading, from where the front wheels stand (point 6),
+      // and the speed of its feedback_speed reading (point 8).
       const double mean_front = (w[kRightFront].angle + w[kLeftFront].angle) / 2.0;
-      fb.steering_angle = interpretation::manual_from_rep103_steering(mean_front);
+      fb.steering_angle = interpretation::manual_from_rep103_steering(
+          front_angle_from_mean(mean_front, g, p.steering_reference));
       const double curvature = interpretation::ackermann_curvature_from_mean_angle(
           motion_.steering(), g.wheelbase, g.track);
       fb.speed = interpretation::ackermann_feedback_speed_from_body_speed(
-          motion_.twist().vx, curvature, g.wheelbase, g.track);
+          twist.vx, curvature, g.wheelbase, g.track, p.feedback_speed);
       break;
     }
     case MotionMode::kOblique: {
@@ -584,20 +630,40 @@ Message VirtualChassis::motion_feedback() const {
       break;
     }
     default: {
-      // Spin: the fixed angle (mean of |angles|) and (point 9) the signed tangential speed.
-      for (const auto& s : w)
-        fb.steering_angle += std::abs(s.angle) / kWheelCount;
-      fb.speed = interpretation::spin_feedback_speed_from_yaw_rate(motion_.twist().wz, g.wheelbase,
-                                                                   g.track);
+      // Spin: the fixed angle (mean of |angles|) and (point 9) the signed tangential speed, in
+      // the profile's spin field.
+      if (config_.spin_angle_reported) {
+        for (const auto& s : w)
+          fb.steering_angle += std::abs(s.angle) / kWheelCount;
+      }
+      if (p.spin_field == SpinField::kWheelSpeed) {
+        fb.speed = interpretation::spin_wire_from_ccw(
+            interpretation::spin_feedback_speed_from_yaw_rate(twist.wz, g.wheelbase, g.track), p);
+      }
       break;
     }
   }
+  // A chassis with the yaw-rate field reports the body's yaw rate there in every mode.
+  if (p.spin_field == SpinField::kYawRate) {
+    fb.yaw_rate = interpretation::spin_wire_from_ccw(twist.wz, p);
+  }
   return fb;
+}
+
+void VirtualChassis::answer_version_request() {
+  const std::string& text = config_.version;
+  for (std::size_t i = 0; i < text.size(); i += 8) {
+    VersionResponse v;
+    v.length = static_cast<std::uint8_t>(std::min<std::size_t>(8, text.size() - i));
+    std::copy_n(text.begin() + static_cast<std::ptrdiff_t>(i), v.length, v.text.begin());
+    send(v, now_);
+  }
 }
 
 void VirtualChassis::send_due(ScheduleId which, Timestamp t) {
   const auto& motors = drivetrain_.motors();
   const std::uint32_t errors = error_word();
+  const ProtocolProfile& p = config_.profile;
   switch (which) {
     case kFast: {
       SystemStatus st;
@@ -607,6 +673,7 @@ void VirtualChassis::send_due(ScheduleId which, Timestamp t) {
       st.control_mode_raw = static_cast<std::uint8_t>(control_mode_);
       st.battery_voltage = drivetrain_.pack().voltage;
       st.error_bits = errors;
+      if (p.error_word == ErrorWordLayout::kAgxV2_16) st.counter = status_counter_++;
       send(st, t);
       send(motion_feedback(), t);
       for (int n = 1; n <= protocol::kMotorCount; ++n) {
@@ -620,13 +687,36 @@ void VirtualChassis::send_due(ScheduleId which, Timestamp t) {
         angles.angles[i] = interpretation::manual_from_rep103_wheel_angle(w[i].angle);
         speeds.speeds[i] = w[i].speed;
       }
-      send(angles, t);
+      if (config_.steering_angles_frame) send(angles, t);
       send(speeds, t);
       MotionModeFeedback mm;
       mm.mode = motion_.mode();  // while switching: the mode being left
-      mm.mode_raw = static_cast<std::uint8_t>(mm.mode);
+      mm.mode_raw = protocol::motion_mode_to_wire(mm.mode, p.mode_numbering).value_or(0);
       mm.switching = motion_.switching();
       send(mm, t);
+      if (config_.vendor_frames) {
+        // 0x231 and 0x241 at 20 ms, the period the vendor's manuals of the same family give
+        // (assumed for the RANGER), each with its counter.
+        LightState light;
+        light.enable = lights_.enable;
+        light.front_mode = lights_.front_mode;
+        light.front_custom = lights_.front_custom;
+        light.rear_mode = lights_.rear_mode;
+        light.rear_custom = lights_.rear_custom;
+        light.counter = vendor_counter_;
+        send(light, t);
+        // The remote control on, SWB up (command mode) unless the remote is in charge.
+        RemoteControlState rc;
+        rc.swa = protocol::RemoteSwitch::kUp;
+        rc.swb = control_mode_ == ControlMode::kRemote ? protocol::RemoteSwitch::kMiddle
+                                                       : protocol::RemoteSwitch::kUp;
+        rc.swc = protocol::RemoteSwitch::kUp;
+        rc.swd = motion_.mode() == MotionMode::kOblique ? protocol::RemoteSwitch::kDown
+                                                        : protocol::RemoteSwitch::kUp;
+        rc.counter = vendor_counter_;
+        send(rc, t);
+        ++vendor_counter_;
+      }
       break;
     }
     case kUltrasonic: {
@@ -642,15 +732,18 @@ void VirtualChassis::send_due(ScheduleId which, Timestamp t) {
       break;
     }
     case kSlow: {
-      const bool power_cut = emergency_stop_ || (errors & kBatteryUnderVoltage) != 0;
+      const bool power_cut = emergency_stop_ || (errors & bit(Fault::kBatteryUnderVoltage)) != 0;
       const double voltage = drivetrain_.pack().voltage;
       for (int n = 1; n <= protocol::kMotorCount; ++n) {
         const auto& m = motors[n - 1];
         std::uint8_t status = 0;
         if (drivetrain_.soc() < kLowBatteryCutoffSoc) status |= kDriverSupplyLow;
-        if (errors & kOverTemperature) status |= kDriverMotorOverTemp | kDriverOverTemp;
-        if (errors & kOverCurrent) status |= kDriverOverCurrent;
-        if ((errors & motor_comm_bit(n)) || (errors & kDriverStatusError)) status |= kDriverError;
+        if (errors & bit(Fault::kOverTemperature)) status |= kDriverMotorOverTemp | kDriverOverTemp;
+        if (errors & bit(Fault::kOverCurrent)) status |= kDriverOverCurrent;
+        const std::uint32_t comm = bit(Fault::kMotorCommunication, n);
+        if ((comm != 0 && (errors & comm)) || (errors & bit(Fault::kDriverStatusError))) {
+          status |= kDriverError;
+        }
         if (power_cut) status |= kDriverDisabled;
         send(MotorLowSpeedFeedback{n, voltage, m.driver_temperature, m.motor_temperature, status},
              t);
@@ -659,7 +752,10 @@ void VirtualChassis::send_due(ScheduleId which, Timestamp t) {
     }
     case kBms: {
       auto send_battery = [&](int slot, const BatteryTelemetry& b) {
-        send(BmsData{slot, b.soc, b.soh, b.voltage, b.current, b.temperature}, t);
+        // BatteryTelemetry counts a charge positive; the wire counts as the profile says.
+        send(BmsData{slot, b.soc, b.soh, b.voltage, interpretation::bms_wire_current(-b.current, p),
+                     b.temperature},
+             t);
         BmsAlarm alarm;
         alarm.battery = slot;
         if (b.soc < kLowBatteryCutoffSoc) alarm.alarm1 |= kBmsUnderVoltage;

@@ -94,7 +94,7 @@ void ChassisMonitor::on_frame(const CanFrame& frame, Timestamp now) {
     ++error_frames_;
     return;
   }
-  auto decoded = decode(frame);
+  auto decoded = decode(frame, profile_);
   stats_.record(frame.id, now, decoded.ok(), frame.dlc - protocol::expected_dlc(frame.id));
   if (!decoded) {
     ++decode_errors_;
@@ -138,7 +138,7 @@ std::string ChassisMonitor::render_text(std::string_view iface, const BusStatus&
 
   if (!fb_.system_status) {
     line(st.red(stats_.total() == 0 ? "no frames received yet: is the chassis on and the bus up?"
-                             : "no 0x211 system status received yet"));
+                                    : "no 0x211 system status received yet"));
   } else {
     const auto& s = fb_.system_status->value;
     const bool stale = now - fb_.system_status->received > std::chrono::milliseconds(500);
@@ -150,7 +150,7 @@ std::string ChassisMonitor::render_text(std::string_view iface, const BusStatus&
     if (stale) age = st.red(age + "  CHASSIS SILENT");
     line("Chassis   control " + control + "   vehicle " + vehicle +
          fmt("   battery %.1f V", s.battery_voltage) + "   " + age);
-    const auto names = protocol::error_bit_names(s.error_bits);
+    const auto names = protocol::error_bit_names(s.error_bits, profile_.error_word);
     if (names.empty()) {
       line("Errors    " + st.green("none"));
     } else {
@@ -324,7 +324,7 @@ std::string ChassisMonitor::render_json(std::string_view iface, const BusStatus&
     w.key("battery_voltage").number(s.battery_voltage);
     w.key("error_bits").unsigned_integer(s.error_bits);
     w.key("errors").begin_array();
-    for (const auto& n : protocol::error_bit_names(s.error_bits))
+    for (const auto& n : protocol::error_bit_names(s.error_bits, profile_.error_word))
       w.string(n);
     w.end_array();
     w.key("status_age")

@@ -11,19 +11,23 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 
-#include "ranger_can/transport/bus.hpp"
-#include "ranger_can/wire/codec.hpp"
 #include "ranger_can/control/feedback.hpp"
 #include "ranger_can/control/frame_stats.hpp"
+#include "ranger_can/transport/bus.hpp"
+#include "ranger_can/wire/codec.hpp"
 #include "ranger_can/wire/frame.hpp"
+#include "ranger_can/wire/profile.hpp"
 
 namespace ranger::cli {
 
 class ChassisMonitor {
  public:
-  explicit ChassisMonitor(std::chrono::nanoseconds rate_window = std::chrono::seconds(1))
-      : stats_(rate_window) {}
+  // Frames are decoded under `profile` (the chassis's protocol: units, signs, the error word).
+  explicit ChassisMonitor(std::chrono::nanoseconds rate_window = std::chrono::seconds(1),
+                          ProtocolProfile profile = manual_profile())
+      : profile_(std::move(profile)), stats_(rate_window) {}
 
   // A frame received at `now` (the monitor's clock).
   void on_frame(const CanFrame& frame, Timestamp now);
@@ -49,6 +53,7 @@ class ChassisMonitor {
     Timestamp received{0};
   };
 
+  ProtocolProfile profile_;
   ChassisFeedback fb_;
   std::optional<Seen<MotionCommand>> motion_command_;  // commands from other nodes (the host)
   std::optional<Seen<MotionModeCommand>> motion_mode_command_;

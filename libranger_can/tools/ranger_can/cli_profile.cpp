@@ -1,5 +1,6 @@
 #include "cli_profile.hpp"
 
+#include <algorithm>
 #include <sstream>
 #include <string>
 
@@ -36,16 +37,23 @@ std::vector<std::string> protocol_choices() {
   return choices;
 }
 
-OptionSpec protocol_option() {
+OptionSpec protocol_option(bool with_auto) {
+  const std::vector<std::string> choices =
+      with_auto ? protocol_choices() : protocol_revision_names();
   std::string names;
-  for (const std::string& n : protocol_choices())
+  for (const std::string& n : choices)
     names += (names.empty() ? "" : "|") + n;
   return option("--protocol", names,
-                "the protocol revision the chassis speaks: auto (the default) identifies it from "
-                "the chassis's own frames (a log's frames when reading one); manual (the user "
-                "manual) or agx_v2 (the vendor's current software) force a preset; "
-                "docs/PROTOCOL_INTERPRETATIONS.md lists what each one sets and how auto decides",
-                one_of(protocol_choices()));
+                with_auto
+                    ? "the protocol revision the chassis speaks: auto (the default) identifies "
+                      "it from the chassis's own frames (a log's frames when reading one); "
+                      "manual (the user manual) or agx_v2 (the vendor's current software) "
+                      "force a preset; docs/PROTOCOL_INTERPRETATIONS.md lists what each one "
+                      "sets and how auto decides"
+                    : "the protocol revision: manual (the user manual) or agx_v2 (the "
+                      "vendor's current software); default: the model's, else manual; "
+                      "docs/PROTOCOL_INTERPRETATIONS.md lists what each one sets",
+                one_of(choices));
 }
 
 OptionSpec set_option() {
@@ -54,6 +62,43 @@ OptionSpec set_option() {
 
 std::vector<OptionSpec> profile_options() {
   return {protocol_option(), set_option()};
+}
+
+OptionSpec model_option() {
+  std::string names;
+  for (const std::string& n : model_names())
+    names += (names.empty() ? "" : ", ") + n;
+  return option("--model", "MODEL",
+                "the vehicle, one of " + names +
+                    ": its geometry, limits and protocol profile (libranger_can/models/; "
+                    "--protocol and --set change the profile after it)",
+                one_of(model_names()));
+}
+
+std::vector<OptionSpec> vehicle_options(bool with_auto) {
+  return {model_option(), protocol_option(with_auto), set_option()};
+}
+
+Result<Vehicle> vehicle_from_args(const ParsedArgs& args) {
+  const auto& options = args.spec().options;
+  const bool has_model_option = std::any_of(
+      options.begin(), options.end(), [](const OptionSpec& o) { return o.name == "--model"; });
+  Vehicle v;
+  if (has_model_option && args.has("--model")) {
+    auto model = model_preset(*args.get("--model"));
+    if (!model) return Error{model.error().code, "--model: " + model.error().message};
+    v.model = *model;
+    v.geometry = model->geometry;
+    v.limits = model->limits;
+  }
+  std::string revision = args.get_or("--protocol", "auto");
+  if (revision == "auto") revision = v.model ? v.model->protocol : "manual";
+  Result<ProtocolProfile> profile =
+      v.model ? model_profile(*v.model, revision) : protocol_preset(revision);
+  if (!profile) return Error{profile.error().code, "--protocol: " + profile.error().message};
+  if (Status st = apply_set_options(*profile, args); !st) return st.error();
+  v.profile = *profile;
+  return v;
 }
 
 bool protocol_is_auto(const ParsedArgs& args) {
@@ -110,15 +155,9 @@ Result<ProtocolProfile> profile_for_frames(const ParsedArgs& args,
 }
 
 Result<ProtocolProfile> profile_from_args(const ParsedArgs& args) {
-  const std::string revision = args.get_or("--protocol", "auto");
-  Result<ProtocolProfile> profile = protocol_preset(revision == "auto" ? "manual" : revision);
-  if (!profile) return Error{profile.error().code, "--protocol: " + profile.error().message};
-  for (const std::string& assignment : args.all("--set")) {
-    if (Status st = apply_setting(*profile, assignment); !st) {
-      return Error{st.error().code, "--set: " + st.error().message};
-    }
-  }
-  return profile;
+  auto v = vehicle_from_args(args);
+  if (!v) return v.error();
+  return v->profile;
 }
 
 }  // namespace ranger::cli

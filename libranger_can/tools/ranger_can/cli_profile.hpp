@@ -1,10 +1,12 @@
 // The protocol profile on the command line: one place for the options every sub-command that
 // speaks the RANGER protocol takes, and for turning them into a ranger::ProtocolProfile.
 //
+//   --model NAME               a vehicle model (control/model.hpp): its geometry, limits and
+//                              protocol profile (a revision preset and the model's own settings)
 //   --protocol auto|manual|agx_v2   auto (the default): identified from the chassis's frames
 //                              (control/identification.hpp: a log's frames for decode and odom,
 //                              the live chassis for identify and commission); or a revision's
-//                              preset
+//                              preset (with --model, the model's own settings still apply on top)
 //   --set NAME=VALUE           one interpretation changed after the preset (repeatable, applied in
 //                              order; NAME and VALUE as in docs/PROTOCOL_INTERPRETATIONS.md)
 //
@@ -24,19 +26,37 @@
 #include "cli_options.hpp"
 #include "ranger_can/control/geometry.hpp"
 #include "ranger_can/control/identification.hpp"
+#include "ranger_can/control/model.hpp"
 #include "ranger_can/result.hpp"
 #include "ranger_can/wire/frame.hpp"
 #include "ranger_can/wire/profile.hpp"
 
 namespace ranger::cli {
 
-OptionSpec protocol_option();               // --protocol REVISION
-OptionSpec set_option();                    // --set NAME=VALUE, repeatable
-std::vector<OptionSpec> profile_options();  // both, in that order
+// --protocol; `with_auto` = false for the commands that set the chassis's own protocol (sim) or
+// send without listening (send): there is nothing to identify from.
+OptionSpec protocol_option(bool with_auto = true);               // --protocol REVISION
+OptionSpec set_option();                                         // --set NAME=VALUE, repeatable
+std::vector<OptionSpec> profile_options();                       // both, in that order
+OptionSpec model_option();                                       // --model NAME
+std::vector<OptionSpec> vehicle_options(bool with_auto = true);  // --model, --protocol, --set
 
-// The preset --protocol names (manual for auto or when absent: the fallback), then every --set in
-// order. The parser has already checked each value against the same rules, so an error here is
-// unexpected; it names the option and lists the valid values all the same.
+// What --model, --protocol and --set make of a vehicle: the model's geometry and limits (the
+// library's defaults, a RANGER, without --model) and the profile: the model's (or manual), its
+// revision replaced by a forced --protocol (the model's own settings kept), then every --set.
+// With --protocol auto this profile is the fallback an identification starts from.
+struct Vehicle {
+  std::optional<ModelPreset> model;
+  VehicleGeometry geometry;
+  KinematicsLimits limits;
+  ProtocolProfile profile;
+};
+Result<Vehicle> vehicle_from_args(const ParsedArgs& args);
+
+// vehicle_from_args(...).profile: the preset --protocol names (the model's, or manual, for auto
+// or when absent: the fallback), then every --set in order. The parser has already checked each
+// value against the same rules, so an error here is unexpected; it names the option and lists the
+// valid values all the same.
 Result<ProtocolProfile> profile_from_args(const ParsedArgs& args);
 
 // Whether --protocol is auto (given or by default).

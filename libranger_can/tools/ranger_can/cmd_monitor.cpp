@@ -3,19 +3,22 @@
 // (cli_monitor_view.hpp); this file opens the bus, keeps time and decides when to draw.
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <iostream>
 #include <optional>
 #include <string>
+#include <vector>
 
-#include "ranger_can/parse.hpp"
 #include "cli_bus.hpp"
 #include "cli_commands.hpp"
 #include "cli_monitor_view.hpp"
 #include "cli_options.hpp"
+#include "cli_profile.hpp"
 #include "cli_signals.hpp"
 #include "ranger_can/clock.hpp"
+#include "ranger_can/parse.hpp"
 
 namespace ranger::cli {
 
@@ -53,6 +56,8 @@ std::chrono::nanoseconds seconds(double s) {
 
 int monitor_main(const ParsedArgs& args, Io io) {
   const MonitorOptions o = options_from(args);
+  const Result<Vehicle> vehicle = vehicle_from_args(args);
+  if (!vehicle) return usage_error(monitor_command(), io, vehicle.error().message);
 
   auto bus = open_interface(o.iface);
   if (!bus) {
@@ -66,18 +71,33 @@ int monitor_main(const ParsedArgs& args, Io io) {
 
   StopSignals signals;
   SteadyClock clock;
-  ChassisMonitor monitor(seconds(o.window));
+  // With --protocol auto (the default) the first half second of frames (or the --once window)
+  // identifies the chassis's settings passively, as `decode` does for a log; the view starts then.
+  const bool identify = protocol_is_auto(args);
+  std::vector<CanFrame> heard;  // while identifying
+  std::optional<ChassisMonitor> monitor;
+  if (!identify) monitor.emplace(seconds(o.window), vehicle->profile);
   const Timestamp start = clock.now();
   const auto period = seconds(1.0 / o.rate);
-  Timestamp next_view = start + (o.once ? seconds(o.window) : period);
+  Timestamp next_view = start + (o.once ? seconds(o.window) : std::max(period, seconds(0.5)));
   long views = 0;
 
   while (!StopSignals::requested()) {
     const Timestamp now = clock.now();
+    if (now >= next_view && !monitor) {
+      ProtocolProfile profile = identify_log(heard, vehicle->geometry).profile;
+      if (Status st = apply_set_options(profile, args); !st) {
+        return usage_error(monitor_command(), io, st.error().message);
+      }
+      monitor.emplace(seconds(o.window), profile);
+      for (const CanFrame& f : heard)
+        monitor->on_frame(f, now);
+      heard.clear();
+    }
     if (now >= next_view) {
       const BusStatus status = (*bus)->status();
-      std::string view = o.json ? monitor.render_json(o.iface, status, now) + "\n"
-                                : monitor.render_text(o.iface, status, now, color);
+      std::string view = o.json ? monitor->render_json(o.iface, status, now) + "\n"
+                                : monitor->render_text(o.iface, status, now, color);
       if (clear) {
         view = "\x1b[H\x1b[2J" + view;
       } else if (!o.json && views > 0) {
@@ -87,7 +107,7 @@ int monitor_main(const ParsedArgs& args, Io io) {
       io.out.flush();
       ++views;
       if (o.once) {
-        if (!monitor.heard_chassis()) {
+        if (!monitor->heard_chassis()) {
           io.err << "ranger_can monitor: no RANGER feedback on " << o.iface << " within "
                  << o.window << " s\n";
           return 1;
@@ -100,7 +120,11 @@ int monitor_main(const ParsedArgs& args, Io io) {
     }
     auto frame = (*bus)->receive(std::min<std::chrono::nanoseconds>(next_view - clock.now(), 50ms));
     if (frame) {
-      monitor.on_frame(*frame, clock.now());
+      if (monitor) {
+        monitor->on_frame(*frame, clock.now());
+      } else {
+        heard.push_back(*frame);
+      }
     } else if (frame.error().code != Errc::kTimeout) {
       // The bus reports and recovers a lost interface itself; the view shows the state.
       ::usleep(20000);
@@ -119,7 +143,8 @@ const CommandSpec& monitor_command() {
       "motion mode, speed and steering (with 'left'/'right' spelled out), per-wheel angle/speed\n"
       "and motor rpm/current/temperature, battery and BMS alarms, 0x211 errors by name,\n"
       "ultrasonic distances, the commands the host sends (0x111 age and rate), frame rates per\n"
-      "ID against the manual's periods, and the bus state.",
+      "ID against the manual's periods, and the bus state. Frames are read under the protocol\n"
+      "profile of --model, --protocol and --set (docs/PROTOCOL_INTERPRETATIONS.md).",
       {required_arg("IFACE", "the CAN interface of the chassis", "can0")},
       {
           flag("--once",
@@ -134,6 +159,9 @@ const CommandSpec& monitor_command() {
                "no ANSI colours (default: colours on a terminal unless NO_COLOR is set)"),
           flag("--no-clear",
                "do not clear the screen between views (default: clear on a terminal)"),
+          model_option(),
+          protocol_option(),
+          set_option(),
       },
       "",
       monitor_main,

@@ -93,13 +93,15 @@ int odom_main(const ParsedArgs& args, Io io) {
   Options opt;
   opt.path = args.get("FILE");
   if (const auto source = args.get("--source")) opt.config.source = *parse_odometry_source(*source);
+  const Result<Vehicle> vehicle = vehicle_from_args(args);
+  if (!vehicle) return usage_error(odom_command(), io, vehicle.error().message);
+  opt.config.geometry = vehicle->geometry;  // the model's (a RANGER without --model)
   opt.config.geometry.wheelbase = args.number("--wheelbase", opt.config.geometry.wheelbase);
   opt.config.geometry.track = args.number("--track", opt.config.geometry.track);
   opt.every = static_cast<long>(args.integer("--every", 1));
   opt.quiet = args.has("--quiet");
-  const Result<ProtocolProfile> profile = profile_from_args(args);
-  if (!profile) return usage_error(odom_command(), io, profile.error().message);
-  opt.profile = *profile;
+  opt.profile = vehicle->profile;
+  opt.config.profile = vehicle->profile;  // the 0x221 readings of the odometry's fallback
   if (Status st = opt.config.validate(); !st) {
     return usage_error(odom_command(), io, st.error().message);
   }
@@ -116,6 +118,7 @@ int odom_main(const ParsedArgs& args, Io io) {
       if (!identified) return usage_error(odom_command(), io, identified.error().message);
       Options o = opt;
       o.profile = *identified;
+      o.config.profile = *identified;
       std::istringstream again(text);
       return replay(again, o, io);
     });
@@ -147,8 +150,9 @@ const CommandSpec& odom_command() {
       "The log needs timestamps (candump -L, or candump -ta): odometry integrates over the "
       "frames'\n"
       "own times. Steps longer than 0.5 s or going backwards are not integrated. Frames are\n"
-      "decoded under the protocol profile of --protocol and --set (units, signs, lengths);\n"
-      "--protocol auto (the default) identifies it from the whole log first.\n"
+      "decoded under the protocol profile of --model, --protocol and --set (units, signs,\n"
+      "lengths; --protocol auto, the default, identifies it from the whole log first), and the\n"
+      "geometry is the model's unless --wheelbase/--track say otherwise.\n"
       "Malformed lines are reported on stderr as 'line N: reason' (the first 20, then a count)\n"
       "and skipped; frames with extended (29-bit) IDs (other devices) are counted and skipped.",
       {optional_arg("FILE", "the candump log; standard input when absent or '-'", any_text())},
@@ -159,15 +163,17 @@ const CommandSpec& odom_command() {
                  "steering with the 0x291 motion mode only",
                  checked_by(check_source)),
           option("--wheelbase", "M",
-                 "front to rear axle, m (default " + number_text(defaults.geometry.wheelbase) + ")",
+                 "front to rear axle, m (default: the model's, else " +
+                     number_text(defaults.geometry.wheelbase) + ")",
                  number_in(1e-3, 10.0)),
           option("--track", "M",
-                 "left to right wheel centres, m (default " + number_text(defaults.geometry.track) +
-                     ")",
+                 "left to right wheel centres, m (default: the model's, else " +
+                     number_text(defaults.geometry.track) + ")",
                  number_in(1e-3, 10.0)),
           option("--every", "N", "print every Nth step only (default 1)",
                  integer_in(1, std::numeric_limits<std::int32_t>::max())),
           flag("--quiet", "print the final pose only"),
+          model_option(),
           protocol_option(),
           set_option(),
       },

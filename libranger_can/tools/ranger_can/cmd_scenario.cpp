@@ -8,6 +8,7 @@
 #include "cli_commands.hpp"
 #include "cli_input.hpp"
 #include "cli_options.hpp"
+#include "cli_profile.hpp"
 #include "ranger_can/sim/scenario.hpp"
 #include "ranger_can/sim/sim_bus_source.hpp"
 
@@ -34,6 +35,19 @@ int scenario_main(const ParsedArgs& args, Io io) {
   sim::ScenarioOptions options;
   options.every = *sim::parse_milliseconds("--every", args.get_or("--every", "0.1"));
   options.variant = args.get_or("--chassis-variant", options.variant);
+  // --model, --protocol and --set: the driver's vehicle, and the chassis's before its variant.
+  const Result<Vehicle> vehicle = vehicle_from_args(args);
+  if (!vehicle) return usage_error(scenario_command(), io, vehicle.error().message);
+  if (vehicle->model) {
+    options.chassis = sim::chassis_for_model(*vehicle->model);
+    options.driver.controller.geometry = vehicle->geometry;
+    options.driver.controller.limits = vehicle->limits;
+    options.driver.odometry.geometry = vehicle->geometry;
+  }
+  options.chassis.profile = vehicle->profile;
+  options.driver.controller.profile = vehicle->profile;
+  // auto (the default, as in the node): the driver identifies the chassis before it moves.
+  if (protocol_is_auto(args)) options.driver.protocol = ProtocolChoice::kAuto;
   for (const std::string& p : args.all("--param")) {
     if (Status st = sim::apply_scenario_param(options.driver, p); !st) {
       return usage_error(scenario_command(), io, "--param: " + st.error().message);
@@ -112,8 +126,13 @@ const CommandSpec& scenario_command() {
                  checked_by(check_every)),
           option("--chassis-variant", "VARIANT",
                  "the virtual chassis (bus spec sim:VARIANT), one of: " +
-                     join(sim::variant_names(), ", ") + " (default manual)",
+                     join(sim::variant_names(), ", ") +
+                     " (default manual); it applies over --model, --protocol and --set, which "
+                     "configure the driver and the chassis alike",
                  one_of(sim::variant_names())),
+          model_option(),
+          protocol_option(),
+          set_option(),
           option("--param", "NAME=VALUE",
                  "a driver setting: steer_first_threshold=RAD (0 disables steer-first), "
                  "cmd_timeout=SEC, auto_reclaim_after_remote=true|false, "

@@ -8,12 +8,13 @@
 #include <string>
 #include <vector>
 
-#include "ranger_can/parse.hpp"
 #include "cli_bus.hpp"
 #include "cli_commands.hpp"
 #include "cli_frame_format.hpp"
 #include "cli_options.hpp"
+#include "cli_profile.hpp"
 #include "ranger_can/clock.hpp"
+#include "ranger_can/parse.hpp"
 #include "ranger_can/wire/candump_log.hpp"
 #include "ranger_can/wire/codec.hpp"
 #include "ranger_can/wire/interpretation.hpp"
@@ -125,11 +126,31 @@ Result<Message> parse_command(const std::string& name, const Words& args) {
   return bad("unknown command '" + name + "' (" + command_names() + ")");
 }
 
+// The 0x111 of `send motion` in the vehicle's protocol: the spin (a wheel speed, counter-clockwise
+// positive) goes out in the profile's spin field with its sign, a yaw rate through the geometry.
+void apply_spin_field(Message& message, const Vehicle& vehicle) {
+  auto* m = std::get_if<MotionCommand>(&message);
+  if (m == nullptr) return;
+  const double ccw = m->spin_speed;
+  m->spin_speed = 0.0;
+  if (vehicle.profile.spin_field == SpinField::kYawRate) {
+    m->yaw_rate = interpretation::spin_wire_from_ccw(
+        interpretation::spin_yaw_rate_from_wheel_speed(ccw, vehicle.geometry.wheelbase,
+                                                       vehicle.geometry.track),
+        vehicle.profile);
+  } else {
+    m->spin_speed = interpretation::spin_wire_from_ccw(ccw, vehicle.profile);
+  }
+}
+
 int send_main(const ParsedArgs& args, Io io) {
   const std::string iface = *args.get("IFACE");
+  const Result<Vehicle> vehicle = vehicle_from_args(args);
+  if (!vehicle) return usage_error(send_command(), io, vehicle.error().message);
   auto message = parse_command(*args.get("COMMAND"), args.all("ARGS"));
   if (!message) return usage_error(send_command(), io, message.error().message);
-  auto frame = encode(*message);
+  apply_spin_field(*message, *vehicle);
+  auto frame = encode(*message, vehicle->profile);
   if (!frame) {
     io.err << "ranger_can send: " << frame.error().message << "\n";
     return 1;
@@ -167,11 +188,14 @@ const CommandSpec& send_command() {
   static const CommandSpec spec{
       "send",
       "send one command: " + command_names(),
-      "Sends one command frame to the chassis on IFACE and prints it in candump -L format.",
+      "Sends one command frame to the chassis on IFACE and prints it in candump -L format,\n"
+      "encoded under the protocol profile of --model, --protocol and --set (units, signs, the\n"
+      "spin field, the mode numbering, the frame length).",
       {required_arg("IFACE", "the CAN interface of the chassis", "can0"),
        required_arg("COMMAND", "one of the commands below: " + command_names(), "control"),
        rest_args("ARGS", "the command's arguments (negative numbers need no '--')")},
-      {flag("--dry-run", "print the frame, do not open IFACE").alias('n')},
+      {flag("--dry-run", "print the frame, do not open IFACE").alias('n'), model_option(),
+       protocol_option(false), set_option()},
       commands_help(),
       send_main,
   };

@@ -22,15 +22,17 @@
 #include <string>
 #include <vector>
 
-#include "ranger_can/parse.hpp"
 #include "cli_bus.hpp"
 #include "cli_commands.hpp"
 #include "cli_input.hpp"
 #include "cli_json.hpp"
 #include "cli_options.hpp"
+#include "cli_profile.hpp"
 #include "cli_signals.hpp"
-#include "ranger_can/sim/chassis_commands.hpp"
 #include "ranger_can/clock.hpp"
+#include "ranger_can/parse.hpp"
+#include "ranger_can/sim/chassis_commands.hpp"
+#include "ranger_can/sim/sim_bus_source.hpp"
 #include "ranger_can/sim/virtual_chassis_runner.hpp"
 
 namespace ranger::cli {
@@ -54,6 +56,7 @@ const std::string& control_help() {
 struct SimOptions {
   std::string iface;
   sim::VirtualChassisConfig config;
+  std::string variant = "manual";
   bool estop = false;
   bool stuck = false;
   std::vector<int> errors;
@@ -86,9 +89,16 @@ std::chrono::nanoseconds duration_of(double seconds) {
       std::chrono::duration<double>(seconds));
 }
 
-SimOptions options_from(const ParsedArgs& args) {
+// The chassis: the model's (--model; a RANGER without it), speaking the profile of --protocol and
+// --set, the options below, then the variant's deviation (--chassis-variant), last.
+Result<SimOptions> options_from(const ParsedArgs& args) {
   SimOptions o;
   o.iface = *args.get("IFACE");
+  const Result<Vehicle> vehicle = vehicle_from_args(args);
+  if (!vehicle) return vehicle.error();
+  if (vehicle->model) o.config = sim::chassis_for_model(*vehicle->model);
+  o.config.profile = vehicle->profile;
+  o.variant = args.get_or("--chassis-variant", o.variant);
   if (args.has("--mode-switch-time")) {
     o.config.mode_switch_duration = duration_of(args.number("--mode-switch-time", 0.0));
   }
@@ -120,6 +130,9 @@ SimOptions options_from(const ParsedArgs& args) {
   o.read_stdin = !args.has("--no-stdin");
   if (args.has("--duration")) o.duration = args.number("--duration", 0.0);
   o.quiet = args.has("--quiet");
+  auto config = sim::apply_variant(o.variant, o.config);
+  if (!config) return config.error();
+  o.config = *config;
   return o;
 }
 
@@ -208,7 +221,9 @@ std::string stamp_prefix(Timestamp since_boot) {
 }
 
 int sim_main(const ParsedArgs& args, Io io) {
-  const SimOptions o = options_from(args);
+  const Result<SimOptions> parsed = options_from(args);
+  if (!parsed) return usage_error(sim_command(), io, parsed.error().message);
+  const SimOptions& o = *parsed;
 
   std::ofstream pose_file;
   if (!o.pose_out.empty()) {
@@ -257,8 +272,9 @@ int sim_main(const ParsedArgs& args, Io io) {
       c.set_error_bit(b, true);
   });
   if (!o.quiet) {
-    io.out << "ranger_can sim: virtual RANGER on " << (*bus)->name()
-           << " (Ctrl-C to stop; 'help' lists control commands)\n";
+    io.out << "ranger_can sim: virtual RANGER on " << (*bus)->name() << " (variant " << o.variant
+           << ", protocol " << describe(o.config.profile)
+           << "; Ctrl-C to stop; 'help' lists control commands)\n";
     io.out.flush();
   }
 
@@ -434,10 +450,21 @@ const CommandSpec& sim_command() {
       "printed as '[seconds since boot] what happened'. Faults are injected with the options\n"
       "below or with control commands read from standard input and/or a FIFO (--control).\n"
       "\n"
-      "Try it:  ranger_can sim vcan0 &   ranger_can monitor vcan0   ranger_can send vcan0 control "
-      "can",
+      "The chassis is the model of --model (default: a RANGER) speaking the protocol of\n"
+      "--protocol and --set (default: the model's; docs/PROTOCOL_INTERPRETATIONS.md); the\n"
+      "variant of --chassis-variant applies last. Variants (also the bus spec sim:VARIANT):\n" +
+          sim::variants_help() +
+          "\n"
+          "Try it:  ranger_can sim vcan0 &   ranger_can monitor vcan0   ranger_can send vcan0 "
+          "control can",
       {required_arg("IFACE", "the CAN interface to run the chassis on", "vcan0")},
       {
+          option("--chassis-variant", "VARIANT",
+                 "how this chassis differs (see the list above; default manual)",
+                 one_of(sim::variant_names())),
+          model_option(),
+          protocol_option(false),
+          set_option(),
           option("--mode-switch-time", "SEC",
                  "time a motion-mode switch takes once at rest (default " +
                      seconds_of(defaults.mode_switch_duration) + ")",

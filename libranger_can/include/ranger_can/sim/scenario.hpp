@@ -128,6 +128,8 @@ struct ScenarioOptions {
   std::string variant = "manual";  // the chassis: bus spec "sim:VARIANT"
   std::chrono::milliseconds every{100};
   DriverConfig driver;  // the library's defaults = the ROS node's defaults
+  // The chassis before the variant applies (its model and profile: chassis_for_model).
+  VirtualChassisConfig chassis;
 };
 // Checks the options (variant known, every >= 1 ms, the driver config valid).
 Status validate(const ScenarioOptions& options);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "ranger_can/clock.hpp"
+#include "ranger_can/control/model.hpp"
 #include "ranger_can/result.hpp"
 #include "ranger_can/sim/virtual_chassis.hpp"
 #include "ranger_can/sim/virtual_chassis_runner.hpp"
@@ -19,11 +20,30 @@
 
 namespace ranger::sim {
 
-// The names `sim:VARIANT` accepts ("manual" is the plain `sim`).
+// A virtual chassis variant: a chassis that differs from the manual in one documented way (or, for
+// `agx_v2` and `mini_v1`, the way a whole revision or model does), for testing a driver against
+// every reading of the protocol. Each variant is the config's profile changed by settings, plus
+// what the chassis sends beyond the codec; the driver drives it right with `driver` (the
+// options of `ranger_can`; the same settings as parameters for the node).
+struct VariantInfo {
+  std::string name;         // "spin_cw"
+  std::string description;  // one line
+  // What makes a driver match it, as `ranger_can` options ("--model M", "--protocol R",
+  // "--set NAME=VALUE", space-separated; empty for the defaults).
+  std::string driver;
+};
+// Every variant, "manual" (the plain `sim`) first.
+const std::vector<VariantInfo>& variants();
+// The names `sim:VARIANT` accepts.
 const std::vector<std::string>& variant_names();
-// `config` changed the way VARIANT's chassis differs from the manual. kInvalidArgument naming
-// the valid variants for an unknown one.
+// "  manual               the user manual's chassis ..." lines, one per variant (for --help).
+std::string variants_help();
+// `config` changed the way VARIANT's chassis differs: applied last, over whatever model and
+// profile `config` already has ("manual" changes nothing). kInvalidArgument naming the valid
+// variants for an unknown one.
 Result<VirtualChassisConfig> apply_variant(std::string_view variant, VirtualChassisConfig config);
+// `config` as the chassis of `model`: its geometry, limits (the chassis's own ranges) and profile.
+VirtualChassisConfig chassis_for_model(const ModelPreset& model, VirtualChassisConfig config = {});
 
 struct SimSourceOptions {
   VirtualChassisConfig chassis;       // before the variant is applied

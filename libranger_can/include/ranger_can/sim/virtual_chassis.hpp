@@ -10,6 +10,16 @@
 //  * Boots in standby (or in remote mode if configured). In standby it obeys 0x421 only. In remote
 //    mode it ignores every CAN command, 0x421 included: the remote has the highest priority.
 //    In CAN command mode it obeys 0x111, 0x141, 0x421, 0x441 and 0x451.
+//  * It speaks the protocol of its profile (config.profile, wire/profile.hpp): commands are decoded
+//    and feedback encoded with it (units, signs, the error-word layout and its counter, the BMS
+//    scale, the mode numbering, the DLC of what it sends), and its physics applies the profile's
+//    geometric readings: the angle 0x111 steers and 0x221 reports in Ackermann mode
+//    (steering_reference), what 0x221's speed is (feedback_speed), where the spin comes from
+//    (spin_field: a wheel speed in 0x111 bytes 4-5, or a yaw rate in bytes 2-3; the other field is
+//    ignored in spin mode, so the wheels turn to the spin position and nothing moves) and its sign
+//    (spin_sign). Error bits are set by meaning (protocol::fault_bit of the profile's layout).
+//    What a chassis sends beyond the codec is the config's too (vendor_frames, ...): the variants
+//    of sim_bus_source.hpp are made of both.
 //  * 0x111 acts per the current motion mode, with the signs and units of interpretation.hpp.
 //    Reading: the Ackermann/oblique linear speed is the speed of the body centre.
 //  * Command watchdog: 500 ms after the last 0x111 the chassis stops by itself and sets error
@@ -21,10 +31,16 @@
 //    `mode_switch_duration`; meanwhile 0x291 reports the mode being left with switching = 1 and
 //    speed commands are ignored. A 0x141 naming the current mode changes nothing.
 //  * 0x111's linear speed is the body centre's (interpretation point 7).
-//  * 0x221: Ackermann — (alpha+beta)/2 of the front wheels and the mean of the four wheel speeds
-//    (point 8); oblique — the mean of the four wheel angles and of the four speeds; spin — the
-//    mean of the absolute wheel angles and (point 9, as the vendor's driver expects) the signed
-//    tangential wheel speed, counter-clockwise positive.
+//  * 0x221: Ackermann — the front angle of the profile's steering_reference ((alpha+beta)/2 or the
+//    inner wheel's) and the speed of its feedback_speed (the mean of the four wheel speeds, point
+//    8, or the body centre's); oblique — the mean of the four wheel angles and of the four speeds;
+//    spin — the mean of the absolute wheel angles and (point 9, as the vendor's driver expects)
+//    the signed tangential wheel speed, counter-clockwise positive (spin_field wheel_speed), or
+//    the yaw rate in bytes 2-3 (spin_field yaw_rate, which then carries the body's yaw rate in
+//    every mode). Spin values carry the profile's spin_sign.
+//  * With vendor_frames (the vendor's revision has them, the manual does not): 0x231 light state
+//    (what the last 0x121 set) and 0x241 remote-control state every 20 ms, each with a counter in
+//    byte 7, and an answer to every 0x4A1 version request (`version`, 8 characters a frame).
 //  * Motion is refused (the chassis brakes to rest and ignores 0x111's motion) while: not in CAN
 //    mode, e-stop, a critical error bit (protocol::is_critical_error), battery under-voltage
 //    (set whenever SOC < 10 %, latched until 0x441 0x09 / 0x00 finds the SOC back at >= 10 %),
@@ -44,12 +60,13 @@
 #include <string>
 #include <vector>
 
-#include "ranger_can/transport/bus.hpp"
-#include "ranger_can/sim/chassis_model.hpp"
-#include "ranger_can/wire/codec.hpp"
-#include "ranger_can/sim/drivetrain_model.hpp"
-#include "ranger_can/wire/frame.hpp"
 #include "ranger_can/control/geometry.hpp"
+#include "ranger_can/sim/chassis_model.hpp"
+#include "ranger_can/sim/drivetrain_model.hpp"
+#include "ranger_can/transport/bus.hpp"
+#include "ranger_can/wire/codec.hpp"
+#include "ranger_can/wire/frame.hpp"
+#include "ranger_can/wire/profile.hpp"
 #include "ranger_can/wire/protocol.hpp"
 
 namespace ranger::sim {
@@ -57,6 +74,13 @@ namespace ranger::sim {
 struct VirtualChassisConfig {
   VehicleGeometry geometry;
   MotionLimits limits;
+  // How the chassis speaks and which readings its physics follows (the manual's by default).
+  ProtocolProfile profile;
+  // What it sends beyond the profile's codec, a chassis's signature:
+  bool vendor_frames = false;                // 0x231, 0x241 every 20 ms and 0x4A1 answers (agx_v2)
+  std::string version = "ranger_sim 0.1.0";  // the 0x4A1 answer (vendor_frames only)
+  bool steering_angles_frame = true;         // 0x271 (false: never sent)
+  bool spin_angle_reported = true;           // 0x221's angle in spin mode (false: 0, as at rest)
   DrivetrainConfig drivetrain;
   std::chrono::nanoseconds mode_switch_duration = std::chrono::milliseconds(500);
   std::chrono::nanoseconds command_timeout =
@@ -145,8 +169,12 @@ class VirtualChassis {
   // Remote control lost-connection protection: standby, error byte 7 bit 2.
   void remote_signal_lost();
   void set_emergency_stop(bool on);
-  // Sets (or clears) any 0x211 error bit, by position in the 32-bit error word.
+  // Sets (or clears) any 0x211 error bit, by position in the error word of the profile's layout
+  // (32 bits under manual32, 16 under agx16; others are ignored).
   void set_error_bit(int index, bool on);
+  // The same by meaning; false (nothing changes) when the layout has no such bit.
+  bool set_fault(protocol::Fault fault, bool on, int motor = 0);
+  const ProtocolProfile& profile() const { return config_.profile; }
   void set_error_bits(std::uint32_t bits);  // replaces the injected set entirely
   void set_battery_soc(double soc_percent);
   // Stops sending anything (frames that fall due are skipped) until resumed / for a while.
@@ -185,6 +213,8 @@ class VirtualChassis {
   void handle_motion_mode(const MotionModeCommand& cmd);
   void handle_control_mode(const ControlModeCommand& cmd);
   void handle_ultrasonic_setting(const UltrasonicSettingCommand& cmd);
+  void answer_version_request();
+  std::uint32_t bit(protocol::Fault fault, int motor = 0) const;
   void set_control_mode(protocol::ControlMode mode, const std::string& why);
 
   std::uint32_t error_word() const;
@@ -213,6 +243,9 @@ class VirtualChassis {
   std::mt19937 garbage_rng_;
   std::array<Schedule, kScheduleCount> schedules_;
   std::uint32_t last_reported_errors_ = 0;
+  std::uint8_t status_counter_ = 0;  // 0x211 byte 7 under agx16: +1 per frame
+  std::uint8_t vendor_counter_ = 0;  // 0x231 / 0x241 byte 7: +1 per frame
+  LightCommand lights_;              // what the last 0x121 set (reported in 0x231)
   std::string last_refusal_;
 
   VirtualChassisCounters counters_;
