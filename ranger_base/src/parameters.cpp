@@ -10,6 +10,7 @@
 #include <set>
 #include <sstream>
 
+#include <ranger_can/control/commissioning.hpp>
 #include <ranger_can/sim/chassis_commands.hpp>
 #include <ranger_can/transport/bus_source.hpp>
 
@@ -65,6 +66,13 @@ std::string show(const XmlRpc::XmlRpcValue& v) {
     default:
       return "a value of another type";
   }
+}
+
+std::string join(const std::vector<std::string>& items, const char* separator = ", ") {
+  std::string out;
+  for (const auto& i : items)
+    out += (out.empty() ? "" : separator) + i;
+  return out;
 }
 
 std::optional<double> as_number(const XmlRpc::XmlRpcValue& v) {
@@ -140,6 +148,27 @@ class Reader {
       return def;
     }
     return static_cast<std::string&>(copy);
+  }
+
+  // A value that may be given as a string, a number or a bool (an interpretation setting:
+  // `tx_dlc: 8`, `bms_voltage_scale: 0.1`, `vehicle_status_1_is_estop: true`), as text; nullopt
+  // when unset. Lists and dictionaries are reported.
+  std::optional<std::string> scalar_text(const std::string& name, const std::string& expected) {
+    names_.push_back(name);
+    const auto raw = source_.get(name);
+    if (!raw) return std::nullopt;
+    XmlRpc::XmlRpcValue copy = *raw;
+    switch (copy.getType()) {
+      case XmlRpc::XmlRpcValue::TypeString:
+        return static_cast<std::string&>(copy);
+      case XmlRpc::XmlRpcValue::TypeBoolean:
+      case XmlRpc::XmlRpcValue::TypeInt:
+      case XmlRpc::XmlRpcValue::TypeDouble:
+        return show(*raw);
+      default:
+        fail(name, "= " + show(*raw) + ": expected " + expected);
+        return std::nullopt;
+    }
   }
 
   // A tf2 frame id: non-empty, no whitespace, no leading '/'.
@@ -256,6 +285,91 @@ void check_port_name(Reader& r, const std::string& port) {
   }
 }
 
+// The protocol settings: `protocol`, `commissioning_file`, one parameter per interpretation
+// setting and `identify_timeout`, resolved into DriverConfig::protocol and controller.profile.
+void read_protocol(Reader& r, const ranger::ModelPreset& model, NodeParameters& p) {
+  auto& pp = p.protocol;
+  auto& d = p.driver;
+
+  std::vector<std::string> choices = {"auto"};
+  for (const auto& n : ranger::protocol_revision_names())
+    choices.push_back(n);
+  pp.protocol = r.text("protocol", pp.protocol);
+  const bool known_protocol =
+      std::find(choices.begin(), choices.end(), pp.protocol) != choices.end();
+  if (!known_protocol) {
+    r.fail("protocol", "= \"" + pp.protocol + "\": expected one of " + join(choices) +
+                           " (auto: identified from the chassis before anything moves)");
+  }
+
+  pp.commissioning_file = r.text("commissioning_file", pp.commissioning_file);
+  std::optional<ranger::ProtocolProfile> commissioned;
+  if (!pp.commissioning_file.empty()) {
+    auto loaded = ranger::load_commissioning_file(pp.commissioning_file);
+    if (loaded) {
+      commissioned = *loaded;
+    } else {
+      r.fail("commissioning_file",
+             "= \"" + pp.commissioning_file + "\": " + loaded.error().message);
+    }
+  }
+
+  // One parameter per interpretation setting, checked against the settings table: they force
+  // that setting after whatever the profile started from.
+  for (const ranger::ProfileSetting& s : ranger::profile_settings()) {
+    const std::string name(s.name);
+    std::vector<std::string> values(s.values.begin(), s.values.end());
+    const auto value = r.scalar_text(name, "one of " + join(values));
+    if (!value) continue;
+    ranger::ProtocolProfile scratch;
+    if (!ranger::set_setting(scratch, name, *value)) {
+      r.fail(name, "= \"" + *value + "\": expected one of " + join(values) + " (" +
+                       std::string(s.description) + ")");
+      continue;
+    }
+    pp.settings.emplace_back(name, *value);
+  }
+
+  d.identification.timeout =
+      r.seconds("identify_timeout", d.identification.timeout, closed(1.0, 600.0));
+
+  // The profile: a commissioning file, else the model's on the revision `protocol` names (the
+  // model's own revision for auto: the fallback an identification starts from); then every
+  // interpretation parameter.
+  ranger::ProtocolProfile profile = model.profile;
+  if (commissioned) {
+    profile = *commissioned;
+  } else if (known_protocol && pp.protocol != "auto") {
+    if (auto m = ranger::model_profile(model, pp.protocol)) profile = *m;
+  }
+  std::vector<std::string> forced;
+  for (const auto& [name, value] : pp.settings) {
+    (void)ranger::set_setting(profile, name, value);  // checked above
+    forced.push_back(name + ": " + value);
+  }
+  d.controller.profile = profile;
+
+  const std::string on_model = "model " + pp.model;
+  if (!pp.commissioning_file.empty()) {
+    d.protocol = ranger::ProtocolChoice::kForced;
+    pp.source = "forced: commissioning file " + pp.commissioning_file;
+    if (pp.protocol != "auto") pp.source += " (it overrides protocol " + pp.protocol + ")";
+  } else if (pp.protocol != "auto") {
+    d.protocol = ranger::ProtocolChoice::kForced;
+    pp.source = "forced: protocol " + pp.protocol + ", " + on_model;
+  } else if (!pp.settings.empty()) {
+    // The driver identifies a whole profile; it cannot keep single settings forced on top of
+    // it. Set settings win: the profile is forced, and the start-up log says so.
+    d.protocol = ranger::ProtocolChoice::kForced;
+    pp.auto_overridden = true;
+    pp.source = "forced: protocol auto overridden by the interpretation parameters, " + on_model;
+  } else {
+    d.protocol = ranger::ProtocolChoice::kAuto;
+    pp.source = "auto: identified from the chassis, " + on_model;
+  }
+  if (!forced.empty()) pp.source += ", with " + join(forced);
+}
+
 // Reads everything; `r` collects the problems.
 NodeParameters read_all(Reader& r) {
   NodeParameters p;
@@ -285,6 +399,23 @@ NodeParameters read_all(Reader& r) {
   p.driver.reconnect_interval =
       r.seconds("reconnect_interval", p.driver.reconnect_interval, closed(0.05, 60.0));
 
+  // ---- the vehicle model: its geometry, limits and protocol profile are the defaults of the
+  // geometry and limit parameters below and of the protocol settings; the virtual chassis (port
+  // sim[:VARIANT]) is that model.
+  auto& pp = p.protocol;
+  pp.model = r.text("model", pp.model);
+  ranger::ModelPreset model = ranger::model_preset("ranger").value();
+  if (auto m = ranger::model_preset(pp.model)) {
+    model = *m;
+  } else {
+    r.fail("model", "= \"" + pp.model + "\": expected one of " + join(ranger::model_names()) +
+                        " (libranger_can/models/)");
+  }
+  pp.model_display_name = model.display_name;
+  pp.model_settings = model.settings;
+  c.limits = model.limits;
+  p.sim.chassis = ranger::sim::chassis_for_model(model, p.sim.chassis);
+
   // ---- control
   c.cmd_timeout = r.seconds("cmd_vel_timeout", c.cmd_timeout, closed(0.02, 60.0));
   c.auto_command_mode = r.flag("auto_command_mode", c.auto_command_mode);
@@ -301,8 +432,8 @@ NodeParameters read_all(Reader& r) {
                                      closed(0.0, M_PI / 2), "rad (0 disables)");
   c.low_battery_soc = r.number("low_battery_soc", c.low_battery_soc, closed(0.0, 100.0), "%");
 
-  // ---- geometry (ranger_description/config/geometry.yaml)
-  ranger::VehicleGeometry g = c.geometry;
+  // ---- geometry (the model's; ranger_description/config/geometry.yaml for the RANGER)
+  ranger::VehicleGeometry g = model.geometry;
   g.wheelbase = r.number("wheelbase", g.wheelbase, open_closed(0.0, 10.0), "m");
   g.track = r.number("track", g.track, open_closed(0.0, 10.0), "m");
   g.wheel_radius = r.number("wheel_radius", g.wheel_radius, open_closed(0.0, 5.0), "m");
@@ -412,6 +543,8 @@ NodeParameters read_all(Reader& r) {
       r.fail("sim/errors", "contains \"" + name + "\": " + bit.error().message);
     }
   }
+
+  read_protocol(r, model, p);
   return p;
 }
 

@@ -1,9 +1,12 @@
 // Parameter loading and validation, without a ROS master (MapParameterSource).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <unistd.h>
 
 #include "ranger_base/parameters.hpp"
 
@@ -52,6 +55,9 @@ TEST(Parameters, EveryDefaultIsTheLibrarysOwn) {
   auto p = load_parameters(source);
   ASSERT_TRUE(p.ok()) << p.error().message;
   const ranger::DriverConfig d;
+  // Geometry, limits and profile are the default model's (ranger): its preset, as
+  // `ranger_can scenario --model ranger` has them.
+  const ranger::ModelPreset ranger_model = ranger::model_preset("ranger").value();
   const auto& c = p->driver.controller;
   EXPECT_EQ(p->driver.reconnect_interval, d.reconnect_interval);
   EXPECT_EQ(p->driver.request_answer_timeout, d.request_answer_timeout);
@@ -71,12 +77,19 @@ TEST(Parameters, EveryDefaultIsTheLibrarysOwn) {
   EXPECT_DOUBLE_EQ(c.geometry.wheel_radius, d.controller.geometry.wheel_radius);
   EXPECT_DOUBLE_EQ(p->driver.odometry.geometry.track, d.odometry.geometry.track);
   EXPECT_DOUBLE_EQ(p->sim.chassis.geometry.wheel_radius, d.controller.geometry.wheel_radius);
-  EXPECT_DOUBLE_EQ(c.limits.max_linear_speed, d.controller.limits.max_linear_speed);
+  EXPECT_DOUBLE_EQ(c.geometry.wheelbase, ranger_model.geometry.wheelbase);
+  EXPECT_DOUBLE_EQ(c.limits.max_linear_speed, ranger_model.limits.max_linear_speed);
   EXPECT_DOUBLE_EQ(c.limits.max_speed_at_large_steering,
-                   d.controller.limits.max_speed_at_large_steering);
-  EXPECT_DOUBLE_EQ(c.limits.max_ackermann_steering, d.controller.limits.max_ackermann_steering);
-  EXPECT_DOUBLE_EQ(c.limits.max_oblique_steering, d.controller.limits.max_oblique_steering);
-  EXPECT_DOUBLE_EQ(c.limits.max_spin_wheel_speed, d.controller.limits.max_spin_wheel_speed);
+                   ranger_model.limits.max_speed_at_large_steering);
+  EXPECT_DOUBLE_EQ(c.limits.max_ackermann_steering, ranger_model.limits.max_ackermann_steering);
+  EXPECT_DOUBLE_EQ(c.limits.max_oblique_steering, ranger_model.limits.max_oblique_steering);
+  EXPECT_DOUBLE_EQ(c.limits.max_spin_wheel_speed, ranger_model.limits.max_spin_wheel_speed);
+  EXPECT_EQ(c.profile, ranger_model.profile);
+  EXPECT_EQ(p->sim.chassis.profile, ranger_model.profile);
+  // protocol auto (the default): identified, with the library's identification defaults.
+  EXPECT_EQ(p->driver.protocol, ranger::ProtocolChoice::kAuto);
+  EXPECT_EQ(p->driver.identification.timeout, d.identification.timeout);
+  EXPECT_FALSE(p->driver.identify_revision.has_value());
   for (const auto* axis : {&c.limit_vx, &c.limit_vy, &c.limit_wz}) {
     const ranger::SpeedLimits l;
     EXPECT_EQ(axis->has_velocity_limits, l.has_velocity_limits);
@@ -207,6 +220,18 @@ INSTANTIATE_TEST_SUITE_P(
                       BadValue{"max_linear_speed", 3.0, "not in (0, 2.6"},
                       BadValue{"max_ackermann_steering", 1.0, "40 deg"},
                       BadValue{"max_spin_wheel_speed", 1.5, "(0, 1] m/s"},
+                      BadValue{"model", "ranger_maxi", "ranger_mini_v1, ranger_mini_v2"},
+                      BadValue{"protocol", "agx_v3", "auto, manual, agx_v2"},
+                      BadValue{"protocol", true, "expected a string"},
+                      BadValue{"steering_unit_111", "mrad", "centideg, millirad"},
+                      BadValue{"spin_sign", "left", "ccw, cw"},
+                      BadValue{"tx_dlc", 5, "0, 8"},
+                      BadValue{"bms_voltage_scale", 1.0, "0.01, 0.1"},
+                      BadValue{"vehicle_status_1_is_estop", "maybe", "true, false"},
+                      BadValue{"steering_reference", list({1, 2}), "mean_front, inner_front"},
+                      BadValue{"identify_timeout", 0.0, "[1, 600] s"},
+                      BadValue{"commissioning_file", "/nonexistent/ranger.yaml",
+                               "/nonexistent/ranger.yaml"},
                       BadValue{"odometry_source", "gps", "\"wheels\" or \"motion\""},
                       BadValue{"port_name", "", "CAN interface name"},
                       BadValue{"port_name", "a/b", "CAN interface name"},
@@ -223,6 +248,174 @@ INSTANTIATE_TEST_SUITE_P(
                       BadValue{"mode_switch_max_attempts", 0, "[1, 100]"},
                       BadValue{"ultrasonic/max_range", 0.01, "m"},
                       BadValue{"sim/errors", XmlRpcValue("motor_driver_9"), "list of strings"}));
+
+// ---- protocol settings: protocol, model, the interpretation parameters, commissioning_file --
+
+// A commissioning file written for one test, removed after it.
+class TempFile {
+ public:
+  explicit TempFile(const std::string& text) {
+    char name[] = "/tmp/ranger_base_test_XXXXXX";
+    const int fd = ::mkstemp(name);
+    path_ = name;
+    if (fd >= 0) ::close(fd);
+    std::ofstream(path_) << text;
+  }
+  ~TempFile() { std::remove(path_.c_str()); }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
+ranger::ProtocolProfile preset(const char* revision) {
+  return ranger::protocol_preset(revision).value();
+}
+
+TEST(Protocol, ARevisionForcesItsPresetOnTheModel) {
+  MapParameterSource source;
+  source.values["protocol"] = "agx_v2";
+  auto p = load_parameters(source);
+  ASSERT_TRUE(p.ok()) << p.error().message;
+  EXPECT_EQ(p->driver.protocol, ranger::ProtocolChoice::kForced);
+  EXPECT_EQ(p->driver.controller.profile, preset("agx_v2"));
+  EXPECT_EQ(p->protocol.source, "forced: protocol agx_v2, model ranger");
+  EXPECT_FALSE(p->protocol.auto_overridden);
+  // The virtual chassis is the model's, whatever the driver is told to speak (a chassis of
+  // another revision is sim:VARIANT).
+  EXPECT_EQ(p->sim.chassis.profile, preset("manual"));
+}
+
+TEST(Protocol, AModelGivesGeometryLimitsAndProfileAndTheParametersOverrideThem) {
+  const ranger::ModelPreset mini = ranger::model_preset("ranger_mini_v1").value();
+  MapParameterSource source;
+  source.values["model"] = "ranger_mini_v1";
+  source.values["port_name"] = "sim";
+  auto p = load_parameters(source);
+  ASSERT_TRUE(p.ok()) << p.error().message;
+  const auto& c = p->driver.controller;
+  EXPECT_DOUBLE_EQ(c.geometry.wheelbase, mini.geometry.wheelbase);
+  EXPECT_DOUBLE_EQ(c.geometry.track, mini.geometry.track);
+  EXPECT_DOUBLE_EQ(p->driver.odometry.geometry.wheel_radius, mini.geometry.wheel_radius);
+  EXPECT_DOUBLE_EQ(c.limits.max_oblique_steering, mini.limits.max_oblique_steering);
+  EXPECT_DOUBLE_EQ(c.limits.max_spin_wheel_speed, mini.limits.max_spin_wheel_speed);
+  EXPECT_EQ(c.profile, mini.profile);  // auto: the fallback before the decision
+  EXPECT_EQ(p->driver.protocol, ranger::ProtocolChoice::kAuto);
+  EXPECT_EQ(p->protocol.model_display_name, "RANGER MINI V1");
+  EXPECT_FALSE(p->protocol.model_settings.empty());
+  // The in-process chassis is a MINI V1 too.
+  EXPECT_DOUBLE_EQ(p->sim.chassis.geometry.wheelbase, mini.geometry.wheelbase);
+  EXPECT_EQ(p->sim.chassis.profile, mini.profile);
+
+  // Explicit geometry and limit parameters win over the model's values.
+  source.values["wheelbase"] = 0.4;
+  source.values["max_linear_speed"] = 0.5;
+  source.values["protocol"] = "manual";  // the model's own settings on the manual's preset
+  p = load_parameters(source);
+  ASSERT_TRUE(p.ok()) << p.error().message;
+  EXPECT_DOUBLE_EQ(p->driver.controller.geometry.wheelbase, 0.4);
+  EXPECT_DOUBLE_EQ(p->sim.chassis.geometry.wheelbase, 0.4);
+  EXPECT_DOUBLE_EQ(p->driver.controller.geometry.track, mini.geometry.track);
+  EXPECT_DOUBLE_EQ(p->driver.controller.limits.max_linear_speed, 0.5);
+  EXPECT_EQ(p->driver.controller.profile, ranger::model_profile(mini, "manual").value());
+}
+
+TEST(Protocol, InterpretationParametersForceTheirSettingsAfterThePreset) {
+  MapParameterSource source;
+  source.values["protocol"] = "manual";
+  source.values["steering_unit_111"] = "millirad";
+  source.values["tx_dlc"] = 8;                          // an int
+  source.values["bms_voltage_scale"] = 0.1;             // a double
+  source.values["vehicle_status_1_is_estop"] = false;  // a bool
+  auto p = load_parameters(source);
+  ASSERT_TRUE(p.ok()) << p.error().message;
+  auto expected = preset("manual");
+  expected.steering_unit_111 = ranger::AngleUnit::kMilliradian;
+  expected.tx_dlc = 8;
+  expected.bms_voltage_scale = 0.1;
+  expected.vehicle_status_1_is_estop = false;
+  EXPECT_EQ(p->driver.controller.profile, expected);
+  EXPECT_EQ(p->driver.protocol, ranger::ProtocolChoice::kForced);
+  ASSERT_EQ(p->protocol.settings.size(), 4u);  // in the settings table's order
+  EXPECT_EQ(p->protocol.settings[0], std::make_pair(std::string("steering_unit_111"),
+                                                    std::string("millirad")));
+  EXPECT_NE(p->protocol.source.find("with steering_unit_111: millirad"), std::string::npos)
+      << p->protocol.source;
+}
+
+// The driver identifies a whole profile and cannot keep single settings forced on top of it:
+// a set interpretation parameter with protocol auto forces the profile (the log says so).
+TEST(Protocol, InterpretationParametersWithAutoForceTheProfile) {
+  MapParameterSource source;
+  source.values["spin_sign"] = "cw";
+  auto p = load_parameters(source);
+  ASSERT_TRUE(p.ok()) << p.error().message;
+  EXPECT_EQ(p->driver.protocol, ranger::ProtocolChoice::kForced);
+  EXPECT_TRUE(p->protocol.auto_overridden);
+  EXPECT_EQ(p->driver.controller.profile.spin_sign, -1);
+  EXPECT_EQ(p->driver.controller.profile.revision, "manual");
+  EXPECT_NE(p->protocol.source.find("auto overridden"), std::string::npos) << p->protocol.source;
+}
+
+TEST(Protocol, ACommissioningFileIsForcedOverProtocolAndModelAndUnderTheParameters) {
+  const TempFile file("# ranger_can commission sim:spin_cw --wheels-lifted\nprotocol: manual\n"
+                      "spin_sign: cw\nfeedback_speed: body_centre\n");
+  MapParameterSource source;
+  source.values["commissioning_file"] = file.path();
+  source.values["protocol"] = "agx_v2";         // the file wins
+  source.values["feedback_speed"] = "mean_wheel";  // a parameter wins over the file
+  auto p = load_parameters(source);
+  ASSERT_TRUE(p.ok()) << p.error().message;
+  auto expected = preset("manual");
+  expected.spin_sign = -1;
+  EXPECT_EQ(p->driver.controller.profile, expected);
+  EXPECT_EQ(p->driver.protocol, ranger::ProtocolChoice::kForced);
+  EXPECT_NE(p->protocol.source.find("commissioning file " + file.path()), std::string::npos)
+      << p->protocol.source;
+  EXPECT_NE(p->protocol.source.find("overrides protocol agx_v2"), std::string::npos)
+      << p->protocol.source;
+}
+
+TEST(Protocol, ABadCommissioningFileIsRefusedWithTheLoadersMessage) {
+  const TempFile file("protocol: manual\nsteering_unit_111: mrad\n");
+  MapParameterSource source;
+  source.values["commissioning_file"] = file.path();
+  const std::string message = load_error(source);
+  EXPECT_NE(message.find("~commissioning_file"), std::string::npos) << message;
+  EXPECT_NE(message.find("line 2"), std::string::npos) << message;
+  EXPECT_NE(message.find("centideg|millirad"), std::string::npos) << message;
+}
+
+TEST(Protocol, IdentifyTimeoutReachesTheIdentification) {
+  MapParameterSource source;
+  source.values["identify_timeout"] = 20;
+  auto p = load_parameters(source);
+  ASSERT_TRUE(p.ok()) << p.error().message;
+  EXPECT_EQ(p->driver.identification.timeout, 20s);
+}
+
+TEST(Protocol, UnknownModelProtocolAndValuesAreRefusedAllAtOnceListingTheValidOnes) {
+  MapParameterSource source;
+  source.values["model"] = "ranger_maxi";
+  source.values["protocol"] = "vendor";
+  source.values["steering_sign_271"] = "up";
+  const std::string message = load_error(source);
+  for (const char* expected : {"~model", "ranger, ranger_mini_v1, ranger_mini_v2, ranger_mini_v3",
+                               "~protocol", "auto, manual, agx_v2", "~steering_sign_271",
+                               "right_positive, left_positive"}) {
+    EXPECT_NE(message.find(expected), std::string::npos) << expected << " in:\n" << message;
+  }
+}
+
+TEST(Protocol, EverySettingIsAParameter) {
+  const auto& known = known_parameter_names();
+  for (const ranger::ProfileSetting& s : ranger::profile_settings()) {
+    EXPECT_NE(std::find(known.begin(), known.end(), std::string(s.name)), known.end()) << s.name;
+  }
+  for (const char* name : {"protocol", "model", "commissioning_file", "identify_timeout"}) {
+    EXPECT_NE(std::find(known.begin(), known.end(), name), known.end()) << name;
+  }
+}
 
 TEST(Parameters, ReportsEveryProblemAtOnce) {
   MapParameterSource source;

@@ -15,9 +15,11 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <ranger_can/control/driver.hpp>
+#include <ranger_can/control/model.hpp>
 #include <ranger_can/result.hpp>
 #include <ranger_can/sim/sim_bus_source.hpp>
 
@@ -33,9 +35,33 @@ struct UltrasonicRangeParameters {
   double max_range = 5.0;       // m
 };
 
+// Where the protocol settings come from: the parameters `protocol`, `model`, one parameter per
+// interpretation setting (profile_settings()) and `commissioning_file`, and what they made of
+// DriverConfig::protocol and controller.profile.
+struct ProtocolParameters {
+  std::string protocol = "auto";  // the parameter: auto, or a revision (manual, agx_v2)
+  std::string model = "ranger";   // the parameter: a model_names() entry
+  std::string model_display_name = "RANGER";
+  // The model's own settings on top of its revision (ModelPreset::settings): forced with a
+  // revision, the identification's to decide with `auto`.
+  std::vector<std::pair<std::string, std::string>> model_settings;
+  std::string commissioning_file;  // "" = none
+  // The interpretation parameters that were set (NAME, VALUE as text), in the settings table's
+  // order: they force those settings, after the preset, the model or the commissioning file.
+  std::vector<std::pair<std::string, std::string>> settings;
+  // `protocol: auto` with interpretation parameters set: the driver cannot apply forced settings
+  // on top of an identification, so the settings are forced (kForced) and identification is off.
+  bool auto_overridden = false;
+  // One line, for the start-up log and diagnostics: where the settings in use come from, e.g.
+  // "auto: identified from the chassis (model ranger)", "forced: protocol manual (model ranger)",
+  // "forced: commissioning file /etc/ranger.yaml".
+  std::string source;
+};
+
 // Every default below that has a library counterpart is read from the library's own structs
-// (ranger::DriverConfig{}, ControllerConfig{}, OdometryConfig{}, sim::VirtualChassisConfig{}), so
-// the node and `ranger_can scenario` behave alike.
+// (ranger::DriverConfig{}, ControllerConfig{}, OdometryConfig{}, sim::VirtualChassisConfig{}, and
+// the model's preset, ranger::model_preset(model), for geometry, limits and protocol profile), so
+// the node and `ranger_can scenario --model MODEL` behave alike.
 struct NodeParameters {
   // The bus (ranger::sim::open_bus_source): a SocketCAN interface, sim[:VARIANT] or replay:FILE.
   std::string port_name = "can0";
@@ -61,6 +87,8 @@ struct NodeParameters {
                                                   ranger::OdometryConfig{}.twist_variance_angular};
 
   UltrasonicRangeParameters ultrasonic;
+
+  ProtocolParameters protocol;
 
   // controller (geometry, limits, cmd_vel_timeout, ...), odometry (the same geometry, source,
   // covariance growth), reconnect_interval, request_answer_timeout.
