@@ -273,6 +273,20 @@ std::vector<std::string> cause_names(ranger::StopCauses causes) {
   return out;
 }
 
+bool listening(const ranger::ControllerState& c) {
+  return c.quiet && !c.identifying.empty();
+}
+
+std::string refusal_name(const ranger::ControllerState& c) {
+  if (c.refusal == ranger::MotionRefusal::kNone) return "";
+  // While the identification listens, the controller hears nothing on purpose: the reason
+  // motion waits is the identification, not a lost link.
+  if (c.refusal == ranger::MotionRefusal::kLinkLost && listening(c)) {
+    return std::string(ranger::to_string(ranger::MotionRefusal::kIdentifying));
+  }
+  return std::string(ranger::to_string(c.refusal));
+}
+
 std::string describe_refusal(const ranger::ControllerState& c) {
   using R = ranger::MotionRefusal;
   const auto join = [](const std::vector<std::string>& names) {
@@ -290,6 +304,10 @@ std::string describe_refusal(const ranger::ControllerState& c) {
       }
       return "";
     case R::kLinkLost:
+      if (listening(c)) {
+        return c.identifying + " (nothing is sent until the chassis has been heard; motion waits "
+                               "for the identification)";
+      }
       return c.link == ranger::LinkState::kNeverConnected
                  ? "no chassis heard yet (waiting for its system status)"
                  : "chassis silent (link lost): motion stopped";
@@ -305,7 +323,10 @@ std::string describe_refusal(const ranger::ControllerState& c) {
     case R::kModeSwitchFailed:
       return "motion-mode switch not confirmed by the chassis: send a zero cmd_vel or call resume";
     case R::kImplausible:
-      return "the chassis's feedback contradicts the protocol settings";
+      return "the chassis's feedback contradicts the protocol settings: " +
+             (c.implausible_reason.empty() ? std::string("(no reason given)")
+                                           : c.implausible_reason) +
+             ". Set that parameter (or load a commissioning file), or call resume to try again";
     case R::kRearmRequired:
       return "rearm_required after " + join(cause_names(c.latched_causes)) +
              ": call resume (or send a zero cmd_vel) to drive again";
@@ -324,6 +345,10 @@ std::string describe_refusal(const ranger::ControllerState& c) {
     case R::kBelowMinimum:
       return "below_minimum: cmd_vel is below what the chassis can express (mode_selection/"
              "min_linear_speed, min_yaw_rate): not driven";
+    case R::kIdentifying:
+      // The identification's own words: its phase, or (failed) what to set.
+      return c.identifying.empty() ? std::string("identifying the chassis's protocol settings")
+                                   : c.identifying;
   }
   return std::string(ranger::to_string(c.refusal));
 }
@@ -356,8 +381,11 @@ ranger_msgs::SystemState to_system_state(const ranger::DriverSnapshot& snapshot,
   out.error_word = state.error_bits;
   fill_system_errors(state.error_bits, snapshot.profile.error_word, out.errors);
   out.active_errors = protocol::error_bit_names(state.error_bits, snapshot.profile.error_word);
-  if (state.refusal != ranger::MotionRefusal::kNone) {
-    out.motion_inhibited_reason = std::string(ranger::to_string(state.refusal));
+  out.motion_inhibited_reason = refusal_name(state);
+  out.protocol = std::string(ranger::to_string(snapshot.protocol));
+  out.protocol_profile = ranger::describe(snapshot.profile);
+  if (snapshot.identification) {
+    out.identification = std::string(ranger::to_string(snapshot.identification->phase));
   }
   out.motion_inhibited_detail = describe_refusal(state);
   out.rearm_required = state.rearm_required();

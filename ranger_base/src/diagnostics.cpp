@@ -2,6 +2,8 @@
 
 #include <diagnostic_msgs/DiagnosticStatus.h>
 
+#include <ranger_can/transport/bus_source.hpp>
+
 #include <algorithm>
 #include <cstdio>
 #include <string>
@@ -80,6 +82,14 @@ void diagnose_link(const DriverSnapshot& s, DiagnosticStatusWrapper& out) {
       out.mergeSummary(DiagnosticStatus::OK, "chassis connected");
       break;
     case ranger::LinkState::kNeverConnected:
+      if (listening(c) && s.frames.total() > 0) {
+        // The identification listens before anything is sent: the chassis is heard, the
+        // controller is kept out of it until the settings are proposed.
+        out.summary(out.level, out.message + "; chassis heard (" +
+                                   std::to_string(s.frames.total()) +
+                                   " frames): listening before sending anything (identification)");
+        break;
+      }
       out.mergeSummary(DiagnosticStatus::ERROR,
                        "waiting for the chassis on " + s.bus_name +
                            ": nothing heard from it yet (is it powered on?)");
@@ -115,8 +125,12 @@ void diagnose_control(const DriverSnapshot& s, DiagnosticStatusWrapper& out) {
     out.add("Last command limits", ranger::kinematics_flags_to_string(c.last_solution->flags));
   }
   const std::string detail = describe_refusal(c);
+  const bool identification_failed =
+      s.identification && s.identification->phase == ranger::IdentificationPhase::kFailed;
 
-  if (!s.bus_open || c.link != ranger::LinkState::kConnected) {
+  if (s.bus_open && listening(c)) {
+    out.summary(DiagnosticStatus::OK, "identifying the chassis: listening (nothing sent yet)");
+  } else if (!s.bus_open || c.link != ranger::LinkState::kConnected) {
     out.summary(DiagnosticStatus::ERROR, "no chassis");
   } else if (c.control_mode == protocol::ControlMode::kRemote) {
     out.summary(DiagnosticStatus::WARN, "remote control has the chassis: cmd_vel not applied");
@@ -124,6 +138,14 @@ void diagnose_control(const DriverSnapshot& s, DiagnosticStatusWrapper& out) {
     out.summary(DiagnosticStatus::WARN, detail.empty() ? "standby" : detail);
   } else if (c.mode_switch.failed) {
     out.summary(DiagnosticStatus::ERROR, "motion-mode switch not confirmed by the chassis");
+  } else if (c.refusal == ranger::MotionRefusal::kIdentifying) {
+    if (identification_failed) {
+      out.summary(DiagnosticStatus::ERROR,
+                  "CAN command mode, motion refused: the chassis could not be identified (see "
+                  "Protocol for what to set)");
+    } else {
+      out.summary(DiagnosticStatus::OK, "CAN command mode, " + detail);
+    }
   } else if (c.refusal == ranger::MotionRefusal::kCmdTimeout) {
     out.summary(DiagnosticStatus::OK, "CAN command mode, idle (no recent cmd_vel)");
   } else if (c.refusal != ranger::MotionRefusal::kNone) {
@@ -132,6 +154,77 @@ void diagnose_control(const DriverSnapshot& s, DiagnosticStatusWrapper& out) {
     out.summary(DiagnosticStatus::OK, "CAN command mode, " + detail);
   } else {
     out.summary(DiagnosticStatus::OK, "CAN command mode");
+  }
+}
+
+void diagnose_protocol(const DriverSnapshot& s, const ProtocolContext& context,
+                       DiagnosticStatusWrapper& out) {
+  out.add("Settings from", context.source.empty() ? std::string(ranger::to_string(s.protocol))
+                                                  : context.source);
+  out.add("Settings in use", ranger::describe(s.profile));
+  for (const ranger::ProfileSetting& setting : ranger::profile_settings()) {
+    const auto value = ranger::get_setting(s.profile, setting.name);
+    out.add(std::string(setting.name), value ? *value : value.error().message);
+  }
+
+  std::string ok_summary = "settings " + ranger::describe(s.profile) + " (forced)";
+  std::optional<std::string> failed;
+  if (s.identification) {
+    const ranger::IdentificationStatus& id = *s.identification;
+    out.add("Identification", std::string(ranger::to_string(id.phase)));
+    out.add("Identification message", id.message);
+    out.add("Started from", id.revision);
+    if (id.done()) out.add("Identification time (s)", ranger::seconds(id.elapsed()));
+    if (id.decided_ok()) out.add("Confidence", id.confidence);
+    for (std::size_t i = 0; i < id.evidence.size(); ++i)
+      out.add("Evidence " + std::to_string(i + 1), id.evidence[i]);
+    for (const ranger::IdentifiedSetting& d : id.decided)
+      out.add("Decided " + d.name, d.value + " (" + d.evidence + ")");
+    out.add("Undecided (the preset's value, checked while driving)", join(id.undecided));
+    switch (id.phase) {
+      case ranger::IdentificationPhase::kDecided:
+        ok_summary = "identified: " + ranger::describe(s.profile);
+        break;
+      case ranger::IdentificationPhase::kFailed: {
+        std::string message = id.message;
+        const auto kind = ranger::bus_kind(context.port_name);
+        if (kind && *kind == ranger::BusKind::kSocketCan) {
+          message += " (on this robot: ranger_can commission " + context.port_name +
+                     " --wheels-lifted --output FILE)";
+        }
+        failed = message;
+        break;
+      }
+      case ranger::IdentificationPhase::kListening:
+      case ranger::IdentificationPhase::kAwaitingControl:
+      case ranger::IdentificationPhase::kSpinCheck:
+      case ranger::IdentificationPhase::kSteerProbe:
+      case ranger::IdentificationPhase::kReturning:
+        ok_summary = "identifying the chassis (" + std::string(ranger::to_string(id.phase)) +
+                     "): nothing is driven until it is decided";
+        break;
+    }
+  }
+
+  const ranger::PlausibilityStatus& plausibility = s.plausibility;
+  out.add("Plausibility checks", plausibility.checks);
+  for (std::size_t i = 0; i < plausibility.warnings.size(); ++i)
+    out.add("Plausibility warning " + std::to_string(i + 1), plausibility.warnings[i].text());
+  if (plausibility.stop) out.add("Plausibility stop", plausibility.stop->text());
+
+  if (plausibility.stop) {
+    out.summary(DiagnosticStatus::ERROR,
+                "stopped: the chassis contradicts the protocol settings: " +
+                    plausibility.stop->text() +
+                    ". Set that parameter (or load a commissioning file); resume tries again");
+  } else if (failed) {
+    out.summary(DiagnosticStatus::ERROR, *failed);
+  } else {
+    out.summary(DiagnosticStatus::OK, ok_summary);
+  }
+  for (const ranger::PlausibilityFinding& w : plausibility.warnings) {
+    if (plausibility.stop && w.text() == plausibility.stop->text()) continue;
+    out.mergeSummary(DiagnosticStatus::WARN, "check the setting: " + w.text());
   }
 }
 
@@ -228,11 +321,17 @@ void FrameRateMonitor::diagnose(const DriverSnapshot& s, DiagnosticStatusWrapper
   }
 }
 
-ChassisDiagnostics::ChassisDiagnostics(diagnostic_updater::Updater& updater, SnapshotSource source)
-    : source_(std::move(source)), current_(std::make_shared<DriverSnapshot>()) {
+ChassisDiagnostics::ChassisDiagnostics(diagnostic_updater::Updater& updater, SnapshotSource source,
+                                       ProtocolContext protocol)
+    : source_(std::move(source)),
+      protocol_(std::move(protocol)),
+      current_(std::make_shared<DriverSnapshot>()) {
   updater.add(kDiagLink, [this](DiagnosticStatusWrapper& out) { diagnose_link(*current_, out); });
   updater.add(kDiagControl,
               [this](DiagnosticStatusWrapper& out) { diagnose_control(*current_, out); });
+  updater.add(kDiagProtocol, [this](DiagnosticStatusWrapper& out) {
+    diagnose_protocol(*current_, protocol_, out);
+  });
   updater.add(kDiagErrors,
               [this](DiagnosticStatusWrapper& out) { diagnose_errors(*current_, out); });
   updater.add(kDiagBattery,

@@ -115,8 +115,9 @@ RangerNode::RangerNode(const ros::NodeHandle& nh, const ros::NodeHandle& private
   if (sim_) ground_truth_pub_ = nh_.advertise<nav_msgs::Odometry>("sim/ground_truth", 10);
 
   updater_.setHardwareID(hardware_id(nh_.getNamespace(), params_.port_name));
-  diagnostics_ =
-      std::make_unique<ChassisDiagnostics>(updater_, [this] { return driver_->snapshot(); });
+  diagnostics_ = std::make_unique<ChassisDiagnostics>(
+      updater_, [this] { return driver_->snapshot(); },
+      ProtocolContext{params_.protocol.source, params_.port_name});
   driver_->set_sent_observer([this](const ranger::SentEvent& e) { on_sent(e); });
 }
 
@@ -153,6 +154,45 @@ void RangerNode::start() {
                 : (source_->read_only() ? "a replayed log: nothing is sent" : "SocketCAN"),
            params_.publish_rate, params_.odom_frame.c_str(), params_.base_frame.c_str(),
            params_.publish_odom_tf ? ", TF on" : ", TF off");
+  log_protocol();
+}
+
+void RangerNode::log_protocol() const {
+  const auto& pp = params_.protocol;
+  const auto& c = params_.driver.controller;
+  ROS_INFO("model %s (%s): wheelbase %.3f m, track %.3f m, wheel radius %.3f m, max speed %.2f m/s",
+           pp.model.c_str(), pp.model_display_name.c_str(), c.geometry.wheelbase, c.geometry.track,
+           c.geometry.wheel_radius, c.limits.max_linear_speed);
+  if (params_.driver.protocol == ranger::ProtocolChoice::kAuto) {
+    ROS_INFO(
+        "protocol auto: the settings are identified from the chassis before anything moves "
+        "(listening first, then a few degrees of steering at zero speed; identify_timeout %.1f "
+        "s); nothing is driven until then, and the plausibility monitors check them while "
+        "driving",
+        secs(params_.driver.identification.timeout));
+    if (!pp.model_settings.empty()) {
+      std::vector<std::string> own;
+      for (const auto& [name, value] : pp.model_settings)
+        own.push_back(name + "=" + value);
+      ROS_INFO(
+          "the %s's own readings (%s) are not assumed with protocol auto: the identification "
+          "decides what it can at rest, the plausibility monitors the rest on first motion; set "
+          "protocol: %s to force the model's profile",
+          pp.model_display_name.c_str(), join(own).c_str(), c.profile.revision.c_str());
+    }
+  } else if (pp.auto_overridden) {
+    std::vector<std::string> set;
+    for (const auto& [name, value] : pp.settings)
+      set.push_back(name + ": " + value);
+    ROS_WARN(
+        "protocol auto, but interpretation parameters are set (%s): the driver cannot keep "
+        "single settings forced on top of an identification, so identification is off and the "
+        "settings are forced: %s (the plausibility monitors still check them while driving)",
+        join(set).c_str(), ranger::describe(c.profile).c_str());
+  } else {
+    ROS_INFO("protocol settings %s (%s); the plausibility monitors check them while driving",
+             ranger::describe(c.profile).c_str(), pp.source.c_str());
+  }
 }
 
 void RangerNode::shutdown() {
@@ -495,6 +535,7 @@ void RangerNode::log_state_changes(const ranger::DriverSnapshot& s) {
     }
     last_link_ = c.link;
   }
+  log_protocol_changes(s);  // the identification's decision before "accepts motion"
   if (!last_refusal_ || *last_refusal_ != c.refusal) {
     using R = ranger::MotionRefusal;
     const std::string detail = describe_refusal(c);
@@ -502,12 +543,17 @@ void RangerNode::log_state_changes(const ranger::DriverSnapshot& s) {
       case R::kNone:
         ROS_INFO("chassis accepts motion commands");
         break;
-      case R::kLinkLost:  // the link messages above say it
+      case R::kLinkLost:  // the link messages above say it (and the start-up log the listening)
         break;
       case R::kCmdTimeout:
       case R::kModeUnknown:
       case R::kSwitching:
         ROS_INFO("%s", detail.c_str());
+        break;
+      case R::kIdentifying:  // the identification's own log says how it ends
+        if (!s.identification || !s.identification->done()) {
+          ROS_INFO("motion waits: %s", detail.c_str());
+        }
         break;
       case R::kStandby:
         if (c.reclaim_blocked) {
@@ -516,7 +562,14 @@ void RangerNode::log_state_changes(const ranger::DriverSnapshot& s) {
           ROS_INFO("%s", detail.c_str());
         }
         break;
-      default:
+      case R::kRemote:
+      case R::kEstop:
+      case R::kCriticalError:
+      case R::kLowBattery:
+      case R::kModeSwitchFailed:
+      case R::kImplausible:
+      case R::kRearmRequired:
+      case R::kBelowMinimum:
         ROS_WARN("motion refused: %s", detail.c_str());
         break;
     }
@@ -542,6 +595,63 @@ void RangerNode::log_state_changes(const ranger::DriverSnapshot& s) {
   if (c.last_solution && c.last_solution->flags != ranger::kKinematicsExact) {
     ROS_WARN_THROTTLE(5.0, "cmd_vel adjusted to what the chassis can do: %s",
                       ranger::kinematics_flags_to_string(c.last_solution->flags).c_str());
+  }
+}
+
+void RangerNode::log_protocol_changes(const ranger::DriverSnapshot& s) {
+  if (s.identification) {
+    const ranger::IdentificationStatus& id = *s.identification;
+    if (id.decided_ok() && !identification_logged_) {
+      identification_logged_ = true;
+      logged_decisions_ = id.decided.size();
+      ROS_INFO(
+          "chassis identified in %.2f s (confidence %.2f): protocol settings %s. Evidence: %s. "
+          "Kept at the %s preset's value (no frame at rest tells them; the plausibility monitors "
+          "check them while driving): %s",
+          secs(id.elapsed()), id.confidence, ranger::describe(s.profile).c_str(),
+          join(id.evidence, "; ").c_str(), id.revision.c_str(),
+          id.undecided.empty() ? "none" : join(id.undecided).c_str());
+    } else if (id.phase == ranger::IdentificationPhase::kFailed && !identification_logged_) {
+      identification_logged_ = true;
+      std::string commission;
+      if (is_socketcan(params_.port_name)) {
+        commission = " (on this robot: ranger_can commission " + params_.port_name +
+                     " --wheels-lifted --output FILE)";
+      }
+      ROS_ERROR("%s%s", id.message.c_str(), commission.c_str());
+    }
+    // Settings the identification could not decide at rest, learned while driving (the monitors
+    // stopped the robot; the value they named is in use now).
+    if (id.decided_ok()) {
+      for (std::size_t i = logged_decisions_; i < id.decided.size(); ++i) {
+        const ranger::IdentifiedSetting& d = id.decided[i];
+        ROS_WARN(
+            "learned while driving: %s = %s (%s); protocol settings now %s. The robot stopped: "
+            "send a zero cmd_vel or call resume to drive again",
+            d.name.c_str(), d.value.c_str(), d.evidence.c_str(),
+            ranger::describe(s.profile).c_str());
+      }
+      logged_decisions_ = std::max(logged_decisions_, id.decided.size());
+    }
+  }
+  // Each monitor warning once (by what it suggests: its measured detail changes every cycle).
+  for (const ranger::PlausibilityFinding& w : s.plausibility.warnings) {
+    const std::string key = w.check + "|" + w.setting + "|" + w.try_value;
+    if (!warned_findings_.insert(key).second) continue;
+    ROS_WARN("plausibility: %s (the robot stops if it persists)", w.text().c_str());
+  }
+  if (const auto& stop = s.plausibility.stop) {
+    const std::string key =
+        stop->check + "|" + stop->setting + "|" + std::to_string(stop->since.count());
+    if (key != logged_stop_) {
+      logged_stop_ = key;
+      ROS_ERROR(
+          "plausibility stop: %s. The robot is stopped: set that parameter (or load a "
+          "commissioning file) and restart, or call resume to try again",
+          stop->text().c_str());
+    }
+  } else {
+    logged_stop_.clear();
   }
 }
 

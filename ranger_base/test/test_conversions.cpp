@@ -162,6 +162,58 @@ TEST(SystemState, ReclaimBlockedSteerFirstAndBelowMinimumAreSaid) {
   EXPECT_FLOAT_EQ(to_system_state(snap, ros::Time(1.0)).steer_first_factor, 0.25f);
 }
 
+TEST(SystemState, IdentifyingAndImplausibleAreSaidWithTheirReasons) {
+  ranger::DriverSnapshot snap;
+  auto& c = snap.controller;
+  // Listening: nothing sent, the controller deaf on purpose: "identifying", not "link_lost".
+  c.refusal = ranger::MotionRefusal::kLinkLost;
+  c.quiet = true;
+  c.identifying = "identifying the chassis: listening (0.4 s of 1.2 s)";
+  snap.protocol = ranger::ProtocolChoice::kAuto;
+  snap.identification = ranger::IdentificationStatus{};
+  auto state = to_system_state(snap, ros::Time(1.0));
+  EXPECT_EQ(state.motion_inhibited_reason, "identifying");
+  EXPECT_NE(state.motion_inhibited_detail.find("listening (0.4 s of 1.2 s)"), std::string::npos)
+      << state.motion_inhibited_detail;
+  EXPECT_EQ(state.protocol, "auto");
+  EXPECT_EQ(state.identification, "listening");
+  EXPECT_EQ(state.protocol_profile, "manual");
+  // The probe: the controller's own refusal, the identification's words.
+  c.quiet = false;
+  c.link = ranger::LinkState::kConnected;
+  c.refusal = ranger::MotionRefusal::kIdentifying;
+  c.identifying = "identifying the chassis: steering probe";
+  state = to_system_state(snap, ros::Time(1.0));
+  EXPECT_EQ(state.motion_inhibited_reason, "identifying");
+  EXPECT_EQ(state.motion_inhibited_detail, "identifying the chassis: steering probe");
+  // A plausibility stop names the setting and the value to try.
+  c.identifying.clear();
+  c.refusal = ranger::MotionRefusal::kImplausible;
+  c.implausible_reason = "spin_sign: try cw (turns the other way)";
+  snap.protocol = ranger::ProtocolChoice::kForced;
+  snap.identification.reset();
+  snap.profile.spin_sign = -1;
+  state = to_system_state(snap, ros::Time(1.0));
+  EXPECT_EQ(state.motion_inhibited_reason, "implausible_feedback");
+  EXPECT_NE(state.motion_inhibited_detail.find("spin_sign: try cw"), std::string::npos)
+      << state.motion_inhibited_detail;
+  EXPECT_EQ(state.protocol, "forced");
+  EXPECT_EQ(state.identification, "");
+  EXPECT_EQ(state.protocol_profile, "manual with spin_sign=cw");
+}
+
+// Every refusal has its words (the switch in describe_refusal is exhaustive: -Wswitch).
+TEST(SystemState, EveryRefusalIsDescribed) {
+  ranger::ControllerState c;
+  c.link = ranger::LinkState::kConnected;
+  for (int r = static_cast<int>(ranger::MotionRefusal::kLinkLost);
+       r <= static_cast<int>(ranger::MotionRefusal::kIdentifying); ++r) {
+    c.refusal = static_cast<ranger::MotionRefusal>(r);
+    EXPECT_FALSE(describe_refusal(c).empty()) << ranger::to_string(c.refusal);
+    EXPECT_EQ(refusal_name(c), std::string(ranger::to_string(c.refusal)));
+  }
+}
+
 // ---- cmd_vel_out -------------------------------------------------------------------------------
 
 TEST(CmdVelOut, OnlyMotionCommandsCarryATwistAndTheShutdownStopIsZero) {

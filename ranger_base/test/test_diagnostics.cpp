@@ -178,5 +178,124 @@ TEST(Diagnostics, FrameRatesPerIdFromTheSnapshotAndRejectsWarn) {
   EXPECT_EQ(later.level, DiagnosticStatus::OK) << later.message;  // nothing new rejected
 }
 
+// ---- Protocol: the settings, the identification, the plausibility monitors -----------------
+
+ranger::IdentificationStatus identification(ranger::IdentificationPhase phase) {
+  ranger::IdentificationStatus id;
+  id.phase = phase;
+  id.revision = "manual";
+  id.message = "steering probe";
+  return id;
+}
+
+TEST(ProtocolDiagnostics, ForcedSettingsAreOkAndListed) {
+  auto s = healthy();
+  s.profile.spin_sign = -1;
+  DiagnosticStatusWrapper d;
+  diagnose_protocol(s, {"forced: protocol manual, model ranger", "can0"}, d);
+  EXPECT_EQ(d.level, DiagnosticStatus::OK) << d.message;
+  EXPECT_NE(d.message.find("manual with spin_sign=cw"), std::string::npos) << d.message;
+  EXPECT_EQ(value(d, "Settings from"), "forced: protocol manual, model ranger");
+  EXPECT_EQ(value(d, "spin_sign"), "cw");
+  EXPECT_EQ(value(d, "steering_unit_111"), "centideg");
+  EXPECT_EQ(value(d, "Identification"), "<missing>");
+}
+
+TEST(ProtocolDiagnostics, IdentifyingIsOkAndDecidedShowsTheEvidence) {
+  auto s = healthy();
+  s.protocol = ranger::ProtocolChoice::kAuto;
+  s.identification = identification(ranger::IdentificationPhase::kSteerProbe);
+  DiagnosticStatusWrapper probing;
+  diagnose_protocol(s, {"auto: identified from the chassis, model ranger", "can0"}, probing);
+  EXPECT_EQ(probing.level, DiagnosticStatus::OK) << probing.message;
+  EXPECT_NE(probing.message.find("identifying the chassis (steer_probe)"), std::string::npos)
+      << probing.message;
+
+  auto& id = *s.identification;
+  id.phase = ranger::IdentificationPhase::kDecided;
+  id.evidence = {"no frame only the vendor's revision sends: preset manual",
+                 "spin position at standstill: the unit is centideg"};
+  id.decided = {{"steering_unit_271", "centideg", "spin position 57.8 deg"}};
+  id.undecided = {"spin_field", "spin_sign"};
+  id.confidence = 0.97;
+  DiagnosticStatusWrapper decided;
+  diagnose_protocol(s, {"auto", "can0"}, decided);
+  EXPECT_EQ(decided.level, DiagnosticStatus::OK) << decided.message;
+  EXPECT_EQ(decided.message, "identified: manual");
+  EXPECT_EQ(value(decided, "Identification"), "decided");
+  EXPECT_EQ(value(decided, "Evidence 2"), "spin position at standstill: the unit is centideg");
+  EXPECT_EQ(value(decided, "Decided steering_unit_271"), "centideg (spin position 57.8 deg)");
+  EXPECT_EQ(value(decided, "Undecided (the preset's value, checked while driving)"),
+            "spin_field, spin_sign");
+}
+
+TEST(ProtocolDiagnostics, AFailedIdentificationIsAnErrorNamingWhatToSetAndTheCommissioning) {
+  auto s = healthy();
+  s.protocol = ranger::ProtocolChoice::kAuto;
+  s.identification = identification(ranger::IdentificationPhase::kFailed);
+  s.identification->message = ranger::unidentified_message("no 0x271 answer", 10s);
+  DiagnosticStatusWrapper d;
+  diagnose_protocol(s, {"auto", "can1"}, d);
+  EXPECT_EQ(d.level, DiagnosticStatus::ERROR);
+  for (const char* expected : {"identify_timeout", "protocol: manual", "steering_unit_111",
+                               "commissioning_file", "ranger_can commission IFACE --wheels-lifted",
+                               "ranger_can commission can1 --wheels-lifted"}) {
+    EXPECT_NE(d.message.find(expected), std::string::npos) << expected << " in " << d.message;
+  }
+  // Control mode says why motion is refused, pointing at Protocol.
+  s.controller.refusal = ranger::MotionRefusal::kIdentifying;
+  s.controller.identifying = s.identification->message;
+  DiagnosticStatusWrapper control;
+  diagnose_control(s, control);
+  EXPECT_EQ(control.level, DiagnosticStatus::ERROR) << control.message;
+}
+
+TEST(ProtocolDiagnostics, WarningsAreWarnWithTheValueToTryAndAStopIsAnError) {
+  auto s = healthy();
+  ranger::PlausibilityFinding reference;
+  reference.check = "steering_reference";
+  reference.setting = "steering_reference";
+  reference.try_value = "inner_front";
+  reference.detail = "the wheels fit the inner front wheel";
+  s.plausibility.warnings = {reference};
+  DiagnosticStatusWrapper warned;
+  diagnose_protocol(s, {"forced", "sim"}, warned);
+  EXPECT_EQ(warned.level, DiagnosticStatus::WARN);
+  EXPECT_NE(warned.message.find("steering_reference: try inner_front"), std::string::npos)
+      << warned.message;
+  EXPECT_EQ(value(warned, "Plausibility warning 1"), reference.text());
+
+  ranger::PlausibilityFinding spin;
+  spin.check = "yaw";
+  spin.setting = "spin_sign";
+  spin.try_value = "cw";
+  spin.detail = "turns the other way";
+  spin.stops = true;
+  s.plausibility.stop = spin;
+  DiagnosticStatusWrapper stopped;
+  diagnose_protocol(s, {"forced", "sim"}, stopped);
+  EXPECT_EQ(stopped.level, DiagnosticStatus::ERROR);
+  EXPECT_NE(stopped.message.find("spin_sign: try cw"), std::string::npos) << stopped.message;
+  EXPECT_NE(stopped.message.find("steering_reference: try inner_front"), std::string::npos)
+      << stopped.message;
+  EXPECT_EQ(value(stopped, "Plausibility stop"), spin.text());
+}
+
+TEST(ProtocolDiagnostics, ListeningIsNotAMissingChassis) {
+  auto s = healthy();
+  s.controller.link = ranger::LinkState::kNeverConnected;
+  s.controller.refusal = ranger::MotionRefusal::kLinkLost;
+  s.controller.quiet = true;
+  s.controller.identifying = "identifying the chassis: listening";
+  s.now = ranger::Timestamp(1s);
+  s.frames.record(protocol::kSystemStatusId, s.now, true, 0);
+  DiagnosticStatusWrapper link, control;
+  diagnose_link(s, link);
+  diagnose_control(s, control);
+  EXPECT_EQ(link.level, DiagnosticStatus::OK) << link.message;
+  EXPECT_NE(link.message.find("listening"), std::string::npos) << link.message;
+  EXPECT_EQ(control.level, DiagnosticStatus::OK) << control.message;
+}
+
 }  // namespace
 }  // namespace ranger_base

@@ -63,6 +63,13 @@ nav_msgs::Odometry to_ground_truth(const ranger::sim::ChassisSnapshot& sim,
                                    const NodeParameters& params, const ros::Time& stamp);
 
 // ---- chassis state ----------------------------------------------------------------------------
+// The identification is listening: nothing is sent, and the controller hears nothing on purpose
+// (its link reads never-connected, its refusal link_lost) until the chassis has been heard.
+bool listening(const ranger::ControllerState& state);
+// Why motion is refused, by stable name (libranger_can's MotionRefusal: "estop", "identifying",
+// "implausible_feedback", ...; "" while driven), with the identification's listening reported as
+// "identifying" rather than "link_lost".
+std::string refusal_name(const ranger::ControllerState& state);
 // Why motion is refused, and what to do about it, in words (system_state's
 // motion_inhibited_detail, diagnostics, the log); "" while the chassis is driven as asked.
 std::string describe_refusal(const ranger::ControllerState& state);

@@ -1,5 +1,5 @@
 // /diagnostics for the chassis, through diagnostic_updater: one status per concern (CAN link,
-// control mode, errors, battery, frame rates), each computed from a ranger::DriverSnapshot so the
+// control mode, protocol settings, errors, battery, frame rates), each computed from a ranger::DriverSnapshot so the
 // same rules are unit-tested without ROS plumbing. ranger_bringup's aggregator config groups them.
 #pragma once
 
@@ -11,6 +11,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <string>
 
 #include <ranger_can/control/driver.hpp>
 
@@ -19,6 +20,7 @@ namespace ranger_base {
 // Status names as they appear in /diagnostics (prefixed by the node name by the updater).
 inline constexpr const char* kDiagLink = "CAN link";
 inline constexpr const char* kDiagControl = "Control mode";
+inline constexpr const char* kDiagProtocol = "Protocol";
 inline constexpr const char* kDiagErrors = "Chassis errors";
 inline constexpr const char* kDiagBattery = "Battery";
 inline constexpr const char* kDiagFrameRates = "Frame rates";
@@ -29,6 +31,20 @@ using ranger::DriverSnapshot;
 void diagnose_link(const DriverSnapshot& s, DiagnosticStatusWrapper& out);
 void diagnose_control(const DriverSnapshot& s, DiagnosticStatusWrapper& out);
 void diagnose_errors(const DriverSnapshot& s, DiagnosticStatusWrapper& out);
+
+// What the snapshot does not say about the protocol settings: where they came from (the
+// parameters), and the bus, for the commissioning command.
+struct ProtocolContext {
+  std::string source;     // NodeParameters::protocol.source
+  std::string port_name;  // "can0": the commissioning command names it (a CAN interface only)
+};
+// The settings in use and where they came from; with `protocol: auto` the identification (phase,
+// decision with its evidence, the settings left undecided); the plausibility monitors (every
+// warning with the value to try, and the stop). ERROR while the identification failed (its
+// message names what to set and the commissioning command) or a plausibility stop holds; WARN
+// while a monitor warns.
+void diagnose_protocol(const DriverSnapshot& s, const ProtocolContext& context,
+                       DiagnosticStatusWrapper& out);
 void diagnose_battery(const DriverSnapshot& s, DiagnosticStatusWrapper& out);
 
 // Received frames per ID: the snapshot's rates (FrameStats, over its window), the rejected and
@@ -46,11 +62,13 @@ class FrameRateMonitor {
 class ChassisDiagnostics {
  public:
   using SnapshotSource = std::function<std::shared_ptr<const DriverSnapshot>()>;
-  ChassisDiagnostics(diagnostic_updater::Updater& updater, SnapshotSource source);
+  ChassisDiagnostics(diagnostic_updater::Updater& updater, SnapshotSource source,
+                     ProtocolContext protocol = {});
   void refresh();
 
  private:
   SnapshotSource source_;
+  ProtocolContext protocol_;
   FrameRateMonitor rates_;
   std::shared_ptr<const DriverSnapshot> current_;
 };

@@ -31,6 +31,7 @@
 #include <mutex>
 #include <optional>
 #include <set>
+#include <string>
 #include <thread>
 
 #include <ranger_can/clock.hpp>
@@ -84,6 +85,10 @@ class RangerNode {
   void publish_states();  // ranger_msgs states, battery, ultrasonic
   void publish_diagnostics();
   void log_state_changes(const ranger::DriverSnapshot& s);
+  // The identification's decision or failure (once), settings learned while driving, each new
+  // plausibility warning (once) and a plausibility stop.
+  void log_protocol_changes(const ranger::DriverSnapshot& s);
+  void log_protocol() const;  // at start: the model and where the protocol settings come from
 
   ros::NodeHandle nh_;
   ros::NodeHandle private_nh_;
@@ -131,6 +136,10 @@ class RangerNode {
   std::uint32_t last_error_bits_ = 0;
   ranger::Timestamp waiting_since_{0}, next_waiting_log_{0};
   std::set<std::uint32_t> padded_ids_reported_;
+  bool identification_logged_ = false;  // its decision or failure
+  std::size_t logged_decisions_ = 0;    // identification decisions logged (learned ones after)
+  std::set<std::string> warned_findings_;
+  std::string logged_stop_;
   bool shut_down_ = false;
 };
 
