@@ -123,8 +123,11 @@ class Robot:
         self.rates = {}
         state = {}
         sub = rospy.Subscriber(f"/{ns}/system_state", SystemState, lambda m: state.update(m=m))
+        # CAN command mode with the protocol settings decided (protocol auto identifies the
+        # chassis first; nothing is sent while it listens).
         ok = wait_for(lambda: "m" in state and state["m"].link_up
-                      and state["m"].control_mode == SystemState.CONTROL_MODE_CAN)
+                      and state["m"].control_mode == SystemState.CONTROL_MODE_CAN
+                      and state["m"].identification in ("", "decided"))
         sub.unregister()
         ready = select.select([self.subscribers.stdout], [], [], 30)[0]
         if not ok or not ready or self.subscribers.stdout.readline().strip() != "ready":

@@ -53,11 +53,13 @@ class TwoRobots(unittest.TestCase):
         return callback
 
     def setUp(self):
+        # protocol auto (the default): each node identifies its chassis before it drives.
         self.assertTrue(wait_for(lambda: all(
             r in self.state and self.state[r].link_up
             and self.state[r].control_mode == SystemState.CONTROL_MODE_CAN
+            and self.state[r].identification == "decided"
             and r in self.truth and self.pubs[r].get_num_connections() > 0 for r in ROBOTS)),
-            "both nodes should reach CAN command mode")
+            "both nodes should reach CAN command mode with their protocol settings identified")
 
     def test_names_are_relative(self):
         master = rosgraph.Master("/test_node_namespaces")

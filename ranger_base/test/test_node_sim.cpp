@@ -1,12 +1,19 @@
 // ranger_base_node end to end against its in-process virtual chassis (port_name:=sim), through
 // ROS only: cmd_vel and sim/inject (faults for the virtual chassis) in; system_state, odom,
 // sim/ground_truth, cmd_vel_out (every motion command the node sent, stamped with its send time),
-// /rosout, services out. Launched by node_sim.test (and, filtered to the Faults suite, by
-// node_sim_faults.test).
+// /rosout, /diagnostics, services out. Launched by node_sim.test (NodeSim, Safety), and filtered
+// to one suite by node_sim_faults.test (Faults), node_sim_identify*.test (Identification:
+// protocol auto, the default, on sim, sim:agx_v2 and sim:undecidable) and
+// node_sim_implausible*.test (Implausible: a wrong forced setting on a sim variant).
+//
+// With protocol auto (the default) the node drives nothing until the identification has decided
+// (about 3.6 s after the chassis is first heard): SetUp waits for that, a condition like every
+// other wait here.
 //
 // Nothing sleeps to synchronise: every wait is on an observable condition (a message, a state),
 // bounded only to fail a broken build instead of hanging; timing is asserted on the node's own
 // stamps and on message order, never on how long the test took.
+#include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/Twist.h>
 #include <geometry_msgs/TwistStamped.h>
 #include <gtest/gtest.h>
@@ -30,6 +37,7 @@
 #include <deque>
 #include <functional>
 #include <limits>
+#include <map>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -110,6 +118,12 @@ class NodeSim : public ::testing::Test {
           std::lock_guard<std::mutex> lock(commands_mutex_);
           logs_.push_back(*m);
         }));
+    subs_.push_back(subscribe<diagnostic_msgs::DiagnosticArray>(
+        nh, "/diagnostics", 100, [](const diagnostic_msgs::DiagnosticArray::ConstPtr& m) {
+          std::lock_guard<std::mutex> lock(commands_mutex_);
+          for (const auto& status : m->status)
+            diagnostics_[status.name] = status;
+        }));
     cmd_pub_ = nh.advertise<geometry_msgs::Twist>("cmd_vel", 100);
     inject_pub_ = nh.advertise<std_msgs::String>("sim/inject", 10);
     spinner_ = std::make_unique<ros::AsyncSpinner>(2);
@@ -131,10 +145,66 @@ class NodeSim : public ::testing::Test {
     ASSERT_TRUE(wait_for([] {
       const auto s = state_.get();
       return s && s->link_up && s->control_mode == SystemState::CONTROL_MODE_CAN &&
-             cmd_pub_.getNumSubscribers() > 0 && inject_pub_.getNumSubscribers() > 0 &&
-             truth_.get() && odom_.get();
-    })) << "the node never reached CAN command mode";
+             settings_decided(*s) && cmd_pub_.getNumSubscribers() > 0 &&
+             inject_pub_.getNumSubscribers() > 0 && truth_.get() && odom_.get();
+    })) << "the node never reached CAN command mode with its protocol settings decided";
     stop_and_settle();
+  }
+
+  // The protocol settings are decided: forced (no identification), or identified.
+  static bool settings_decided(const SystemState& s) {
+    return s.identification.empty() || s.identification == "decided";
+  }
+
+  // The node's latest report of one of its diagnostics statuses ("Protocol", ...).
+  static std::optional<diagnostic_msgs::DiagnosticStatus> diagnostic(const std::string& status) {
+    std::lock_guard<std::mutex> lock(commands_mutex_);
+    for (const auto& [name, d] : diagnostics_) {
+      if (name.size() >= status.size() &&
+          name.compare(name.size() - status.size(), status.size(), status) == 0 &&
+          name.find("ranger_base_node: ") != std::string::npos) {
+        return d;
+      }
+    }
+    return std::nullopt;
+  }
+
+  static std::string value_of(const diagnostic_msgs::DiagnosticStatus& d, const std::string& key) {
+    for (const auto& kv : d.values) {
+      if (kv.key == key) return kv.value;
+    }
+    return "<missing>";
+  }
+
+  // Publishes `cmd` `n` times, each time waiting for the node's next system_state: a teleop kept
+  // alive while the node may send no motion command at all.
+  static bool drive_for_states(const geometry_msgs::Twist& cmd, int n) {
+    for (int i = 0; i < n; ++i) {
+      std::size_t seen = 0;
+      {
+        std::lock_guard<std::mutex> lock(commands_mutex_);
+        seen = states_.size();
+      }
+      cmd_pub_.publish(cmd);
+      if (!wait_for(
+              [&] {
+                std::lock_guard<std::mutex> lock(commands_mutex_);
+                return states_.size() > seen;
+              },
+              5.0)) {
+        return false;
+      }
+    }
+    return true;
+  }
+
+  // The stamp of the node's log line containing `text` at `level` or above (zero: none).
+  static ros::Time log_stamp(const std::string& text, std::uint8_t level) {
+    std::lock_guard<std::mutex> lock(commands_mutex_);
+    for (const auto& l : logs_) {
+      if (l.level >= level && l.msg.find(text) != std::string::npos) return l.header.stamp;
+    }
+    return ros::Time();
   }
 
   static bool wait_for(const std::function<bool()>& condition, double limit_s = 20.0) {
@@ -270,6 +340,7 @@ class NodeSim : public ::testing::Test {
   static std::deque<geometry_msgs::TwistStamped> commands_;
   static std::deque<SystemState> states_;
   static std::vector<rosgraph_msgs::Log> logs_;
+  static std::map<std::string, diagnostic_msgs::DiagnosticStatus> diagnostics_;
 };
 
 std::unique_ptr<ros::NodeHandle> NodeSim::nh_;
@@ -286,6 +357,7 @@ std::mutex NodeSim::commands_mutex_;
 std::deque<geometry_msgs::TwistStamped> NodeSim::commands_;
 std::deque<SystemState> NodeSim::states_;
 std::vector<rosgraph_msgs::Log> NodeSim::logs_;
+std::map<std::string, diagnostic_msgs::DiagnosticStatus> NodeSim::diagnostics_;
 
 double yaw_of(const nav_msgs::Odometry& o) {
   return tf2::getYaw(o.pose.pose.orientation);
@@ -560,27 +632,6 @@ class Safety : public NodeSim {
     }
   };
 
-  // Publishes `cmd` `n` times, each time waiting for the node's next system_state: a teleop kept
-  // alive while the node sends no motion command at all (standby).
-  static bool drive_for_states(const geometry_msgs::Twist& cmd, int n) {
-    for (int i = 0; i < n; ++i) {
-      std::size_t seen = 0;
-      {
-        std::lock_guard<std::mutex> lock(commands_mutex_);
-        seen = states_.size();
-      }
-      cmd_pub_.publish(cmd);
-      if (!wait_for(
-              [&] {
-                std::lock_guard<std::mutex> lock(commands_mutex_);
-                return states_.size() > seen;
-              },
-              5.0)) {
-        return false;
-      }
-    }
-    return true;
-  }
 };
 
 TEST_F(Safety, EmergencyStopLatchesUntilResume) {
@@ -789,6 +840,192 @@ TEST_F(Faults, ClearErrorsAnswersThenTheLatchHoldsUntilResume) {
       drive_until(twist(0.4, 0, 0), [] { return truth_.get()->twist.twist.linear.x > 0.3; }));
   EXPECT_FALSE(state_.get()->rearm_required);
   stop_and_settle();
+}
+
+// ---- node_sim_identify*.test: protocol auto (the default) -------------------------------------
+
+class Identification : public NodeSim {
+ protected:
+  void SetUp() override {}  // each test watches the start-up itself
+
+  // The profile the identification must reach (the test's private parameter).
+  static std::string expected_profile() {
+    std::string profile = "manual";
+    ros::param::get("~expected_profile", profile);
+    return profile;
+  }
+
+  static bool ready_for_commands() {
+    const auto s = state_.get();
+    return s && truth_.get() && cmd_pub_.getNumSubscribers() > 0;
+  }
+};
+
+// cmd_vel keeps coming from the first system_state on: nothing is driven while the node says
+// "identifying"; once the identification decided, the same cmd_vel drives and odometry moves.
+TEST_F(Identification, NothingIsDrivenBeforeTheDecisionThenCmdVelDrives) {
+  ASSERT_TRUE(wait_for(ready_for_commands, 30.0)) << "no system_state from the node";
+  const auto first = *state_.get();
+  EXPECT_EQ(first.protocol, "auto");
+  EXPECT_NE(first.identification, "decided")
+      << "the node decided before the test saw it identify: start-up too slow to observe";
+  const auto arc = twist(0.4, 0.0, 0.2);
+  ASSERT_TRUE(drive_until(arc, [] { return state_.get()->identification == "decided"; }, 30.0))
+      << "identification: " << state_.get()->identification << ", "
+      << state_.get()->motion_inhibited_detail;
+
+  // What system_state said until then: identifying, never driven (cmd_vel_out: every motion
+  // command the node sent, stamped when sent; the probe steers at zero speed).
+  ros::Time last_identifying;
+  bool saw_identifying = false;
+  {
+    std::lock_guard<std::mutex> lock(commands_mutex_);
+    for (const auto& st : states_) {
+      if (st.identification == "decided") break;
+      // identifying (listening, probing), or the handshake's own states on the way (standby).
+      EXPECT_FALSE(st.motion_inhibited_reason.empty()) << st.identification;
+      saw_identifying = saw_identifying || st.motion_inhibited_reason == "identifying";
+      last_identifying = st.header.stamp;
+    }
+    for (const auto& c : commands_) {
+      if (c.header.stamp <= last_identifying) EXPECT_TRUE(is_zero(c)) << "driven while identifying";
+    }
+  }
+  EXPECT_TRUE(saw_identifying);
+
+  // Then the same cmd_vel drives, and the odometry follows.
+  const auto start = *truth_.get();
+  ASSERT_TRUE(drive_until(arc, [&] {
+    const auto t = truth_.get();
+    return std::hypot(t->pose.pose.position.x - start.pose.pose.position.x,
+                      t->pose.pose.position.y - start.pose.pose.position.y) > 0.6;
+  }));
+  stop_and_settle();
+  ASSERT_TRUE(wait_for([] { return speed(*odom_.get()) < 1e-3; }));
+  const auto odom = *odom_.get();
+  EXPECT_GT(std::hypot(odom.pose.pose.position.x, odom.pose.pose.position.y), 0.5);
+  expect_odom_matches_truth(1.0);
+
+  const auto s = *state_.get();
+  EXPECT_EQ(s.protocol, "auto");
+  EXPECT_EQ(s.protocol_profile, expected_profile());
+  // Logged once, with its evidence; in diagnostics with the decision.
+  EXPECT_TRUE(logged("chassis identified in", ros::Time(), rosgraph_msgs::Log::INFO));
+  EXPECT_TRUE(logged("Evidence: ", ros::Time(), rosgraph_msgs::Log::INFO));
+  ASSERT_TRUE(wait_for([] {
+    const auto d = diagnostic("Protocol");
+    return d && value_of(*d, "Identification") == "decided";
+  }));
+  const auto d = *diagnostic("Protocol");
+  EXPECT_EQ(d.level, diagnostic_msgs::DiagnosticStatus::OK) << d.message;
+  EXPECT_EQ(d.message, "identified: " + expected_profile());
+  EXPECT_NE(value_of(d, "Evidence 1"), "<missing>");
+  EXPECT_NE(value_of(d, "Undecided (the preset's value, checked while driving)"), "<missing>");
+}
+
+// sim:undecidable: no reading explains it. The node stays at rest and says what to set.
+TEST_F(Identification, AChassisThatCannotBeIdentifiedStaysAtRestAndSaysWhatToSet) {
+  ASSERT_TRUE(wait_for(ready_for_commands, 30.0)) << "no system_state from the node";
+  ASSERT_TRUE(drive_until(twist(0.4, 0, 0), [] { return state_.get()->identification == "failed"; },
+                          30.0))
+      << state_.get()->identification;
+  ASSERT_TRUE(drive_for_states(twist(0.4, 0, 0), 10));
+  EXPECT_LT(speed(*truth_.get()), 1e-3);
+  {
+    std::lock_guard<std::mutex> lock(commands_mutex_);
+    for (const auto& c : commands_)
+      EXPECT_TRUE(is_zero(c)) << "driven although not identified";
+  }
+  const auto s = *state_.get();
+  EXPECT_EQ(s.motion_inhibited_reason, "identifying");
+  EXPECT_NE(s.motion_inhibited_detail.find("could not be identified"), std::string::npos)
+      << s.motion_inhibited_detail;
+  ASSERT_TRUE(wait_for([] {
+    const auto d = diagnostic("Protocol");
+    return d && d->level == diagnostic_msgs::DiagnosticStatus::ERROR;
+  }));
+  const auto d = *diagnostic("Protocol");
+  for (const char* expected : {"could not be identified", "protocol: manual", "identify_timeout",
+                               "ranger_can commission IFACE --wheels-lifted",
+                               "commissioning_file"}) {
+    EXPECT_NE(d.message.find(expected), std::string::npos) << expected << " in " << d.message;
+  }
+  EXPECT_EQ(value_of(d, "Identification"), "failed");
+  EXPECT_TRUE(logged("could not be identified", ros::Time(), rosgraph_msgs::Log::ERROR));
+}
+
+// ---- node_sim_implausible*.test: a sim variant driven with the wrong forced settings ----------
+
+class Implausible : public NodeSim {};
+
+// sim:spin_cw with protocol manual: the spin turns the other way; the yaw check stops it.
+TEST_F(Implausible, AWrongSpinSignIsStoppedAndSaid) {
+  EXPECT_EQ(state_.get()->protocol, "forced");
+  const ros::Time t0 = ros::Time::now();
+  const auto spin = twist(0, 0, 0.5);
+  ASSERT_TRUE(drive_until(
+      spin, [] { return state_.get()->motion_inhibited_reason == "implausible_feedback"; }, 30.0))
+      << state_.get()->motion_inhibited_reason;
+  const auto stopped = *state_.get();
+  EXPECT_NE(stopped.motion_inhibited_detail.find("spin_sign: try cw"), std::string::npos)
+      << stopped.motion_inhibited_detail;
+  // At rest, and it stays there however long cmd_vel keeps coming.
+  ASSERT_TRUE(drive_until(spin, [] { return speed(*truth_.get()) < 1e-3; }));
+  ASSERT_TRUE(drive_for_states(spin, 10));
+  EXPECT_LT(speed(*truth_.get()), 1e-3);
+  EXPECT_EQ(state_.get()->motion_inhibited_reason, "implausible_feedback");
+  EXPECT_TRUE(state_.get()->rearm_required);
+  // Said: the warning (WARN, the value to try), the stop (ERROR), the Protocol diagnostics.
+  EXPECT_TRUE(logged("plausibility: spin_sign: try cw", t0, rosgraph_msgs::Log::WARN));
+  EXPECT_TRUE(logged("plausibility stop: spin_sign: try cw", t0, rosgraph_msgs::Log::ERROR));
+  ASSERT_TRUE(wait_for([] {
+    const auto d = diagnostic("Protocol");
+    return d && d->level == diagnostic_msgs::DiagnosticStatus::ERROR;
+  }));
+  const auto d = *diagnostic("Protocol");
+  EXPECT_NE(d.message.find("spin_sign: try cw"), std::string::npos) << d.message;
+  EXPECT_NE(value_of(d, "Plausibility stop").find("spin_sign: try cw"), std::string::npos);
+  // resume: the operator takes the stop on; the monitors start over.
+  cmd_pub_.publish(twist(0, 0, 0));
+  const auto resumed = call_resume();
+  EXPECT_TRUE(resumed.success) << resumed.message;
+  EXPECT_TRUE(wait_for([] { return state_.get()->motion_inhibited_reason != "implausible_feedback"; }));
+}
+
+// sim:inner_angle with protocol manual: the arc is steered on the wrong reference; a subtle
+// mismatch warns first (WARN, the value to try), then stops.
+TEST_F(Implausible, AWrongSteeringReferenceIsWarnedThenStopped) {
+  const ros::Time t0 = ros::Time::now();
+  const auto arc = twist(0.4, 0, 0.4);
+  ASSERT_TRUE(drive_until(
+      arc, [] { return state_.get()->motion_inhibited_reason == "implausible_feedback"; }, 40.0))
+      << state_.get()->motion_inhibited_reason;
+  EXPECT_NE(state_.get()->motion_inhibited_detail.find("steering_reference: try inner_front"),
+            std::string::npos)
+      << state_.get()->motion_inhibited_detail;
+  ASSERT_TRUE(drive_until(arc, [] { return speed(*truth_.get()) < 1e-3; }));
+  ASSERT_TRUE(logged("plausibility: steering_reference: try inner_front", t0,
+                     rosgraph_msgs::Log::WARN));
+  ASSERT_TRUE(logged("plausibility stop: steering_reference: try inner_front", t0,
+                     rosgraph_msgs::Log::ERROR));
+  // The warning came first, once.
+  EXPECT_LE(log_stamp("plausibility: steering_reference", rosgraph_msgs::Log::WARN),
+            log_stamp("plausibility stop: steering_reference", rosgraph_msgs::Log::ERROR));
+  {
+    std::lock_guard<std::mutex> lock(commands_mutex_);
+    int warnings = 0;
+    for (const auto& l : logs_)
+      warnings += l.msg.find("plausibility: steering_reference") != std::string::npos;
+    EXPECT_EQ(warnings, 1);
+  }
+  ASSERT_TRUE(wait_for([] {
+    const auto d = diagnostic("Protocol");
+    return d && d->level == diagnostic_msgs::DiagnosticStatus::ERROR;
+  }));
+  EXPECT_NE(diagnostic("Protocol")->message.find("steering_reference: try inner_front"),
+            std::string::npos)
+      << diagnostic("Protocol")->message;
+  cmd_pub_.publish(twist(0, 0, 0));
 }
 
 }  // namespace

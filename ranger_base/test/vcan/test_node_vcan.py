@@ -109,9 +109,11 @@ class VcanNode(unittest.TestCase):
 
     def start_node(self, ns):
         # link_timeout: the emulated VM can starve a process for longer than the default 0.1 s.
+        # protocol manual: these tests are about stopping the chassis, not the identification
+        # (which node_sim_identify*.test cover); `ranger_can sim` speaks the manual's protocol.
         node = subprocess.Popen([self.node_exe, f"__ns:=/{ns}", "__name:=ranger_base_node",
                                  f"_port_name:={IFACE}", "_link_timeout:=0.5",
-                                 "_cmd_vel_timeout:=5.0"])
+                                 "_cmd_vel_timeout:=5.0", "_protocol:=manual"])
         state = {}
         sub = rospy.Subscriber(f"/{ns}/system_state", SystemState,
                                lambda m: state.update(msg=m))
