@@ -339,12 +339,20 @@ def launch_args(text):
     return dict(w.split(":=", 1) for w in shlex.split(text) if ":=" in w)
 
 
+def settled(topic):
+    """The driver is in CAN command mode with its protocol settings decided: forced, or
+    identified (`protocol: auto`, the default, identifies the chassis before anything moves)."""
+    return [{"topic": topic, "type": "ranger_msgs/SystemState", "field": "control_mode",
+             "equals": 1},
+            {"topic": topic, "type": "ranger_msgs/SystemState", "field": "identification",
+             "in": ["", "decided"]}]
+
+
 def robot_conditions(ns, sim, port):
     p = f"/{ns}" if ns else ""
     conditions = [{"node": f"{p}/ranger_base_node"}, {"node": f"{p}/robot_state_publisher"}]
-    if sim:  # the node reached CAN command mode with the virtual chassis
-        conditions.append({"topic": f"{p}/system_state", "type": "ranger_msgs/SystemState",
-                           "field": "control_mode", "equals": 1})
+    if sim:  # the node reached CAN command mode with the virtual chassis, its settings decided
+        conditions += settled(f"{p}/system_state")
     else:  # no adapter here: the node runs and reports the missing interface by name
         conditions.append({"topic": "/diagnostics", "type": "diagnostic_msgs/DiagnosticArray",
                            "status": f"{ns + '/' if ns else ''}ranger_base_node: CAN link",
@@ -356,7 +364,8 @@ def robot_conditions(ns, sim, port):
 
 def aggregated(robots):
     """The aggregated status names ranger_diagnostics.launch promises for `robots`."""
-    statuses = ["CAN link", "Control mode", "Chassis errors", "Battery", "Frame rates"]
+    statuses = ["CAN link", "Control mode", "Protocol", "Chassis errors", "Battery",
+                "Frame rates"]
     prefixes = [f"/RANGER/{r}/" for r in robots] if robots else ["/RANGER/"]
     return {"topic": "/diagnostics_agg", "type": "diagnostic_msgs/DiagnosticArray",
             "names": [p + s for p in prefixes for s in statuses]}
@@ -367,7 +376,8 @@ def launch_robot(session, cmd, match):
     CAN command mode on the virtual chassis; on can0, reporting the missing adapter)."""
     args = launch_args(cmd.text)
     ns = (args.get("ns") or args.get("namespace") or "").strip("/")
-    sim = match.group("file") == "ranger_sim" or args.get("sim") == "true"
+    sim = (match.group("file") == "ranger_sim" or args.get("sim") == "true"
+           or bool(args.get("sim_variant")))
     rviz = args.get("rviz") == "true"
     process = session.start(cmd.text, env=session.display_env() if rviz else None)
     conditions = robot_conditions(ns, sim, args.get("port_name", "can0"))
@@ -438,10 +448,10 @@ def roscore(session, cmd, match):
 
 def node_alone(session, cmd, match):
     port = launch_args(cmd.text).get("_port_name", "can0")
+    sim = port == "sim" or port.startswith("sim:")
     process = session.start(cmd.text)
-    session.probe(process, robot_conditions("", port == "sim", port)[:1] + (
-        [{"topic": "/system_state", "type": "ranger_msgs/SystemState", "field": "control_mode",
-          "equals": 1}] if port == "sim" else []))
+    session.probe(process, robot_conditions("", sim, port)[:1] + (
+        settled("/system_state") if sim else []))
 
 
 def drive_one_robot(session, cmd, match):
@@ -595,10 +605,11 @@ RULES = [
     Rule(r"rosrun ranger_bringup bringup_can2usb\.bash", can_adapter,
          "run against stand-ins for sudo/ip/modprobe and a fake /sys/class/net with can0"),
     Rule(r"roslaunch ranger_bringup (?P<file>ranger_minimal|ranger_sim)\.launch( .*)?",
-         launch_robot, "runs until its nodes are up (sim: in CAN command mode; can0: reporting "
-         "the missing adapter), in its namespace only"),
+         launch_robot, "runs until its nodes are up (sim: in CAN command mode with the protocol "
+         "settings decided; can0: reporting the missing adapter), in its namespace only"),
     Rule(r"roslaunch ranger_bringup ranger_sim_two\.launch", launch_two_robots,
-         "runs until both robots are in CAN command mode and one aggregator shows both"),
+         "runs until both robots are in CAN command mode with their protocol settings decided "
+         "and one aggregator shows both"),
     Rule(r"roslaunch ranger_bringup ranger_diagnostics\.launch( .*)?", launch_diagnostics,
          "runs until /diagnostics_agg shows every robot it names"),
     Rule(r"roslaunch ranger_bringup display\.launch( .*)?", launch_display,
@@ -607,7 +618,8 @@ RULES = [
          "runs in a pseudo-terminal; Ctrl-D ends it cleanly, without a REQUIRED banner"),
     Rule(r"roscore", roscore, "runs (on the session's port) until the master is up"),
     Rule(r"rosrun ranger_base ranger_base_node( .*)?", node_alone,
-         "runs until the node is up (in CAN command mode with _port_name:=sim)"),
+         "runs until the node is up (in CAN command mode with its protocol settings decided with "
+         "_port_name:=sim)"),
     Rule(r"rostopic pub -r \S+ (?P<ns>/\S+)/cmd_vel geometry_msgs/Twist .*", drive_one_robot,
          "runs until that robot moves; every other virtual robot must stay put"),
     Rule(r"rostopic pub -1 (?P<ns>(/[^/\s]+)*)/sim/inject std_msgs/String "

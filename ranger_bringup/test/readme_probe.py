@@ -9,6 +9,8 @@ a master of its own). CONDITIONS_JSON is a list of objects, each one of:
   {"no_node": NAME}                   the node is not registered (checked once the rest hold)
   {"topic": T, "type": PKG/MSG, "field": F, "equals": V}
                                       the latest message's field F equals V
+  {"topic": T, "type": PKG/MSG, "field": F, "in": [V...]}
+                                      the latest message's field F is one of the values
   {"topic": T, "type": "diagnostic_msgs/DiagnosticArray", "names": [N...]}
                                       every status name N has been seen on T
   {"topic": T, "type": "diagnostic_msgs/DiagnosticArray", "status": N, "level": L,
@@ -104,6 +106,8 @@ def main(argv):
             return level == c["level"] and c.get("message_contains", "") in message
         if msg is None:
             return False
+        if "field" in c and "in" in c:
+            return field_of(msg, c["field"]) in c["in"]
         if "field" in c:
             return field_of(msg, c["field"]) == c["equals"]
         if "moved_more_than" in c:

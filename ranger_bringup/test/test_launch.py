@@ -95,6 +95,10 @@ def test_minimal_on_can0_by_default():
     assert p["/ranger_base_node/base_frame"] == "base_footprint"  # the URDF's root
     assert p["/ranger_base_node/frame_prefix"] == ""
     assert p["/ranger_base_node/publish_odom_tf"] is True
+    # The RANGER, its protocol settings identified from the chassis, no commissioning file.
+    assert p["/ranger_base_node/model"] == "ranger"
+    assert p["/ranger_base_node/protocol"] == "auto"
+    assert "/ranger_base_node/commissioning_file" not in p
     assert p["/diagnostic_aggregator/analyzers/ranger/path"] == "RANGER"
     assert p["/diagnostic_aggregator/analyzers/ranger/expected"] == [
         f"ranger_base_node: {s}" for s in STATUSES]
@@ -106,6 +110,51 @@ def test_minimal_arguments_reach_the_node():
     assert p["/ranger_base_node/publish_odom_tf"] is False
     assert params("ranger_minimal.launch", "sim:=true", "port_name:=can1")[
         "/ranger_base_node/port_name"] == "sim"
+
+
+def test_model_protocol_and_commissioning_file_reach_the_node():
+    p = params("ranger_minimal.launch", "model:=ranger_mini_v3", "protocol:=agx_v2",
+               "commissioning_file:=/etc/ranger/commissioned.yaml")
+    assert p["/ranger_base_node/model"] == "ranger_mini_v3"
+    assert p["/ranger_base_node/protocol"] == "agx_v2"
+    assert p["/ranger_base_node/commissioning_file"] == "/etc/ranger/commissioned.yaml"
+
+
+def test_sim_variant_is_the_in_process_virtual_chassis():
+    assert params("ranger_minimal.launch", "sim:=true", "sim_variant:=spin_cw")[
+        "/ranger_base_node/port_name"] == "sim:spin_cw"
+    # A variant is always the virtual chassis, whatever port_name says.
+    assert params("ranger_minimal.launch", "sim_variant:=agx_v2", "port_name:=can1")[
+        "/ranger_base_node/port_name"] == "sim:agx_v2"
+
+
+def model_file(model):
+    """A model's flat YAML (libranger_can/models/MODEL.yaml)."""
+    with open(os.path.join(REPO, "libranger_can", "models", model + ".yaml"),
+              encoding="utf-8") as f:
+        return yaml.safe_load(f)
+
+
+def front_left_steering_origin(robot_description):
+    robot = ET.fromstring(robot_description)
+    joint = robot.find("joint[@name='front_left_steering_joint']/origin")
+    x, y, _ = (float(v) for v in joint.get("xyz").split())
+    return x, y
+
+
+def test_another_model_gives_node_and_urdf_its_geometry():
+    """No geometry.yaml for another model: the node takes the model's geometry (model_preset),
+    the URDF is the model's (generate_urdf.py --model)."""
+    mini = model_file("ranger_mini_v2")
+    p = params("ranger_minimal.launch", "model:=ranger_mini_v2")
+    for key in ("wheelbase", "track", "wheel_radius"):
+        assert f"/ranger_base_node/{key}" not in p
+    assert front_left_steering_origin(p["/robot_description"]) == pytest.approx(
+        (mini["wheelbase"] / 2, mini["track"] / 2))
+    # An explicit geometry file still wins, for the node and the URDF alike.
+    p = params("ranger_minimal.launch", "model:=ranger_mini_v2", f"geometry_file:={GEOMETRY}")
+    assert p["/ranger_base_node/wheelbase"] == model_file("ranger")["wheelbase"]
+    assert front_left_steering_origin(p["/robot_description"])[0] == pytest.approx(0.445)
 
 
 def test_node_and_urdf_share_the_geometry_file():
@@ -151,12 +200,27 @@ def test_sim_in_process_and_on_vcan():
     assert "/virtual_chassis" in nodes("ranger_sim.launch", "interface:=vcan0")
     assert params("ranger_sim.launch", "interface:=vcan0")["/ranger_base_node/port_name"] == "vcan0"
     assert "/rviz" in nodes("ranger_sim.launch", "rviz:=true")
+    # model, variant and protocol: the driver's, and the virtual chassis's on vcan0 too.
+    p = params("ranger_sim.launch", "model:=ranger_mini_v1", "sim_variant:=mini_v1",
+               "protocol:=manual")
+    assert p["/ranger_base_node/port_name"] == "sim:mini_v1"
+    assert p["/ranger_base_node/model"] == "ranger_mini_v1"
+    assert p["/ranger_base_node/protocol"] == "manual"
+    p = params("ranger_sim.launch", "interface:=vcan0", "sim_variant:=spin_cw")
+    assert p["/ranger_base_node/port_name"] == "vcan0"
+    out = roslaunch(["--args", "/virtual_chassis"], "ranger_sim.launch", "interface:=vcan0",
+                    "model:=ranger_mini_v2", "sim_variant:=spin_cw")
+    assert "vcan0 --model ranger_mini_v2 --chassis-variant spin_cw" in out
 
 
 def test_display_opens_rviz_with_the_config_in_the_namespace():
     assert nodes("display.launch") == ["/rviz"]
     assert nodes("display.launch", "namespace:=r1") == ["/r1/rviz"]
     assert nodes("display.launch", "description:=true") == ["/robot_state_publisher", "/rviz"]
+    mini = model_file("ranger_mini_v1")
+    p = params("display.launch", "description:=true", "model:=ranger_mini_v1")
+    assert front_left_steering_origin(p["/robot_description"]) == pytest.approx(
+        (mini["wheelbase"] / 2, mini["track"] / 2))
     # The command line rviz gets: the config and the fixed frame.
     out = roslaunch(["--args", "/rviz"], "display.launch")
     assert os.path.join("rviz", "ranger.rviz") in out and "-f odom" in out
@@ -174,7 +238,7 @@ def test_teleop_parameters_and_namespace():
 
 # ---- diagnostics: one aggregator per ROS master -------------------------------------------------
 
-STATUSES = ["CAN link", "Control mode", "Chassis errors", "Battery", "Frame rates"]
+STATUSES = ["CAN link", "Control mode", "Protocol", "Chassis errors", "Battery", "Frame rates"]
 
 
 def analyzer_of(p, robot):
@@ -204,12 +268,17 @@ def test_the_aggregator_stays_at_the_root_when_asked_for_a_namespaced_robot():
 
 
 def test_two_simulated_robots_share_one_aggregator():
+    p = params("ranger_sim_two.launch", "model:=ranger_mini_v3", "protocol:=agx_v2")
+    assert p["/robot2/ranger_base_node/model"] == "ranger_mini_v3"
+    assert p["/robot1/ranger_base_node/protocol"] == "agx_v2"
     assert nodes("ranger_sim_two.launch") == [
         "/diagnostic_aggregator", "/robot1/ranger_base_node", "/robot1/robot_state_publisher",
         "/robot2/ranger_base_node", "/robot2/robot_state_publisher"]
     p = params("ranger_sim_two.launch")
     for robot in ("robot1", "robot2"):
         assert p[f"/{robot}/ranger_base_node/port_name"] == "sim"
+        assert p[f"/{robot}/ranger_base_node/model"] == "ranger"
+        assert p[f"/{robot}/ranger_base_node/protocol"] == "auto"
         assert p[f"/{robot}/ranger_base_node/odom_frame"] == f"{robot}/odom"
         assert p[f"/{robot}/ranger_base_node/base_frame"] == f"{robot}/base_footprint"
         assert p[f"/{robot}/ranger_base_node/frame_prefix"] == f"{robot}/"

@@ -46,8 +46,11 @@ def sim():
 
         s.tf_subs = [rospy.Subscriber(topic, TFMessage, on_tf, queue_size=100)
                      for topic in ("/tf", "/tf_static")]
+        # CAN command mode, and the protocol settings identified (protocol auto, the default:
+        # about 3.6 s after the chassis is first heard nothing is driven).
         launch.wait_until(
-            lambda: s.state.get() is not None and s.state.get().control_mode == 1, timeout=60)
+            lambda: s.state.get() is not None and s.state.get().control_mode == 1
+            and s.state.get().identification == "decided", timeout=60)
         yield s
     finally:
         launch.stop()
@@ -83,8 +86,8 @@ def test_joint_states_name_every_urdf_joint_that_moves(sim):
 
 
 def test_diagnostics_are_aggregated_under_ranger(sim):
-    wanted = {"/RANGER", "/RANGER/CAN link", "/RANGER/Control mode", "/RANGER/Chassis errors",
-              "/RANGER/Battery", "/RANGER/Frame rates"}
+    wanted = {"/RANGER", "/RANGER/CAN link", "/RANGER/Control mode", "/RANGER/Protocol",
+              "/RANGER/Chassis errors", "/RANGER/Battery", "/RANGER/Frame rates"}
 
     def names():
         msg = sim.diagnostics.get()
@@ -101,6 +104,15 @@ def test_diagnostics_are_aggregated_under_ranger(sim):
     assert wait_for(all_reported, timeout=30), {
         k: v.message for k, v in (names() or {}).items() if k in wanted}
     assert names()["/RANGER/CAN link"].level == 0, names()["/RANGER/CAN link"].message
+    # The identification's decision, with its evidence (protocol auto on the plain sim); the
+    # aggregator publishes once a second, so its view may still show the identification going on.
+    assert wait_for(lambda: names()["/RANGER/Protocol"].message == "identified: manual",
+                    timeout=30), names()["/RANGER/Protocol"].message
+    protocol = names()["/RANGER/Protocol"]
+    assert protocol.level == 0, protocol.message
+    values = {kv.key: kv.value for kv in protocol.values}
+    assert values["Identification"] == "decided"
+    assert "Evidence 1" in values
 
 
 def moving(truth):

@@ -17,7 +17,7 @@ sys.path.insert(0, os.path.dirname(__file__))
 from sim_support import Launch, Latest, RosMaster, wait_for  # noqa: E402
 
 ROBOTS = ("robot1", "robot2")
-STATUSES = ("CAN link", "Control mode", "Chassis errors", "Battery", "Frame rates")
+STATUSES = ("CAN link", "Control mode", "Protocol", "Chassis errors", "Battery", "Frame rates")
 
 
 @pytest.fixture(scope="module")
@@ -44,8 +44,10 @@ def fleet():
         f.range = {r: Latest(f"/{r}/ultrasonic/range_1", Range) for r in ROBOTS}
         f.aggregated = Latest("/diagnostics_agg", DiagnosticArray)
         f.raw = RawDiagnostics()
+        # Both in CAN command mode with their protocol settings identified (protocol auto).
         launch.wait_until(lambda: all(
-            f.state[r].get() is not None and f.state[r].get().control_mode == 1 for r in ROBOTS),
+            f.state[r].get() is not None and f.state[r].get().control_mode == 1
+            and f.state[r].get().identification == "decided" for r in ROBOTS),
             timeout=90)
         yield f
     finally:
