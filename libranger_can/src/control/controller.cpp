@@ -191,6 +191,8 @@ void ChassisController::on_message(const Message& message, Timestamp stamp, Time
       state_.ultrasonic_failed = false;
       ultrasonic_attempts_ = 0;
     }
+  } else {
+    return;  // wheel, motor, ultrasonic and other frames change no cause and no fault
   }
   update_causes();
   update_faults();

@@ -260,10 +260,13 @@ void PlausibilityMonitor::check_steering(Timestamp now, const ControllerState& c
     double expected = front;  // oblique: the direction; Ackermann: the commanded reference
     if (std::fabs(expected) > 1e-6) s221 = reported / expected;
   }
-  const std::string seen = "commanded " + deg((wanted[kRightFront] + wanted[kLeftFront]) / 2) +
-                           " at the front wheels, 0x271 shows " +
-                           deg((measured[kRightFront] + measured[kLeftFront]) / 2) +
-                           (s221 ? ", 0x221 scale " + num("%.2f", *s221) : std::string());
+  // Built only for a finding: this check runs at every driver step.
+  auto seen = [&] {
+    return "commanded " + deg((wanted[kRightFront] + wanted[kLeftFront]) / 2) +
+           " at the front wheels, 0x271 shows " +
+           deg((measured[kRightFront] + measured[kLeftFront]) / 2) +
+           (s221 ? ", 0x221 scale " + num("%.2f", *s221) : std::string());
+  };
   auto close = [](double a, double b) {
     return std::fabs(a - b) <= 0.3 * std::max(1.0, std::fabs(b));
   };
@@ -274,7 +277,7 @@ void PlausibilityMonitor::check_steering(Timestamp now, const ControllerState& c
     x.check = "steering";
     x.setting = setting;
     x.try_value = other_value(profile_, setting);
-    x.detail = what + ": " + seen;
+    x.detail = what + ": " + seen();
     return x;
   };
   const bool sign_off = s271 < -0.3;
@@ -360,18 +363,18 @@ void PlausibilityMonitor::check_yaw(Timestamp now, const ControllerState& c,
   const MotionMode mode = *c.motion_mode;
   PlausibilityFinding x;
   x.check = "yaw";
-  x.detail =
-      "commanded " + num("%.2f", wz_cmd) + " rad/s, the wheels show " + num("%.2f", wz) + " rad/s";
   if (wz * wz_cmd < 0 && std::fabs(wz) >= 0.3 * std::fabs(wz_cmd)) {
     x.setting = mode == MotionMode::kSpin ? "spin_sign" : "steering_sign_111";
-    x.detail = "turns the other way: " + x.detail;
+    x.detail = "turns the other way: ";
   } else if (mode == MotionMode::kSpin && std::fabs(wz) < 0.1 * std::fabs(wz_cmd)) {
     x.setting = "spin_field";
-    x.detail = "nothing turns: " + x.detail;
+    x.detail = "nothing turns: ";
   } else {
     yaw_.clear();
     return;
   }
+  x.detail +=
+      "commanded " + num("%.2f", wz_cmd) + " rad/s, the wheels show " + num("%.2f", wz) + " rad/s";
   x.try_value = other_value(profile_, x.setting);
   hold(yaw_, x, now, {}, {});
 }

@@ -64,13 +64,19 @@ const std::vector<protocol::Fault>& critical_faults() {
 }
 
 std::uint32_t critical_error_mask(ErrorWordLayout layout) {
-  std::uint32_t mask = 0;
-  for (const protocol::Fault f : critical_faults()) {
-    mask |= protocol::fault_bit(f, layout);
-    for (int motor = 1; motor <= protocol::kMotorCount; ++motor)
-      mask |= protocol::fault_bit(f, layout, motor);
-  }
-  return mask;
+  // Built once per layout: the controller asks for every 0x211 (50 times a second).
+  auto build = [](ErrorWordLayout l) {
+    std::uint32_t mask = 0;
+    for (const protocol::Fault f : critical_faults()) {
+      mask |= protocol::fault_bit(f, l);
+      for (int motor = 1; motor <= protocol::kMotorCount; ++motor)
+        mask |= protocol::fault_bit(f, l, motor);
+    }
+    return mask;
+  };
+  static const std::uint32_t manual = build(ErrorWordLayout::kManual32);
+  static const std::uint32_t agx = build(ErrorWordLayout::kAgxV2_16);
+  return layout == ErrorWordLayout::kAgxV2_16 ? agx : manual;
 }
 
 }  // namespace ranger::interpretation
