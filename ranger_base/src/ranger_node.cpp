@@ -601,6 +601,10 @@ void RangerNode::log_state_changes(const ranger::DriverSnapshot& s) {
 void RangerNode::log_protocol_changes(const ranger::DriverSnapshot& s) {
   if (s.identification) {
     const ranger::IdentificationStatus& id = *s.identification;
+    if (!id.done()) {  // going on (again, after the bus was reopened): its end is logged anew
+      identification_logged_ = false;
+      logged_decisions_ = 0;
+    }
     if (id.decided_ok() && !identification_logged_) {
       identification_logged_ = true;
       logged_decisions_ = id.decided.size();
@@ -638,7 +642,9 @@ void RangerNode::log_protocol_changes(const ranger::DriverSnapshot& s) {
   for (const ranger::PlausibilityFinding& w : s.plausibility.warnings) {
     const std::string key = w.check + "|" + w.setting + "|" + w.try_value;
     if (!warned_findings_.insert(key).second) continue;
-    ROS_WARN("plausibility: %s (the robot stops if it persists)", w.text().c_str());
+    ROS_WARN("plausibility: %s (check that setting; a persisting mismatch of a sign or a unit "
+             "stops the robot)",
+             w.text().c_str());
   }
   if (const auto& stop = s.plausibility.stop) {
     const std::string key =
