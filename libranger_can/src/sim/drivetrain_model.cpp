@@ -13,7 +13,8 @@ namespace {
 constexpr double kGravity = 9.81;
 // A 48 V LiFePO4 pack (manual 1.1: 铁锂电池): 15 cells of 3.2 V nominal.
 constexpr double kCellsInSeries = 15.0;
-static_assert(std::fabs(kCellsInSeries * 3.2 - vehicle_spec::kBatteryNominalVoltage) < 1e-9);
+constexpr double kNominalError = kCellsInSeries * 3.2 - vehicle_spec::kBatteryNominalVoltage;
+static_assert(kNominalError < 1e-9 && kNominalError > -1e-9);
 // Open-circuit voltage of one LiFePO4 cell by SOC (%), at rest: steep below 10 % and above
 // 95 %, a plateau of 3.07-3.33 V between (46.0-50.0 V for the pack at 10-90 %).
 constexpr std::array<std::pair<double, double>, 13> kCellCurve = {{
