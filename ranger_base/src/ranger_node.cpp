@@ -119,6 +119,10 @@ RangerNode::RangerNode(const ros::NodeHandle& nh, const ros::NodeHandle& private
       updater_, [this] { return driver_->snapshot(); },
       ProtocolContext{params_.protocol.source, params_.port_name});
   driver_->set_sent_observer([this](const ranger::SentEvent& e) { on_sent(e); });
+  // Publication rides on the driver's own iterations (at least every 20 ms while the chassis is
+  // commanded): no thread of the node's own wakes up for it, and each snapshot is seen once.
+  driver_->set_step_observer(
+      [this](const std::shared_ptr<const ranger::DriverSnapshot>&) { publish_due(); });
 }
 
 RangerNode::~RangerNode() {
@@ -147,7 +151,6 @@ void RangerNode::start() {
   service_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &service_queue_);
   cmd_spinner_->start();
   service_spinner_->start();
-  publisher_ = std::thread([this] { publish_loop(); });
   ROS_INFO("ranger_base_node on %s (%s), publishing odom at %.1f Hz (%s -> %s%s)",
            params_.port_name.c_str(),
            sim_ ? "the in-process virtual chassis"
@@ -210,12 +213,6 @@ void RangerNode::shutdown() {
                           : (s->read_only ? "a replayed log is read-only"
                                           : "the driver had nothing to stop"));
   }
-  {
-    std::lock_guard<std::mutex> lock(publisher_mutex_);
-    publisher_stop_ = true;
-  }
-  publisher_wake_.notify_all();
-  if (publisher_.joinable()) publisher_.join();
   // Disabled queues wake their spinner threads at once instead of after their poll timeout.
   cmd_queue_.disable();
   service_queue_.disable();
@@ -396,41 +393,28 @@ bool RangerNode::on_set_motion_mode(ranger_msgs::SetMotionMode::Request& req,
 // ---- publishing
 // ----------------------------------------------------------------------------------
 
-void RangerNode::publish_loop() {
-  ::pthread_setname_np(::pthread_self(), "ranger_publish");
+void RangerNode::publish_due() {
   using Clock = std::chrono::steady_clock;
-  const auto period = [](double rate) {
-    return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / rate));
+  const auto now = Clock::now();
+  // A fixed-rate schedule on the driver's iterations (its 20 ms keep-alive and every command):
+  // a publication goes out at the first iteration from a few ms before its due time, and the
+  // next is due one period after the previous due time, so the average rate is the configured
+  // one; after a stall the schedule restarts from now instead of publishing a burst.
+  constexpr auto kEarly = std::chrono::milliseconds(5);
+  auto due = [now, kEarly](Clock::time_point& next, double rate) {
+    const auto period =
+        std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / rate));
+    if (now < next - kEarly) return false;
+    next += period;
+    if (next < now) next = now + period;
+    return true;
   };
-  struct Task {
-    Clock::duration period;
-    void (RangerNode::*publish)();
-    Clock::time_point due;
-  };
-  const auto start = Clock::now();
-  Task tasks[] = {{period(params_.publish_rate), &RangerNode::publish_motion, start},
-                  {period(params_.state_publish_rate), &RangerNode::publish_states, start},
-                  {period(4.0), &RangerNode::publish_diagnostics, start}};
-  std::unique_lock<std::mutex> lock(publisher_mutex_);
-  while (!publisher_stop_) {
-    const auto now = Clock::now();
-    Clock::time_point next = Clock::time_point::max();
-    for (auto& task : tasks) {
-      if (now >= task.due) {
-        lock.unlock();
-        try {
-          (this->*task.publish)();
-        } catch (const std::exception& e) {  // nothing may escape the thread
-          ROS_ERROR_THROTTLE(5.0, "publishing failed: %s", e.what());
-        }
-        lock.lock();
-        // Fixed rate; after a stall, resume from now instead of publishing a burst.
-        task.due += task.period;
-        if (task.due < now) task.due = now + task.period;
-      }
-      next = std::min(next, task.due);
-    }
-    publisher_wake_.wait_until(lock, next, [this] { return publisher_stop_; });
+  try {
+    if (due(next_motion_publication_, params_.publish_rate)) publish_motion();
+    if (due(next_state_publication_, params_.state_publish_rate)) publish_states();
+    if (due(next_diagnostics_publication_, 1.0)) publish_diagnostics();
+  } catch (const std::exception& e) {  // nothing may escape into the driver thread
+    ROS_ERROR_THROTTLE(5.0, "publishing failed: %s", e.what());
   }
 }
 
@@ -642,9 +626,10 @@ void RangerNode::log_protocol_changes(const ranger::DriverSnapshot& s) {
   for (const ranger::PlausibilityFinding& w : s.plausibility.warnings) {
     const std::string key = w.check + "|" + w.setting + "|" + w.try_value;
     if (!warned_findings_.insert(key).second) continue;
-    ROS_WARN("plausibility: %s (check that setting; a persisting mismatch of a sign or a unit "
-             "stops the robot)",
-             w.text().c_str());
+    ROS_WARN(
+        "plausibility: %s (check that setting; a persisting mismatch of a sign or a unit "
+        "stops the robot)",
+        w.text().c_str());
   }
   if (const auto& stop = s.plausibility.stop) {
     const std::string key =

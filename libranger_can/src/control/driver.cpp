@@ -478,6 +478,12 @@ void Driver::step(Timestamp now) {
   }
   publish(now);
   deliver_events();
+  if (step_observer_) {
+    try {
+      step_observer_(snapshot());
+    } catch (...) {  // the observer's own business; the driver goes on
+    }
+  }
 }
 
 void Driver::use_profile(const ProtocolProfile& profile, bool reset_odometry) {

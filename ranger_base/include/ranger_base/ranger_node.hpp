@@ -6,11 +6,12 @@
 // All topic and service names are relative (the node works under a namespace); only /tf and
 // /diagnostics are global, by their own conventions.
 //
-// Threads besides the driver's: one publishing thread that sleeps until the next publication is
-// due (odometry/TF/joints at publish_rate, states at state_publish_rate, diagnostics), and two
-// callback queues each spun by one thread: cmd_vel (never queued behind anything) and the
-// services (which wait for the chassis's answer). cmd_vel_out is published from the driver's
-// sent-frame observer. None of them touches the bus.
+// Threads: the driver's, which also publishes (its step observer calls publish_due() after each
+// iteration: odometry/TF/joints at publish_rate, states at state_publish_rate, diagnostics at
+// 1 Hz; no thread of the node's own wakes up for publication), and two callback queues each
+// spun by one thread: cmd_vel (never queued behind anything) and the services (which wait for
+// the chassis's answer). cmd_vel_out is published from the driver's sent-frame observer. No ROS
+// callback touches the bus.
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
@@ -56,7 +57,7 @@ class RangerNode {
   RangerNode(const RangerNode&) = delete;
   RangerNode& operator=(const RangerNode&) = delete;
 
-  // Starts the driver thread, the publishing thread and the spinners.
+  // Starts the driver thread (which also publishes) and the spinners.
   void start();
   // Stops the chassis (the driver's zero motion command, logged and published on cmd_vel_out),
   // the driver thread, then the ROS side. Idempotent; returns promptly (services in progress stop
@@ -80,7 +81,7 @@ class RangerNode {
   // The outcome of request `id` once answered or failed, after `timeout`, or at shutdown.
   ranger::RequestOutcome wait_for(std::uint64_t id, std::chrono::nanoseconds timeout);
 
-  void publish_loop();
+  void publish_due();     // on the driver thread, after each of its iterations
   void publish_motion();  // odom, TF, joint_states, sim/ground_truth
   void publish_states();  // ranger_msgs states, battery, ultrasonic
   void publish_diagnostics();
@@ -117,18 +118,15 @@ class RangerNode {
 
   std::unique_ptr<ros::AsyncSpinner> cmd_spinner_, service_spinner_;
 
-  std::thread publisher_;
-  std::mutex publisher_mutex_;
-  std::condition_variable publisher_wake_;
-  bool publisher_stop_ = false;  // guarded by publisher_mutex_
-
   std::atomic<bool> stopping_{false};   // services stop waiting
   std::atomic<bool> stop_sent_{false};  // the driver's shutdown stop was observed
 
-  // Publishing thread only.
+  // The driver thread only (publish_due).
+  std::chrono::steady_clock::time_point next_motion_publication_, next_state_publication_,
+      next_diagnostics_publication_;
   ranger::Timestamp last_odom_stamp_{0}, last_joints_stamp_{0};
   std::array<ranger::Timestamp, 2> last_ultrasonic_stamp_{};
-  // For logging transitions once instead of every cycle (publishing thread only).
+  // For logging transitions once instead of every cycle (the driver thread: publish_states).
   std::optional<ranger::MotionRefusal> last_refusal_;
   std::optional<ranger::LinkState> last_link_;
   bool last_bus_open_ = false;

@@ -158,6 +158,12 @@ class Driver {
   void set_sent_observer(SentObserver observer) { sent_observer_ = std::move(observer); }
   // Called with every received frame (any ID), before the driver handles it. Set before start().
   void set_frame_tap(FrameTap tap) { frame_tap_ = std::move(tap); }
+  // Called on the driver thread (or in step()) with the snapshot just published, after every
+  // iteration, outside the driver's locks: a program that publishes the state (the ROS node)
+  // does it here instead of waking a thread of its own, and sees every snapshot once. Must not
+  // block and must not call stop(); an exception it throws is swallowed. Set before start().
+  using StepObserver = std::function<void(const std::shared_ptr<const DriverSnapshot>&)>;
+  void set_step_observer(StepObserver observer) { step_observer_ = std::move(observer); }
 
   // Starts the thread. Without it the owner calls step() instead.
   void start();
@@ -214,6 +220,7 @@ class Driver {
   const Clock& clock_;
   SentObserver sent_observer_;
   FrameTap frame_tap_;
+  StepObserver step_observer_;
 
   // ---- owned by the driver thread (or the lock-step caller) ----
   std::unique_ptr<Bus> bus_;
