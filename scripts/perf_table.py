@@ -103,6 +103,13 @@ def node():
     cpu = load["driver_cpu_percent"]
     row("Driver CPU (node minus chassis thread)", "chassis thread not found" if cpu is None else
         f"{cpu} % of one core", "node", "≤ 1 %", cpu is not None and cpu <= 1.0)
+    floor = doc["roscpp_floor"]
+    row("roscpp floor: the same topics and rates, no driver (`roscpp_floor`)",
+        f"{floor['cpu_percent']} % (" + ", ".join(
+            f"{t['name']} {t['tid']}: {t['cpu_percent']}" for t in floor["threads"]
+            if t["cpu_percent"]) + ")", "node")
+    if "driver_over_floor_percent" in load:
+        row("Driver CPU above the roscpp floor", f"{load['driver_over_floor_percent']} %", "node")
     row("Virtual chassis thread (name tid)", f"{load['chassis_cpu_percent']} % "
         f"({load['chassis_thread']})", "node")
     row("Node process (driver + chassis)", f"{load['node_cpu_percent']} % (feedback "

@@ -9,6 +9,9 @@ process, as in real use, so the node serialises and sends those messages at 50 H
      each thread from /proc/<pid>/task, RSS from /proc/<pid>/status. The process also hosts the
      virtual chassis: its thread (named ranger_sim; before the driver rewrite unnamed, created
      just before the CAN thread) is not the driver's cost: driver CPU = node total - that thread.
+     The same load on roscpp_floor (a node that only publishes odom, /tf and joint_states at
+     50 Hz and subscribes to cmd_vel, through the node's own conversions) gives the floor:
+     what roscpp's transport alone costs for that traffic, which no roscpp driver goes below.
   2. Latency cmd_vel -> 0x111: --samples twists 50-70 ms apart (at random, so every phase
      against the 20 ms keep-alive occurs); the node (publish_cmd:=true) stamps each 0x111 with its
      send time on cmd_vel_out; latency = that stamp - the time the twist was published.
@@ -38,21 +41,25 @@ CLK_TCK = os.sysconf("SC_CLK_TCK")
 CAN_THREADS = ("ranger_driver", "ranger_can_link")  # after / before the driver rewrite
 
 # The subscribers, in a process of their own: rospy.AnyMsg, so they cost little themselves.
-# They print one line once every topic has delivered, and the message counts when interrupted.
+# They print one line once every topic has delivered, and when interrupted each topic's rate
+# (messages/s between its first and its last message).
 SUBSCRIBERS = """
-import json, sys, rospy
+import json, sys, time, rospy
 ns, topics = sys.argv[1], ["odom", "/tf", "joint_states"]
-count = dict.fromkeys(topics, 0)
+seen = {}  # topic -> [count, first, last]
 def on(topic):
     def cb(_):
-        count[topic] += 1
-        if count[topic] == 1 and all(count.values()):
+        now = time.monotonic()
+        s = seen.setdefault(topic, [0, now, now])
+        s[0], s[2] = s[0] + 1, now
+        if s[0] == 1 and len(seen) == len(topics):
             print("ready", flush=True)
     return cb
 rospy.init_node("perf_subscribers", anonymous=True)
 subs = [rospy.Subscriber(t if t[0] == "/" else f"/{ns}/{t}", rospy.AnyMsg, on(t)) for t in topics]
 rospy.spin()
-print(json.dumps(count), flush=True)
+print(json.dumps({t: round((n - 1) / (last - first), 1) if last > first else 0.0
+                  for t, (n, first, last) in seen.items()}), flush=True)
 """
 
 
@@ -105,18 +112,19 @@ def percentile(values, p):
 
 
 class Robot:
-    """ranger_base_node (port_name:=sim) in namespace ns, in CAN command mode, with the
-    subscribers of real use connected; on leaving, both stop and .rates holds what the
-    subscribers received (messages/s per topic)."""
+    """ranger_base_node (port_name:=sim) in namespace ns, in CAN command mode (or, floor=True,
+    roscpp_floor), with the subscribers of real use connected; on leaving, both stop and .rates
+    holds what the subscribers received (messages/s per topic)."""
 
-    def __init__(self, rospy, ns, params):
+    def __init__(self, rospy, ns, params, floor=False):
         import roslib.packages
         from ranger_msgs.msg import SystemState
-        exe = roslib.packages.find_node("ranger_base", "ranger_base_node")
+        name = "roscpp_floor" if floor else "ranger_base_node"
+        exe = roslib.packages.find_node("ranger_base", name)
         if not exe:
-            sys.exit("ranger_base_node not found: build and source the workspace first")
-        self.node = subprocess.Popen([exe[0], "__name:=ranger_base_node", f"__ns:=/{ns}",
-                                      "_port_name:=sim", *params],
+            sys.exit(f"{name} not found: build and source the workspace first")
+        args = [] if floor else ["_port_name:=sim", *params]
+        self.node = subprocess.Popen([exe[0], f"__name:={name}", f"__ns:=/{ns}", *args],
                                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         self.subscribers = subprocess.Popen([sys.executable, "-c", SUBSCRIBERS, ns],
                                             stdout=subprocess.PIPE, text=True)
@@ -125,15 +133,14 @@ class Robot:
         sub = rospy.Subscriber(f"/{ns}/system_state", SystemState, lambda m: state.update(m=m))
         # CAN command mode with the protocol settings decided (protocol auto identifies the
         # chassis first; nothing is sent while it listens).
-        ok = wait_for(lambda: "m" in state and state["m"].link_up
-                      and state["m"].control_mode == SystemState.CONTROL_MODE_CAN
-                      and state["m"].identification in ("", "decided"))
+        ok = floor or wait_for(lambda: "m" in state and state["m"].link_up
+                               and state["m"].control_mode == SystemState.CONTROL_MODE_CAN
+                               and state["m"].identification in ("", "decided"))
         sub.unregister()
         ready = select.select([self.subscribers.stdout], [], [], 30)[0]
         if not ok or not ready or self.subscribers.stdout.readline().strip() != "ready":
             self.__exit__()
             sys.exit("the node did not reach CAN command mode or publish odom, tf, joint_states")
-        self.t0 = time.monotonic()
 
     def __enter__(self):
         return self
@@ -141,7 +148,6 @@ class Robot:
     def __exit__(self, *_):
         for p in (self.subscribers, self.node):
             p.send_signal(signal.SIGINT)
-        seconds = time.monotonic() - getattr(self, "t0", time.monotonic())
         try:
             out = self.subscribers.communicate(timeout=20)[0].strip().splitlines()
             self.node.wait(timeout=20)
@@ -149,14 +155,15 @@ class Robot:
             self.subscribers.kill()
             self.node.kill()
             out = []
-        if out and out[-1].startswith("{") and seconds > 0:
-            self.rates = {t: round(n / seconds, 1) for t, n in json.loads(out[-1]).items()}
+        if out and out[-1].startswith("{"):
+            self.rates = json.loads(out[-1])
 
 
-def measure_load(rospy, duration, params):
+def measure_load(rospy, duration, params, floor=False):
     from diagnostic_msgs.msg import DiagnosticArray
     from geometry_msgs.msg import Twist
-    pub = rospy.Publisher("/perf_load/cmd_vel", Twist, queue_size=1)
+    ns = "perf_floor" if floor else "perf_load"
+    pub = rospy.Publisher(f"/{ns}/cmd_vel", Twist, queue_size=1)
     cmd, stop, rates, rss = Twist(), threading.Event(), [], []
     cmd.linear.x, cmd.angular.z = 0.4, 0.2  # an operator at 20 Hz, driving a slow circle
 
@@ -168,7 +175,7 @@ def measure_load(rospy, duration, params):
     def on_diagnostics(msg):
         rates.extend(float(kv.value) for s in msg.status if s.name.endswith("Frame rates")
                      for kv in s.values if kv.key == "Total (frames/s)")
-    with Robot(rospy, "perf_load", params) as robot:
+    with Robot(rospy, ns, params, floor) as robot:
         pid = robot.node.pid
         diag = rospy.Subscriber("/diagnostics", DiagnosticArray, on_diagnostics)
         driver = threading.Thread(target=teleop, daemon=True)
@@ -189,6 +196,10 @@ def measure_load(rospy, duration, params):
         return round(100.0 * seconds / wall, 2)
     threads = [{"tid": tid, "name": name, "cpu_percent": share(t1 - threads0.get(tid, ("", 0))[1])}
                for tid, (name, t1) in threads1.items()]
+    if floor:
+        return {"duration_s": round(wall, 1), "cpu_percent": share(cpu1 - cpu0),
+                "threads": sorted(threads, key=lambda t: -t["cpu_percent"]),
+                "subscribers_messages_per_s": robot.rates}
     chassis = chassis_thread(pid, threads1)
     chassis_cpu = next((t["cpu_percent"] for t in threads if t["tid"] == chassis), None)
     total = share(cpu1 - cpu0)
@@ -266,7 +277,12 @@ def main():
                    "date": time.strftime("%Y-%m-%d %H:%M:%S %Z"),
                    "command": " ".join([os.path.relpath(sys.argv[0])] + sys.argv[1:]),
                    "load": measure_load(rospy, args.duration, args.node_arg),
+                   "roscpp_floor": measure_load(rospy, args.duration, [], floor=True),
                    "latency_cmd_vel_to_0x111": measure_latency(rospy, args.samples, args.node_arg)}
+        load, floor = figures["load"], figures["roscpp_floor"]
+        if load["driver_cpu_percent"] is not None:
+            load["driver_over_floor_percent"] = round(load["driver_cpu_percent"]
+                                                      - floor["cpu_percent"], 2)
     finally:
         master.send_signal(signal.SIGINT)
         try:

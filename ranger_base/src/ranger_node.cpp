@@ -71,6 +71,12 @@ std::string hex_word(std::uint32_t word) {
   return buf;
 }
 
+// Builds and publishes a message only for a topic someone listens to (nothing is lost: the
+// states are published whole at every period, there is no history to keep up).
+template <class Make>
+void publish_if_heard(const ros::Publisher& pub, Make make) {
+  if (pub.getNumSubscribers() > 0) pub.publish(make());
+}
 }  // namespace
 
 ranger::Result<std::unique_ptr<RangerNode>> RangerNode::create(const ros::NodeHandle& nh,
@@ -444,11 +450,12 @@ void RangerNode::publish_motion() {
 void RangerNode::publish_states() {
   const auto s = driver_->snapshot();
   const ros::Time stamp = ros::Time::now();
-  system_state_pub_.publish(to_system_state(*s, stamp));
-  actuator_state_pub_.publish(to_actuator_state(s->feedback, stamp));
-  bms_state_pub_.publish(to_bms_state(s->feedback, s->now, stamp));
-  battery_state_pub_.publish(to_battery_state(s->feedback, s->now, stamp));
-  ultrasonic_state_pub_.publish(to_ultrasonic_state(*s, stamp));
+  publish_if_heard(system_state_pub_, [&] { return to_system_state(*s, stamp); });
+  publish_if_heard(actuator_state_pub_, [&] { return to_actuator_state(s->feedback, stamp); });
+  publish_if_heard(bms_state_pub_, [&] { return to_bms_state(s->feedback, s->now, stamp); });
+  publish_if_heard(battery_state_pub_,
+                   [&] { return to_battery_state(s->feedback, s->now, stamp); });
+  publish_if_heard(ultrasonic_state_pub_, [&] { return to_ultrasonic_state(*s, stamp); });
   if (s->motion_known) {
     for (std::size_t g = 0; g < s->feedback.ultrasonic.size(); ++g) {
       const auto& group = s->feedback.ultrasonic[g];
@@ -457,9 +464,10 @@ void RangerNode::publish_states() {
       for (int k = 0; k < 4; ++k) {
         const int sensor = group->value.first_sensor + k;
         if (sensor < 1 || sensor > static_cast<int>(range_pubs_.size())) continue;
-        range_pubs_[static_cast<std::size_t>(sensor - 1)].publish(
-            to_range(sensor, group->value.raw[static_cast<std::size_t>(k)], params_,
-                     to_ros_time(group->stamp)));
+        publish_if_heard(range_pubs_[static_cast<std::size_t>(sensor - 1)], [&] {
+          return to_range(sensor, group->value.raw[static_cast<std::size_t>(k)], params_,
+                          to_ros_time(group->stamp));
+        });
       }
     }
   }
