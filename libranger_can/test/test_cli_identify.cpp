@@ -38,6 +38,21 @@ TEST(CliIdentify, IdentifiesTheVirtualChassisWithItsEvidence) {
   EXPECT_NE(r.out.find("spin position at standstill"), std::string::npos);
 }
 
+TEST(CliIdentify, AMiniIsJudgedByItsOwnGeometryWithModel) {
+  // The spin position is +-atan(wheelbase/track): 45 deg on a MINI, 57.8 deg on a RANGER.
+  const auto mini = run_cli(cli::run_identify, {"sim:mini_v1", "--model", "ranger_mini_v1"});
+  ASSERT_EQ(mini.rc, 0) << mini.err;
+  EXPECT_NE(mini.out.find("expected +-45.00 deg"), std::string::npos) << mini.out;
+  EXPECT_NE(mini.out.find("steering_unit_271          centideg        decided"), std::string::npos)
+      << mini.out;
+  const auto ranger = run_cli(cli::run_identify, {"sim:mini_v1"});
+  EXPECT_NE(ranger.out.find("spin check inconclusive"), std::string::npos) << ranger.out;
+  const auto bad = run_cli(cli::run_identify, {"sim", "--model", "nope"});
+  EXPECT_EQ(bad.rc, 2);
+  EXPECT_NE(bad.err.find("--model: 'nope' is not one of ranger, ranger_mini_v1"), std::string::npos)
+      << bad.err;
+}
+
 TEST(CliIdentify, AReplayedLogIsIdentifiedFromItsFramesAlone) {
   const auto r =
       run_cli(cli::run_identify, {std::string("replay:") + RANGER_DATA_DIR + "/sample_agx_v2.log"});

@@ -101,6 +101,15 @@ Result<Vehicle> vehicle_from_args(const ParsedArgs& args) {
   return v;
 }
 
+void apply_vehicle(const Vehicle& vehicle, DriverConfig& config) {
+  if (vehicle.model) {
+    config.controller.geometry = vehicle.geometry;
+    config.controller.limits = vehicle.limits;
+    config.odometry.geometry = vehicle.geometry;
+  }
+  config.controller.profile = vehicle.profile;
+}
+
 bool protocol_is_auto(const ParsedArgs& args) {
   return args.get_or("--protocol", "auto") == "auto";
 }

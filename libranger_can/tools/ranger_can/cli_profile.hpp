@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "cli_options.hpp"
+#include "ranger_can/control/driver.hpp"
 #include "ranger_can/control/geometry.hpp"
 #include "ranger_can/control/identification.hpp"
 #include "ranger_can/control/model.hpp"
@@ -52,6 +53,9 @@ struct Vehicle {
   ProtocolProfile profile;
 };
 Result<Vehicle> vehicle_from_args(const ParsedArgs& args);
+// The driver's vehicle: the model's geometry and limits (with --model; the config's own without)
+// and the profile (with auto, the fallback the identification starts from).
+void apply_vehicle(const Vehicle& vehicle, DriverConfig& config);
 
 // vehicle_from_args(...).profile: the preset --protocol names (the model's, or manual, for auto
 // or when absent: the fallback), then every --set in order. The parser has already checked each

@@ -370,6 +370,9 @@ int commission_main(const ParsedArgs& args, Io io) {
     return 2;
   }
   DriverConfig config;
+  const Result<Vehicle> vehicle = vehicle_from_args(args);  // --model: a MINI's geometry
+  if (!vehicle) return usage_error(commission_command(), io, vehicle.error().message);
+  apply_vehicle(*vehicle, config);
   config.protocol = ProtocolChoice::kAuto;
   config.identify_revision = protocol_revision(args);
   config.plausibility.enabled = false;  // the moves judge for themselves
@@ -427,21 +430,33 @@ int commission_main(const ParsedArgs& args, Io io) {
   c.set_row({"tx_dlc", std::to_string(c.profile.tx_dlc), true, "every command", "obeyed",
              "the chassis obeyed commands of DLC " +
                  std::string(c.profile.tx_dlc == 8 ? "8 (padded)" : "of each layout")});
-  c.set_row(
-      {"mode_numbering", *get_setting(c.profile, "mode_numbering"), true, "0x141 ackermann/spin",
-       "0x291 confirmed",
-       "the spin and Ackermann switches were answered as numbered (modes above 2 not tried)"});
+  // What the moves cannot tell: the model's value (--model), else the identified revision's
+  // preset's; --set over either.
+  ProtocolProfile kept = c.profile;
+  std::string source = "the " + c.profile.revision + " preset's value";
+  if (vehicle->model) {
+    if (auto m = model_profile(*vehicle->model, c.profile.revision);
+        m && apply_set_options(*m, args)) {
+      kept = *m;
+      source = "the " + vehicle->model->display_name + "'s value";
+    }
+  }
+  c.set_row({"mode_numbering", *get_setting(kept, "mode_numbering"), true, "0x141 ackermann/spin",
+             "0x291 confirmed",
+             "the spin and Ackermann switches were answered as numbered (modes above 2 not "
+             "tried: " +
+                 source + ")"});
   // Everything else: kept, and why.
   for (const ProfileSetting& p : profile_settings()) {
     bool present = false;
     for (const Row& r : c.rows)
       present = present || r.setting == p.name;
     if (present) continue;
-    std::string why = "not decidable by these moves: the " + c.profile.revision + " preset's value";
+    std::string why = "not decidable by these moves: " + source;
     if (p.name == "vehicle_status_1_is_estop") {
       why = "needs the e-stop pressed (watch 0x211 byte 0 with `ranger_can decode`): kept";
     }
-    c.set_row({std::string(p.name), *get_setting(c.profile, p.name), false, "-", "-", why});
+    c.set_row({std::string(p.name), *get_setting(kept, p.name), false, "-", "-", why});
   }
   // The decided values are the profile from here on.
   for (const Row& r : c.rows)
@@ -467,7 +482,8 @@ int commission_main(const ParsedArgs& args, Io io) {
   if (const auto out = args.get("--output")) {
     const std::string text =
         format_commissioning_file(c.profile, file_rows,
-                                  {"ranger_can commission " + iface + " --wheels-lifted",
+                                  {"ranger_can commission " + iface + " --wheels-lifted" +
+                                       (vehicle->model ? " --model " + vehicle->model->name : ""),
                                    "load it with the node's parameter commissioning_file (or "
                                    "ranger::load_commissioning_file)",
                                    "identified as " + describe(c.profile)});
@@ -500,7 +516,7 @@ const CommandSpec& commission_command() {
       {required_arg("IFACE", "the bus: a SocketCAN interface, sim or sim:VARIANT", "can0")},
       {flag("--wheels-lifted", "the chassis is on blocks, every wheel off the ground: move"),
        option("--output", "FILE", "write the commissioning file there", non_empty()),
-       protocol_option(), set_option()},
+       model_option(), protocol_option(), set_option()},
       "Exit status: 0 every move answered (the file written); 1 a move got no response or\n"
       "contradicted the identification (it says which; no file), the chassis was not\n"
       "identified, the bus could not be opened, or interrupted; 2 without --wheels-lifted or on a\n"

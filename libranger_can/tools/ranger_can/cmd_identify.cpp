@@ -57,6 +57,9 @@ void print_identification(const IdentificationStatus& s, const ProtocolProfile& 
 int identify_main(const ParsedArgs& args, Io io) {
   const std::string iface = *args.get("IFACE");
   DriverConfig config;
+  const Result<Vehicle> vehicle = vehicle_from_args(args);  // --model: a MINI's geometry
+  if (!vehicle) return usage_error(identify_command(), io, vehicle.error().message);
+  apply_vehicle(*vehicle, config);
   config.protocol = ProtocolChoice::kAuto;
   config.identify_revision = protocol_revision(args);
   config.identification.timeout = from_seconds(args.number("--timeout", 10.0));
@@ -111,7 +114,7 @@ const CommandSpec& identify_command() {
       "time, deterministic), replay:FILE (a log: the frames alone decide).",
       {required_arg("IFACE", "the bus: a SocketCAN interface, sim, sim:VARIANT or replay:FILE",
                     "can0")},
-      {protocol_option(), set_option(),
+      {model_option(), protocol_option(), set_option(),
        option("--timeout", "S", "give up after S seconds (default 10): the node's identify_timeout",
               number_in(2.0, 600.0)),
        flag("--no-spin-check", "skip the spin-mode check of the 0x271 unit and sign")},

@@ -38,14 +38,9 @@ int scenario_main(const ParsedArgs& args, Io io) {
   // --model, --protocol and --set: the driver's vehicle, and the chassis's before its variant.
   const Result<Vehicle> vehicle = vehicle_from_args(args);
   if (!vehicle) return usage_error(scenario_command(), io, vehicle.error().message);
-  if (vehicle->model) {
-    options.chassis = sim::chassis_for_model(*vehicle->model);
-    options.driver.controller.geometry = vehicle->geometry;
-    options.driver.controller.limits = vehicle->limits;
-    options.driver.odometry.geometry = vehicle->geometry;
-  }
+  if (vehicle->model) options.chassis = sim::chassis_for_model(*vehicle->model);
   options.chassis.profile = vehicle->profile;
-  options.driver.controller.profile = vehicle->profile;
+  apply_vehicle(*vehicle, options.driver);
   // auto (the default, as in the node): the driver identifies the chassis before it moves.
   if (protocol_is_auto(args)) options.driver.protocol = ProtocolChoice::kAuto;
   for (const std::string& p : args.all("--param")) {
