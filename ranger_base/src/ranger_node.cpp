@@ -60,6 +60,15 @@ std::string join(const std::vector<std::string>& items, const char* separator = 
   return out;
 }
 
+// "name<separator>value, ..." of (name, value) pairs, for the log.
+std::string join_pairs(const std::vector<std::pair<std::string, std::string>>& pairs,
+                       const char* separator) {
+  std::vector<std::string> items;
+  for (const auto& [name, value] : pairs)
+    items.push_back(name + separator + value);
+  return join(items);
+}
+
 bool is_socketcan(const std::string& port) {
   const auto kind = ranger::bus_kind(port);
   return kind && *kind == ranger::BusKind::kSocketCan;
@@ -180,24 +189,19 @@ void RangerNode::log_protocol() const {
         "driving",
         secs(params_.driver.identification.timeout));
     if (!pp.model_settings.empty()) {
-      std::vector<std::string> own;
-      for (const auto& [name, value] : pp.model_settings)
-        own.push_back(name + "=" + value);
       ROS_INFO(
           "the %s's own readings (%s) are not assumed with protocol auto: the identification "
           "decides what it can at rest, the plausibility monitors the rest on first motion; set "
           "protocol: %s to force the model's profile",
-          pp.model_display_name.c_str(), join(own).c_str(), c.profile.revision.c_str());
+          pp.model_display_name.c_str(), join_pairs(pp.model_settings, "=").c_str(),
+          c.profile.revision.c_str());
     }
   } else if (pp.auto_overridden) {
-    std::vector<std::string> set;
-    for (const auto& [name, value] : pp.settings)
-      set.push_back(name + ": " + value);
     ROS_WARN(
         "protocol auto, but interpretation parameters are set (%s): the driver cannot keep "
         "single settings forced on top of an identification, so identification is off and the "
         "settings are forced: %s (the plausibility monitors still check them while driving)",
-        join(set).c_str(), ranger::describe(c.profile).c_str());
+        join_pairs(pp.settings, ": ").c_str(), ranger::describe(c.profile).c_str());
   } else {
     ROS_INFO("protocol settings %s (%s); the plausibility monitors check them while driving",
              ranger::describe(c.profile).c_str(), pp.source.c_str());
