@@ -46,7 +46,7 @@ ros_env() {  # the environment every ROS stage runs in (system Python first, our
   if [ -f /opt/ros/noetic/setup.bash ]; then set +u; source /opt/ros/noetic/setup.bash; set -u; fi
   set +u; source install/setup.bash; set -u
   export ROS_HOME=${ROS_HOME:-$root/build/ros_home} ROS_HOSTNAME=localhost
-  export ROS_MASTER_URI=http://localhost:11311
+  export ROS_MASTER_URI=${ROS_MASTER_URI:-http://localhost:11311}
 }
 stage_ros_vcan() { (ros_env && scripts/run_vcan_tests.sh build/ws/ranger_base "$results/ros_vcan.xml"); }
 stage_ros() {
