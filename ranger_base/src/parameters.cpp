@@ -392,7 +392,8 @@ NodeParameters read_all(Reader& r) {
                                "no leading '/')");
   }
   p.publish_odom_tf = r.flag("publish_odom_tf", p.publish_odom_tf);
-  p.publish_rate = r.number("publish_rate", p.publish_rate, open_closed(0.0, 1000.0), "Hz");
+  // The chassis reports its motion every 20 ms: a higher rate would have no estimate to publish.
+  p.publish_rate = r.number("publish_rate", p.publish_rate, open_closed(0.0, 50.0), "Hz");
   p.state_publish_rate =
       r.number("state_publish_rate", p.state_publish_rate, open_closed(0.0, 100.0), "Hz");
   p.publish_cmd = r.flag("publish_cmd", p.publish_cmd);

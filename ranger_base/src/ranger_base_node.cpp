@@ -1,4 +1,5 @@
-// ranger_base_node: the RANGER driver. Reads and checks its parameters (exit status 2 naming
+// ranger_base_node: the RANGER driver as an executable (ranger_nodelet.cpp: the same as a
+// nodelet; both run ranger_base::RangerNode). Reads and checks its parameters (exit status 2 naming
 // every bad one), runs until SIGINT/SIGTERM or `rosnode kill`, and stops the chassis (a zero
 // motion command, logged and published on cmd_vel_out) before ROS goes down.
 //
@@ -27,7 +28,6 @@
 #include <string>
 #include <thread>
 
-#include "ranger_base/parameters.hpp"
 #include "ranger_base/ranger_node.hpp"
 
 namespace ros {
@@ -116,23 +116,12 @@ int main(int argc, char** argv) {
   ros::XMLRPCManager::instance()->unbind("shutdown");
   ros::XMLRPCManager::instance()->bind("shutdown", on_shutdown_request);
 
-  const ranger_base::NodeHandleParameterSource source(private_nh);
-  for (const auto& name : ranger_base::unknown_parameter_names(source)) {
-    ROS_WARN("unknown parameter %s ignored (see ranger_base/README.md for the names)",
-             source.display_name(name).c_str());
-  }
-  auto params = ranger_base::load_parameters(source);
-  if (!params) {
-    std::istringstream lines(params.error().message);
+  auto node = ranger_base::RangerNode::from_parameters(nh, private_nh);
+  if (!node) {
+    std::istringstream lines(node.error().message);
     for (std::string line; std::getline(lines, line);)
       ROS_FATAL("%s", line.c_str());
-    ROS_FATAL("ranger_base_node not started: fix the parameters above");
-    ros::shutdown();
-    return 2;
-  }
-  auto node = ranger_base::RangerNode::create(nh, private_nh, std::move(*params));
-  if (!node) {
-    ROS_FATAL("ranger_base_node not started: %s", node.error().message.c_str());
+    ROS_FATAL("ranger_base_node not started: fix the above");
     ros::shutdown();
     return 2;
   }

@@ -9,14 +9,22 @@
 #include <sensor_msgs/BatteryState.h>
 #include <sensor_msgs/JointState.h>
 #include <sensor_msgs/Range.h>
+#include <tf2_msgs/TFMessage.h>
 
+#include <poll.h>
 #include <pthread.h>
+#include <sys/eventfd.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <boost/make_shared.hpp>
 
 #include <algorithm>
 #include <chrono>
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
+#include <sstream>
 #include <string>
 
 #include <ranger_can/sim/chassis_commands.hpp>
@@ -80,11 +88,39 @@ std::string hex_word(std::uint32_t word) {
   return buf;
 }
 
+// Publishes a message as a shared pointer: a subscriber in the same process gets this very
+// message, without serialisation.
+template <class M>
+void publish_shared(const ros::Publisher& pub, M&& message) {
+  pub.publish(boost::make_shared<std::decay_t<M>>(std::forward<M>(message)));
+}
+
 // Builds and publishes a message only for a topic someone listens to (nothing is lost: the
 // states are published whole at every period, there is no history to keep up).
 template <class Make>
 void publish_if_heard(const ros::Publisher& pub, Make make) {
-  if (pub.getNumSubscribers() > 0) pub.publish(make());
+  if (pub.getNumSubscribers() > 0) publish_shared(pub, make());
+}
+
+// A publication is due from this long before its time (the estimates come with the driver's
+// iterations, which jitter), never more than a quarter of its period.
+std::chrono::steady_clock::duration early_margin(std::chrono::steady_clock::duration period) {
+  return std::min<std::chrono::steady_clock::duration>(std::chrono::milliseconds(5), period / 4);
+}
+
+std::chrono::steady_clock::duration period_of(double rate_hz) {
+  return std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double>(1.0 / rate_hz));
+}
+
+// A fixed-rate schedule: the next publication is due one period after the previous due time, so
+// the average rate is the configured one; after a stall it restarts from now instead of
+// publishing a burst.
+void advance(std::chrono::steady_clock::time_point& next,
+             std::chrono::steady_clock::duration period,
+             std::chrono::steady_clock::time_point now) {
+  next += period;
+  if (next < now) next = now + period;
 }
 }  // namespace
 
@@ -97,6 +133,18 @@ ranger::Result<std::unique_ptr<RangerNode>> RangerNode::create(const ros::NodeHa
                          "port_name \"" + params.port_name + "\": " + source.error().message};
   }
   return std::unique_ptr<RangerNode>(new RangerNode(nh, private_nh, std::move(params), *source));
+}
+
+ranger::Result<std::unique_ptr<RangerNode>> RangerNode::from_parameters(
+    const ros::NodeHandle& nh, const ros::NodeHandle& private_nh) {
+  const NodeHandleParameterSource source(private_nh);
+  for (const auto& name : unknown_parameter_names(source)) {
+    ROS_WARN("unknown parameter %s ignored (see ranger_base/README.md for the names)",
+             source.display_name(name).c_str());
+  }
+  auto params = load_parameters(source);
+  if (!params) return params.error();
+  return create(nh, private_nh, std::move(*params));
 }
 
 RangerNode::RangerNode(const ros::NodeHandle& nh, const ros::NodeHandle& private_nh,
@@ -129,23 +177,28 @@ RangerNode::RangerNode(const ros::NodeHandle& nh, const ros::NodeHandle& private
   }
   if (sim_) ground_truth_pub_ = nh_.advertise<nav_msgs::Odometry>("sim/ground_truth", 10);
 
+  if (params_.publish_odom_tf) tf_pub_ = nh_.advertise<tf2_msgs::TFMessage>("/tf", 100);
+
   updater_.setHardwareID(hardware_id(nh_.getNamespace(), params_.port_name));
   diagnostics_ = std::make_unique<ChassisDiagnostics>(
       updater_, [this] { return driver_->snapshot(); },
       ProtocolContext{params_.protocol.source, params_.port_name});
+  // Both observers run on the driver thread: they queue, or wake the publication thread, and
+  // return (publication never runs on the thread that owns the 0x111 keep-alive).
+  publication_wake_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
   driver_->set_sent_observer([this](const ranger::SentEvent& e) { on_sent(e); });
-  // Publication rides on the driver's own iterations (at least every 20 ms while the chassis is
-  // commanded): no thread of the node's own wakes up for it, and each snapshot is seen once.
   driver_->set_step_observer(
-      [this](const std::shared_ptr<const ranger::DriverSnapshot>&) { publish_due(); });
+      [this](const std::shared_ptr<const ranger::DriverSnapshot>&) { on_step(); });
 }
 
 RangerNode::~RangerNode() {
   shutdown();
+  if (publication_wake_fd_ >= 0) ::close(publication_wake_fd_);
 }
 
 void RangerNode::start() {
   driver_->start();
+  publication_thread_ = std::thread([this] { publication_loop(); });
 
   // Latest command wins: a queue of one drops stale twists under a flood instead of replaying
   // them late; TCP_NODELAY keeps the latency down.
@@ -216,6 +269,9 @@ void RangerNode::shutdown() {
   cmd_vel_sub_.shutdown();
   sim_inject_sub_.shutdown();
   driver_->stop();  // the zero motion command (on_sent logs it), then the driver thread ends
+  publication_stop_ = true;
+  wake_publication();
+  if (publication_thread_.joinable()) publication_thread_.join();  // cmd_vel_out has the stop
   if (!stop_sent_) {
     const auto s = driver_->snapshot();
     ROS_INFO("no stop sent to the chassis: %s",
@@ -260,7 +316,22 @@ void RangerNode::on_sent(const ranger::SentEvent& e) {
   ros::Time stamp;
   stamp.fromNSec(static_cast<std::uint64_t>(
       std::chrono::duration_cast<nanoseconds>(e.wall.time_since_epoch()).count()));
-  cmd_vel_out_pub_.publish(to_twist_stamped(*achieved, stamp, params_.base_frame));
+  {
+    std::lock_guard<std::mutex> lock(sent_mutex_);  // the publication thread only swaps it out
+    sent_queue_.push_back(SentTwist{*achieved, stamp});
+  }
+  wake_publication();
+}
+
+void RangerNode::on_step() {
+  if (snapshot_wanted_.exchange(false)) wake_publication();
+}
+
+void RangerNode::wake_publication() {
+  if (publication_wake_fd_ < 0) return;
+  const std::uint64_t one = 1;
+  // A full counter (EAGAIN) means a wake-up is pending anyway.
+  [[maybe_unused]] const auto n = ::write(publication_wake_fd_, &one, sizeof one);
 }
 
 void RangerNode::on_sim_inject(const std_msgs::String::ConstPtr& msg) {
@@ -403,52 +474,103 @@ bool RangerNode::on_set_motion_mode(ranger_msgs::SetMotionMode::Request& req,
 // ---- publishing
 // ----------------------------------------------------------------------------------
 
-void RangerNode::publish_due() {
+void RangerNode::publication_loop() {
+  ::pthread_setname_np(::pthread_self(), "ranger_publish");
   using Clock = std::chrono::steady_clock;
-  const auto now = Clock::now();
-  // A fixed-rate schedule on the driver's iterations (its 20 ms keep-alive and every command):
-  // a publication goes out at the first iteration from a few ms before its due time, and the
-  // next is due one period after the previous due time, so the average rate is the configured
-  // one; after a stall the schedule restarts from now instead of publishing a burst.
-  constexpr auto kEarly = std::chrono::milliseconds(5);
-  auto due = [now, kEarly](Clock::time_point& next, double rate) {
-    const auto period =
-        std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / rate));
-    if (now < next - kEarly) return false;
-    next += period;
-    if (next < now) next = now + period;
-    return true;
-  };
+  const auto motion_period = period_of(params_.publish_rate);
+  const auto state_period = period_of(params_.state_publish_rate);
+  const auto diagnostics_period = period_of(1.0);
+  const auto motion_early = early_margin(motion_period);
+  const auto state_early = early_margin(state_period);
+  const auto start = Clock::now();
+  next_motion_publication_ = next_state_publication_ = next_diagnostics_publication_ = start;
+  bool waiting_for_snapshot = false;  // motion is due, the latest snapshot had nothing new
+  while (!publication_stop_) {
+    try {
+      publish_sent();
+      const auto now = Clock::now();
+      if (now >= next_motion_publication_ - motion_early) {
+        // Wanted before the snapshot is read: an iteration that ends meanwhile wakes us.
+        snapshot_wanted_ = true;
+        if (publish_motion(*driver_->snapshot())) {
+          snapshot_wanted_ = false;
+          waiting_for_snapshot = false;
+          if (sim_ && ground_truth_pub_) publish_ground_truth();
+          advance(next_motion_publication_, motion_period, now);
+        } else {
+          waiting_for_snapshot = true;
+        }
+      }
+      if (now >= next_state_publication_ - state_early) {
+        publish_states();
+        advance(next_state_publication_, state_period, now);
+      }
+      if (now >= next_diagnostics_publication_) {
+        publish_diagnostics();
+        advance(next_diagnostics_publication_, diagnostics_period, now);
+      }
+    } catch (const std::exception& e) {  // nothing may escape the thread
+      ROS_ERROR_THROTTLE(5.0, "publishing failed: %s", e.what());
+    }
+    // Until the next publication is due, a frame was sent, or (motion due) the driver's next
+    // iteration.
+    auto until = std::min(next_state_publication_ - state_early, next_diagnostics_publication_);
+    if (!waiting_for_snapshot) until = std::min(until, next_motion_publication_ - motion_early);
+    const auto wait = std::chrono::duration_cast<nanoseconds>(std::clamp<Clock::duration>(
+        until - Clock::now(), Clock::duration::zero(), std::chrono::seconds(1)));
+    const timespec ts{static_cast<time_t>(wait.count() / 1'000'000'000),
+                      static_cast<long>(wait.count() % 1'000'000'000)};
+    pollfd fd{publication_wake_fd_, POLLIN, 0};
+    if (::ppoll(&fd, 1, &ts, nullptr) > 0 && (fd.revents & POLLIN)) {
+      std::uint64_t value;
+      [[maybe_unused]] const auto n = ::read(publication_wake_fd_, &value, sizeof value);
+    }
+  }
   try {
-    if (due(next_motion_publication_, params_.publish_rate)) publish_motion();
-    if (due(next_state_publication_, params_.state_publish_rate)) publish_states();
-    if (due(next_diagnostics_publication_, 1.0)) publish_diagnostics();
-  } catch (const std::exception& e) {  // nothing may escape into the driver thread
-    ROS_ERROR_THROTTLE(5.0, "publishing failed: %s", e.what());
+    publish_sent();  // the shutdown's stop
+  } catch (const std::exception& e) {
+    ROS_ERROR("publishing failed: %s", e.what());
   }
 }
 
-void RangerNode::publish_motion() {
-  const auto s = driver_->snapshot();
+void RangerNode::publish_sent() {
+  std::vector<SentTwist> sent;
+  {
+    std::lock_guard<std::mutex> lock(sent_mutex_);
+    sent.swap(sent_queue_);
+  }
+  for (const SentTwist& t : sent)
+    publish_shared(cmd_vel_out_pub_, to_twist_stamped(t.twist, t.stamp, params_.base_frame));
+}
+
+bool RangerNode::publish_motion(const ranger::DriverSnapshot& s) {
   // Publish only what is known: nothing while the chassis is not heard (never, or link lost),
   // and each estimate once, stamped with the time of the frames that produced it.
-  if (s->motion_known) {
-    if (s->odometry.stamp > last_odom_stamp_) {
-      last_odom_stamp_ = s->odometry.stamp;
-      const nav_msgs::Odometry odom = to_odometry(s->odometry, params_);
-      odom_pub_.publish(odom);
-      if (params_.publish_odom_tf) tf_broadcaster_.sendTransform(to_transform(odom));
+  if (!s.motion_known) return true;  // nothing to wait for
+  bool published = false;
+  if (s.odometry.stamp > last_odom_stamp_) {
+    last_odom_stamp_ = s.odometry.stamp;
+    auto odom = boost::make_shared<nav_msgs::Odometry>(to_odometry(s.odometry, params_));
+    odom_pub_.publish(odom);
+    if (tf_pub_) {
+      auto tf = boost::make_shared<tf2_msgs::TFMessage>();
+      tf->transforms.push_back(to_transform(*odom));
+      tf_pub_.publish(tf);
     }
-    const ranger::Timestamp joints = joints_stamp(s->feedback);
-    if ((s->joints.has_steering || s->joints.has_wheels) && joints > last_joints_stamp_) {
-      last_joints_stamp_ = joints;
-      joint_state_pub_.publish(to_joint_state(s->joints, to_ros_time(joints)));
-    }
+    published = true;
   }
-  if (sim_ && ground_truth_pub_) {
-    const auto truth = sim_->snapshot();
-    ground_truth_pub_.publish(to_ground_truth(truth, params_, to_ros_time(truth.time)));
+  const ranger::Timestamp joints = joints_stamp(s.feedback);
+  if ((s.joints.has_steering || s.joints.has_wheels) && joints > last_joints_stamp_) {
+    last_joints_stamp_ = joints;
+    publish_shared(joint_state_pub_, to_joint_state(s.joints, to_ros_time(joints)));
+    published = true;
   }
+  return published;
+}
+
+void RangerNode::publish_ground_truth() {
+  const auto truth = sim_->snapshot();
+  publish_shared(ground_truth_pub_, to_ground_truth(truth, params_, to_ros_time(truth.time)));
 }
 
 void RangerNode::publish_states() {

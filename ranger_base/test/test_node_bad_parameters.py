@@ -32,7 +32,7 @@ class BadParameters(unittest.TestCase):
                                "_cmd_vel_timeout:=0", "_port_name:=sim")
         self.assertEqual(result.returncode, 2, result.stderr)
         out = result.stdout + result.stderr
-        for expected in ("publish_rate", "(0, 1000] Hz", "odometry_source",
+        for expected in ("publish_rate", "(0, 50] Hz", "odometry_source",
                          '"wheels" or "motion"', "cmd_vel_timeout", "[0.02, 60] s",
                          "not started"):
             self.assertIn(expected, out)

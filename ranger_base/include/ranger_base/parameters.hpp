@@ -71,7 +71,7 @@ struct NodeParameters {
   // files give odom_frame and base_frame with the same prefix.
   std::string frame_prefix;
   bool publish_odom_tf = true;
-  double publish_rate = 50.0;        // Hz: odom, TF, joint_states
+  double publish_rate = 50.0;        // Hz: odom, TF, joint_states (at most the feedback's 50 Hz)
   double state_publish_rate = 10.0;  // Hz: ranger_msgs states, battery, ultrasonic
   bool publish_cmd = false;          // cmd_vel_out: the twist each motion command realises
 

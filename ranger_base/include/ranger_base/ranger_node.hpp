@@ -1,17 +1,26 @@
-// ranger_base_node's ROS side around libranger_can's driver runtime (ranger::Driver): parameters
+// The RANGER driver's ROS side around libranger_can's driver runtime (ranger::Driver): parameters
 // become a DriverConfig, snapshots become messages and diagnostics, ROS callbacks post to the
 // driver's mailbox. The node knows no frame: the driver owns the bus, the controller, the
-// odometry and the joint tracker on a thread of its own.
+// odometry and the joint tracker on a thread of its own. One class behind both front ends: the
+// executable ranger_base_node (ranger_base_node.cpp) and the nodelet ranger_base/RangerNodelet
+// (ranger_nodelet.cpp) construct it the same way (from_parameters) and run the same code.
 //
 // All topic and service names are relative (the node works under a namespace); only /tf and
-// /diagnostics are global, by their own conventions.
+// /diagnostics are global, by their own conventions. Every message is published as a shared
+// pointer, so that a subscriber in the same process (a nodelet in the same manager) gets it
+// without serialisation.
 //
-// Threads: the driver's, which also publishes (its step observer calls publish_due() after each
-// iteration: odometry/TF/joints at publish_rate, states at state_publish_rate, diagnostics at
-// 1 Hz; no thread of the node's own wakes up for publication), and two callback queues each
-// spun by one thread: cmd_vel (never queued behind anything) and the services (which wait for
-// the chassis's answer). cmd_vel_out is published from the driver's sent-frame observer. No ROS
-// callback touches the bus.
+// Threads:
+//  * the driver's (the bus, the 0x111 keep-alive): the node only posts to its mailbox and reads
+//    its snapshots; the node's observers on it (a sent frame, an iteration done) append to a
+//    queue or write to an eventfd and never wait for publication;
+//  * publication, the node's own (publication_loop): odometry/TF/joints at publish_rate (each
+//    estimate once: when the rate is due it waits for the driver's next snapshot with a new
+//    estimate), states at state_publish_rate, diagnostics at 1 Hz, cmd_vel_out for every motion
+//    frame sent. However slow a subscriber or however much is published, the driver's schedule
+//    does not move;
+//  * two callback queues each spun by one thread: cmd_vel (never queued behind anything) and the
+//    services (which wait for the chassis's answer). No ROS callback touches the bus.
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
@@ -23,7 +32,6 @@
 #include <ros/ros.h>
 #include <std_msgs/String.h>
 #include <std_srvs/Trigger.h>
-#include <tf2_ros/transform_broadcaster.h>
 
 #include <array>
 #include <atomic>
@@ -34,6 +42,7 @@
 #include <set>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <ranger_can/clock.hpp>
 #include <ranger_can/control/driver.hpp>
@@ -53,15 +62,20 @@ class RangerNode {
   static ranger::Result<std::unique_ptr<RangerNode>> create(const ros::NodeHandle& nh,
                                                             const ros::NodeHandle& private_nh,
                                                             NodeParameters params);
+  // Both front ends start here: warns about unknown parameter names, reads and checks the
+  // parameters in `private_nh` and creates the node. The error's message names every bad
+  // parameter (one per line) or says why the bus source cannot be opened.
+  static ranger::Result<std::unique_ptr<RangerNode>> from_parameters(
+      const ros::NodeHandle& nh, const ros::NodeHandle& private_nh);
   ~RangerNode();  // shutdown()
   RangerNode(const RangerNode&) = delete;
   RangerNode& operator=(const RangerNode&) = delete;
 
-  // Starts the driver thread (which also publishes) and the spinners.
+  // Starts the driver thread, the publication thread and the spinners.
   void start();
   // Stops the chassis (the driver's zero motion command, logged and published on cmd_vel_out),
-  // the driver thread, then the ROS side. Idempotent; returns promptly (services in progress stop
-  // waiting).
+  // the driver thread, the publication thread, then the ROS side. Idempotent; returns promptly
+  // (services in progress stop waiting).
   void shutdown();
 
  private:
@@ -70,7 +84,8 @@ class RangerNode {
 
   void on_cmd_vel(const geometry_msgs::Twist::ConstPtr& msg);
   void on_sim_inject(const std_msgs::String::ConstPtr& msg);
-  void on_sent(const ranger::SentEvent& event);  // driver thread
+  void on_sent(const ranger::SentEvent& event);  // driver thread: queued for publication
+  void on_step();  // driver thread: wakes the publication thread if it waits for a snapshot
   bool on_resume(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
   bool on_clear_errors(ranger_msgs::ClearErrors::Request& req,
                        ranger_msgs::ClearErrors::Response& res);
@@ -81,9 +96,14 @@ class RangerNode {
   // The outcome of request `id` once answered or failed, after `timeout`, or at shutdown.
   ranger::RequestOutcome wait_for(std::uint64_t id, std::chrono::nanoseconds timeout);
 
-  void publish_due();     // on the driver thread, after each of its iterations
-  void publish_motion();  // odom, TF, joint_states, sim/ground_truth
-  void publish_states();  // ranger_msgs states, battery, ultrasonic
+  // ---- the publication thread ----
+  void publication_loop();
+  void wake_publication();  // any thread; never blocks
+  void publish_sent();      // cmd_vel_out for the frames queued by on_sent
+  // Publishes what the snapshot has new; false if it has nothing new (wait for the next one).
+  bool publish_motion(const ranger::DriverSnapshot& s);  // odom, TF, joint_states
+  void publish_ground_truth();                           // sim/ground_truth
+  void publish_states();                                 // ranger_msgs states, battery, ultrasonic
   void publish_diagnostics();
   void log_state_changes(const ranger::DriverSnapshot& s);
   // The identification's decision or failure (once), settings learned while driving, each new
@@ -108,9 +128,8 @@ class RangerNode {
   ros::Subscriber cmd_vel_sub_, sim_inject_sub_;
   ros::Publisher odom_pub_, joint_state_pub_, system_state_pub_, actuator_state_pub_,
       bms_state_pub_, battery_state_pub_, ultrasonic_state_pub_, cmd_vel_out_pub_,
-      ground_truth_pub_;
+      ground_truth_pub_, tf_pub_;
   std::array<ros::Publisher, 8> range_pubs_;
-  tf2_ros::TransformBroadcaster tf_broadcaster_;
   ros::ServiceServer resume_srv_, clear_errors_srv_, set_ultrasonic_srv_, set_motion_mode_srv_;
 
   diagnostic_updater::Updater updater_;
@@ -121,12 +140,25 @@ class RangerNode {
   std::atomic<bool> stopping_{false};   // services stop waiting
   std::atomic<bool> stop_sent_{false};  // the driver's shutdown stop was observed
 
-  // The driver thread only (publish_due).
+  // The publication thread and what wakes it (the driver's observers write to the eventfd; the
+  // queue's lock is held only to append or to swap it out).
+  std::thread publication_thread_;
+  int publication_wake_fd_ = -1;
+  std::atomic<bool> publication_stop_{false};
+  std::atomic<bool> snapshot_wanted_{false};  // publication waits for the driver's next iteration
+  struct SentTwist {
+    ranger::BodyTwist twist;
+    ros::Time stamp;
+  };
+  std::mutex sent_mutex_;
+  std::vector<SentTwist> sent_queue_;  // guarded by sent_mutex_
+
+  // The publication thread only.
   std::chrono::steady_clock::time_point next_motion_publication_, next_state_publication_,
       next_diagnostics_publication_;
   ranger::Timestamp last_odom_stamp_{0}, last_joints_stamp_{0};
   std::array<ranger::Timestamp, 2> last_ultrasonic_stamp_{};
-  // For logging transitions once instead of every cycle (the driver thread: publish_states).
+  // For logging transitions once instead of every cycle (the publication thread: publish_states).
   std::optional<ranger::MotionRefusal> last_refusal_;
   std::optional<ranger::LinkState> last_link_;
   bool last_bus_open_ = false;

@@ -105,7 +105,7 @@ struct SentEvent {
   std::chrono::system_clock::time_point wall;  // wall time right after the send
 };
 
-// A consistent copy of the runtime's state, published after every iteration that changed it.
+// A consistent copy of the runtime's state, published after every iteration.
 struct DriverSnapshot {
   std::uint64_t sequence = 0;  // increases with every publication
   Timestamp now{0};            // driver clock at publication
@@ -154,14 +154,17 @@ class Driver {
   Driver& operator=(const Driver&) = delete;
 
   // Called on the driver thread (or in step()) after every frame sent, outside the driver's
-  // locks; must not block. Set before start().
+  // locks; must not block (it delays the next frame): queue the event and return. Set before
+  // start().
   void set_sent_observer(SentObserver observer) { sent_observer_ = std::move(observer); }
   // Called with every received frame (any ID), before the driver handles it. Set before start().
   void set_frame_tap(FrameTap tap) { frame_tap_ = std::move(tap); }
   // Called on the driver thread (or in step()) with the snapshot just published, after every
-  // iteration, outside the driver's locks: a program that publishes the state (the ROS node)
-  // does it here instead of waking a thread of its own, and sees every snapshot once. Must not
-  // block and must not call stop(); an exception it throws is swallowed. Set before start().
+  // iteration, outside the driver's locks. It runs on the thread that owns the keep-alive, so it
+  // must not block, publish or serialise anything: a program that publishes the state (the ROS
+  // node) does that on a thread of its own, reading snapshot(), and uses this only to wake it
+  // when a new snapshot is worth reading. Must not call stop(); an exception it throws is
+  // swallowed. Set before start().
   using StepObserver = std::function<void(const std::shared_ptr<const DriverSnapshot>&)>;
   void set_step_observer(StepObserver observer) { step_observer_ = std::move(observer); }
 
