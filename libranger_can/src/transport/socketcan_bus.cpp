@@ -14,8 +14,10 @@
 #endif
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <cstring>
+#include <deque>
 #include <system_error>
 #include <thread>
 
@@ -291,9 +293,38 @@ Result<std::unique_ptr<SocketCanBus>> SocketCanBus::open(const std::string& inte
   return std::make_unique<SocketCanBus>(Key{}, interface, std::move(options), std::move(socket));
 }
 
+// The buffers of one recvmmsg(), and the frames it read that receive() has not returned yet.
+struct SocketCanBus::ReceiveBatch {
+  static constexpr std::size_t kControlBytes =
+      CMSG_SPACE(sizeof(struct timespec)) + CMSG_SPACE(sizeof(std::uint32_t));
+  struct alignas(struct cmsghdr) Control {
+    char bytes[kControlBytes];
+  };
+  std::array<struct can_frame, kReceiveBatch> frames;
+  std::array<struct iovec, kReceiveBatch> iov;
+  std::array<Control, kReceiveBatch> control;
+  std::array<struct mmsghdr, kReceiveBatch> msgs;
+  std::deque<Result<CanFrame>> ready;
+  std::uint64_t filter_generation = 0;  // the filter `ready` passed
+
+  // Points the headers at the buffers again (the kernel rewrites the lengths).
+  void reset() {
+    for (std::size_t i = 0; i < kReceiveBatch; ++i) {
+      iov[i] = {&frames[i], sizeof frames[i]};
+      std::memset(&msgs[i], 0, sizeof msgs[i]);
+      msgs[i].msg_hdr.msg_iov = &iov[i];
+      msgs[i].msg_hdr.msg_iovlen = 1;
+      msgs[i].msg_hdr.msg_control = control[i].bytes;
+      msgs[i].msg_hdr.msg_controllen = kControlBytes;
+    }
+  }
+};
+
 SocketCanBus::SocketCanBus(Key, std::string interface, SocketCanOptions options,
                            std::shared_ptr<Socket> socket)
-    : interface_(std::move(interface)), options_(std::move(options)) {
+    : interface_(std::move(interface)),
+      options_(std::move(options)),
+      rx_(std::make_unique<ReceiveBatch>()) {
   const Clock& clock = options_.clock ? *options_.clock : default_reopen_clock();
   state_ = std::make_unique<State>(interface_, clock, options_.reopen_interval);
   state_->filter.set(options_.filter);
@@ -379,9 +410,83 @@ Status SocketCanBus::send(const CanFrame& frame) {
                interface_ + ": cannot send frame " + hex_id(frame.id) + ": " + errno_text(err)};
 }
 
+int SocketCanBus::read_batch(const std::shared_ptr<Socket>& socket, int& err) {
+  ReceiveBatch& b = *rx_;
+  b.reset();
+  const int n = ::recvmmsg(socket->fd.get(), b.msgs.data(), static_cast<unsigned>(kReceiveBatch),
+                           MSG_DONTWAIT, nullptr);
+  err = errno;
+  if (n < 0) return (err == EAGAIN || err == EWOULDBLOCK) ? 0 : -1;
+
+  struct timespec now_ts {};
+  bool have_now = false;
+  std::lock_guard<std::mutex> lock(mutex_);  // once for the whole batch
+  State& s = *state_;
+  if (b.ready.empty()) b.filter_generation = filter_generation_.load();
+  for (std::size_t i = 0; i < static_cast<std::size_t>(n); ++i) {
+    struct msghdr& msg = b.msgs[i].msg_hdr;
+    Timestamp stamp{0};
+    bool have_drops = false;
+    std::uint32_t drops = 0;
+    for (struct cmsghdr* c = CMSG_FIRSTHDR(&msg); c; c = CMSG_NXTHDR(&msg, c)) {
+      if (c->cmsg_level != SOL_SOCKET) continue;
+      if (c->cmsg_type == SCM_TIMESTAMPNS) {
+        struct timespec ts;
+        std::memcpy(&ts, CMSG_DATA(c), sizeof ts);
+        stamp = std::chrono::seconds(ts.tv_sec) + std::chrono::nanoseconds(ts.tv_nsec);
+      } else if (c->cmsg_type == SO_RXQ_OVFL) {
+        std::memcpy(&drops, CMSG_DATA(c), sizeof drops);
+        have_drops = true;
+      }
+    }
+    if (stamp.count() == 0) {  // never seen, but a frame must not claim time zero
+      if (!have_now) {
+        ::clock_gettime(CLOCK_REALTIME, &now_ts);
+        have_now = true;
+      }
+      stamp = std::chrono::seconds(now_ts.tv_sec) + std::chrono::nanoseconds(now_ts.tv_nsec);
+    }
+    if (have_drops) s.account_drops(*socket, drops);
+    auto frame = socketcan::from_kernel(b.frames[i], b.msgs[i].msg_len, interface_);
+    if (!frame) {
+      b.ready.push_back(frame.error());
+      continue;
+    }
+    frame->stamp = stamp;
+    if (frame->is_error) {
+      s.tracker.on_error_frame(*frame);
+    } else if (!s.filter.accepts(frame->id)) {
+      continue;  // sent before a filter change took effect
+    } else {
+      ++s.tracker.stats().rx_frames;
+    }
+    b.ready.push_back(std::move(frame));
+  }
+  return n;
+}
+
 Result<CanFrame> SocketCanBus::receive(std::chrono::nanoseconds timeout) {
   using std::chrono::steady_clock;
   const auto deadline = steady_clock::now() + timeout;
+  std::lock_guard<std::mutex> receive_lock(receive_mutex_);
+  std::deque<Result<CanFrame>>& ready = rx_->ready;
+  auto next_ready = [&ready] {
+    Result<CanFrame> r = std::move(ready.front());
+    ready.pop_front();
+    return r;
+  };
+  if (!ready.empty() && rx_->filter_generation != filter_generation_.load()) {
+    // The filter changed since these were read: they must pass the new one.
+    std::lock_guard<std::mutex> lock(mutex_);
+    rx_->filter_generation = filter_generation_.load();
+    const IdFilter& filter = state_->filter;
+    ready.erase(std::remove_if(ready.begin(), ready.end(),
+                               [&filter](const Result<CanFrame>& f) {
+                                 return f && !f->is_error && !filter.accepts(f->id);
+                               }),
+                ready.end());
+  }
+  if (!ready.empty()) return next_ready();  // read by an earlier recvmmsg: no system call
   bool poll_reported_error = false;
   for (;;) {
     auto socket = acquire_socket();
@@ -392,56 +497,14 @@ Result<CanFrame> SocketCanBus::receive(std::chrono::nanoseconds timeout) {
     }
     const int fd = socket->fd.get();
 
-    struct can_frame kf;
-    struct iovec iov = {&kf, sizeof kf};
-    alignas(struct cmsghdr) char
-        control[CMSG_SPACE(sizeof(struct timespec)) + CMSG_SPACE(sizeof(std::uint32_t))];
-    struct msghdr msg;
-    std::memset(&msg, 0, sizeof msg);
-    msg.msg_iov = &iov;
-    msg.msg_iovlen = 1;
-    msg.msg_control = control;
-    msg.msg_controllen = sizeof control;
-    const ssize_t n = ::recvmsg(fd, &msg, MSG_DONTWAIT);
-    const int err = errno;
-
-    if (n >= 0) {
-      Timestamp stamp{0};
-      bool have_drops = false;
-      std::uint32_t drops = 0;
-      for (struct cmsghdr* c = CMSG_FIRSTHDR(&msg); c; c = CMSG_NXTHDR(&msg, c)) {
-        if (c->cmsg_level != SOL_SOCKET) continue;
-        if (c->cmsg_type == SCM_TIMESTAMPNS) {
-          struct timespec ts;
-          std::memcpy(&ts, CMSG_DATA(c), sizeof ts);
-          stamp = std::chrono::seconds(ts.tv_sec) + std::chrono::nanoseconds(ts.tv_nsec);
-        } else if (c->cmsg_type == SO_RXQ_OVFL) {
-          std::memcpy(&drops, CMSG_DATA(c), sizeof drops);
-          have_drops = true;
-        }
-      }
-      if (stamp.count() == 0) {  // never seen, but a frame must not claim time zero
-        struct timespec ts;
-        ::clock_gettime(CLOCK_REALTIME, &ts);
-        stamp = std::chrono::seconds(ts.tv_sec) + std::chrono::nanoseconds(ts.tv_nsec);
-      }
-      auto frame = socketcan::from_kernel(kf, static_cast<std::size_t>(n), interface_);
-      std::lock_guard<std::mutex> lock(mutex_);
-      State& s = *state_;
-      if (have_drops) s.account_drops(*socket, drops);
-      if (!frame) return frame.error();
-      frame->stamp = stamp;
-      if (frame->is_error) {
-        s.tracker.on_error_frame(*frame);
-        return frame;
-      }
-      if (!s.filter.accepts(frame->id)) continue;  // sent before a filter change took effect
-      ++s.tracker.stats().rx_frames;
-      return frame;
+    int err = 0;
+    const int n = read_batch(socket, err);
+    if (n > 0) {
+      if (!ready.empty()) return next_ready();
+      continue;  // every frame was filtered out: read again
     }
-
-    if (err == EINTR) continue;
-    if (err == EAGAIN || err == EWOULDBLOCK) {
+    if (n < 0 && err == EINTR) continue;
+    if (n == 0) {  // nothing queued
       if (poll_reported_error) {
         int so_error = 0;
         socklen_t len = sizeof so_error;
@@ -469,7 +532,7 @@ Result<CanFrame> SocketCanBus::receive(std::chrono::nanoseconds timeout) {
       if (r > 0 && !(pfd.revents & POLLIN) && (pfd.revents & (POLLERR | POLLHUP | POLLNVAL))) {
         poll_reported_error = true;
       }
-      continue;  // read again: a pending socket error is reported by recvmsg itself
+      continue;  // read again: a pending socket error is reported by recvmmsg itself
     }
     if (is_interface_loss(err)) {
       if (!on_interface_lost(socket, err)) return down_error();
@@ -501,6 +564,7 @@ void SocketCanBus::set_filter(const std::vector<std::uint32_t>& ids) {
   std::lock_guard<std::mutex> lock(mutex_);
   State& s = *state_;
   s.filter.set(ids);
+  ++filter_generation_;
   if (s.socket) {
     if (auto st = apply_filter(s.socket->fd.get(), s.filter.ids(), interface_); !st) {
       // The software filter in receive() still applies; report why the kernel one is missing.

@@ -6,19 +6,23 @@
 //    odometry integrates over when the frame arrived, not over when a thread got round to it.
 //  * send() never blocks: a full transmit queue (ENOBUFS from the qdisc, EAGAIN from the socket
 //    buffer) drops the frame, counts it in tx_dropped and returns kWouldBlock.
+//  * Frames are read in batches: one recvmmsg() takes everything queued (up to kReceiveBatch
+//    frames), and receive() hands them out one by one without another system call.
 //  * Frames the kernel dropped because we read too slowly are counted in rx_dropped
 //    (SO_RXQ_OVFL on every frame, SO_MEMINFO when the status is read).
 //  * Losing the interface (link down: ENETDOWN; adapter unplugged: ENODEV) closes the socket,
 //    reports kDown with the reason, and later send()/receive() calls reopen it by name once it is
 //    back (first attempt at once, then at most one per `reopen_interval` on the injected clock).
 //
-// Thread-safety: send() and receive() may be called from different threads; status(), fd(),
+// Thread-safety: send() and receive() may be called from different threads (concurrent
+// receive() calls take turns); status(), fd(),
 // set_filter() from any thread. fd() changes when the socket is reopened: re-read it after
 // status() reported kDown.
 #pragma once
 
 #include <linux/can.h>
 
+#include <atomic>
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
@@ -28,11 +32,11 @@
 #include <string_view>
 #include <vector>
 
-#include "ranger_can/transport/bus.hpp"
 #include "ranger_can/clock.hpp"
+#include "ranger_can/result.hpp"
+#include "ranger_can/transport/bus.hpp"
 #include "ranger_can/wire/frame.hpp"
 #include "ranger_can/wire/protocol.hpp"
-#include "ranger_can/result.hpp"
 
 namespace ranger {
 
@@ -50,6 +54,9 @@ struct SocketCanOptions {
 
 class SocketCanBus final : public Bus {
  public:
+  // At most this many frames per recvmmsg() (about 20 ms of the RANGER's feedback).
+  static constexpr std::size_t kReceiveBatch = 32;
+
   // Opens `interface` (e.g. "can0", "vcan0"). Errors name the interface and say what to do:
   // kNoSuchInterface, kNotCanInterface, kInterfaceDown, kPermissionDenied, or kIoError (e.g. a
   // kernel without CAN support: "modprobe can-raw").
@@ -82,18 +89,25 @@ class SocketCanBus final : public Bus {
   // null while the interface is down.
   std::shared_ptr<Socket> on_interface_lost(const std::shared_ptr<Socket>& failed, int err);
   Error down_error() const;
+  // Reads what `socket` has queued (one recvmmsg, not waiting) into rx_: the number of frames
+  // read, 0 for none (EAGAIN), -1 for an error (`err` set).
+  int read_batch(const std::shared_ptr<Socket>& socket, int& err);
 
   struct State;
+  struct ReceiveBatch;
   const std::string interface_;
   const SocketCanOptions options_;
   mutable std::mutex mutex_;
-  std::unique_ptr<State> state_;  // guarded by mutex_
+  std::unique_ptr<State> state_;      // guarded by mutex_
+  std::mutex receive_mutex_;          // one receive() at a time
+  std::unique_ptr<ReceiveBatch> rx_;  // guarded by receive_mutex_: read, not yet returned
+  std::atomic<std::uint64_t> filter_generation_{0};  // set_filter() calls so far
 };
 
 // ---- kernel frame conversion (exposed for unit tests; no socket needed) -----------------------
 namespace socketcan {
 
-// Converts what recvmsg() returned (`nbytes` bytes into `kf`) into a CanFrame. Rejects, with a
+// Converts what recvmmsg() returned (`nbytes` bytes into `kf`) into a CanFrame. Rejects, with a
 // message naming `interface` and the ID: a size other than a classic CAN frame, DLC > 8,
 // extended (29-bit) and remote frames. Error frames come back with is_error set.
 Result<CanFrame> from_kernel(const struct can_frame& kf, std::size_t nbytes,
