@@ -15,8 +15,19 @@ process, as in real use, so the node serialises and sends those messages at 50 H
   2. Latency cmd_vel -> 0x111: --samples twists 50-70 ms apart (at random, so every phase
      against the 20 ms keep-alive occurs); the node (publish_cmd:=true) stamps each 0x111 with its
      send time on cmd_vel_out; latency = that stamp - the time the twist was published.
+  3. keepalive: the 0x111 keep-alive's period with a subscriber on every topic the node
+     advertises (and two slow ones, 0.2 s per message, on odom and /tf): one twist, then no
+     command for --duration s (cmd_vel_timeout 60 s), so that every 0x111 is a scheduled one;
+     deviation = |interval between consecutive cmd_vel_out stamps - 20 ms|.
+  4. nodelet: the driver as a nodelet (ranger_base/RangerNodelet) in a manager of its own, with
+     the subscriber nodelet ranger_base/PerfSubscriber on odom, /tf and joint_states in the same
+     manager (no serialisation), cmd_vel at 20 Hz: CPU of the manager process and its threads.
+  5. fleet: --robots nodes, each with its own virtual chassis, at once, each driven in its own
+     circle at 10 Hz: total and per-robot CPU and RSS; then each is stopped and its odometry
+     compared with its chassis's ground truth (sim/ground_truth).
 
   ranger_base/scripts/measure_performance.py [--duration 30] [--samples 400] [--json FILE]
+      [--phases load,floor,latency,keepalive,nodelet,fleet] [--robots 10]
 
 Needs a built and sourced workspace (ranger_base_node findable by rospack).
 """
@@ -248,11 +259,251 @@ def measure_latency(rospy, samples, params):
             **{f"p{p}_ms": round(percentile(ms, p), 3) for p in (50, 90, 99)}}
 
 
+# Every topic the node advertises, and two slow subscribers (0.2 s per message) on odom and /tf.
+ALL_SUBSCRIBERS = """
+import sys, time, rospy
+ns = sys.argv[1]
+rospy.init_node("perf_all_subscribers", anonymous=True)
+topics = sorted(t for t, _ in rospy.get_published_topics()
+                if t.startswith(f"/{ns}/") or t in ("/tf", "/diagnostics"))
+subs = [rospy.Subscriber(t, rospy.AnyMsg, lambda _: None, queue_size=100) for t in topics]
+subs += [rospy.Subscriber(t, rospy.AnyMsg, lambda _: time.sleep(0.2), queue_size=1)
+         for t in (f"/{ns}/odom", "/tf")]
+print(len(topics), flush=True)
+rospy.spin()
+"""
+
+
+def measure_keepalive(rospy, duration, params):
+    from geometry_msgs.msg import Twist, TwistStamped
+    ns, stamps = "perf_keepalive", []
+    with Robot(rospy, ns, ["_publish_cmd:=true", "_cmd_vel_timeout:=60", *params]):
+        extra = subprocess.Popen([sys.executable, "-c", ALL_SUBSCRIBERS, ns],
+                                 stdout=subprocess.PIPE, text=True)
+        try:
+            ready = select.select([extra.stdout], [], [], 60)[0]
+            topics = int(extra.stdout.readline()) if ready else 0
+            sub = rospy.Subscriber(f"/{ns}/cmd_vel_out", TwistStamped,
+                                   lambda m: stamps.append(m.header.stamp.to_sec()),
+                                   queue_size=10000, tcp_nodelay=True)
+            pub = rospy.Publisher(f"/{ns}/cmd_vel", Twist, queue_size=1, latch=True)
+            wait_for(lambda: pub.get_num_connections() > 0 and sub.get_num_connections() > 0)
+            cmd = Twist()
+            cmd.linear.x, cmd.angular.z = 0.3, 0.1
+            pub.publish(cmd)  # the only command: every 0x111 after it is a scheduled keep-alive
+            time.sleep(2.0)
+            del stamps[:]
+            time.sleep(min(duration, 50.0))
+            sub.unregister()
+            pub.unregister()
+        finally:
+            extra.send_signal(signal.SIGINT)
+            try:
+                extra.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                extra.kill()
+    ms = [1000.0 * (b - a) for a, b in zip(stamps, stamps[1:])]
+    if len(ms) < 10:
+        raise RuntimeError("too few cmd_vel_out messages to measure the keep-alive")
+    deviation = [abs(m - 20.0) for m in ms]
+    return {"intervals": len(ms), "topics_subscribed": topics,
+            "period_ms_mean": round(statistics.mean(ms), 3),
+            **{f"deviation_p{p}_ms": round(percentile(deviation, p), 3) for p in (50, 90, 99)},
+            "deviation_max_ms": round(max(deviation), 3)}
+
+
+def node_params(args):
+    """_name:=value arguments -> {name: value} (values read as YAML, as rosrun does)."""
+    import yaml
+    out = {}
+    for a in args:
+        name, value = a.split(":=", 1)
+        out[name.lstrip("_")] = yaml.safe_load(value)
+    return out
+
+
+def measure_nodelet(rospy, duration, params):
+    import roslib.packages
+    from geometry_msgs.msg import Twist
+    from nodelet.srv import NodeletLoad, NodeletUnload
+    from ranger_msgs.msg import SystemState
+    exe = roslib.packages.find_node("nodelet", "nodelet")
+    if not exe:
+        raise RuntimeError("nodelet not found (libnodeletlib-tools)")
+    ns, manager_name = "perf_nodelet", "/perf_manager"
+    driver, subscriber = f"/{ns}/ranger_base_node", f"/{ns}/perf_subscriber"
+    report = tempfile.NamedTemporaryFile(prefix="ranger-perf-nodelet-", suffix=".json",
+                                         delete=False).name
+    for name, value in {"port_name": "sim", **node_params(params)}.items():
+        rospy.set_param(f"{driver}/{name}", value)
+    rospy.set_param(f"{subscriber}/report", report)
+    manager = subprocess.Popen([exe[0], "manager", f"__name:={manager_name[1:]}"],
+                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    stop, state = threading.Event(), {}
+    try:
+        rospy.wait_for_service(f"{manager_name}/load_nodelet", timeout=60)
+        load = rospy.ServiceProxy(f"{manager_name}/load_nodelet", NodeletLoad)
+        unload = rospy.ServiceProxy(f"{manager_name}/unload_nodelet", NodeletUnload)
+        for name, kind in ((driver, "ranger_base/RangerNodelet"),
+                           (subscriber, "ranger_base/PerfSubscriber")):
+            if not load(name=name, type=kind, remap_source_args=[], remap_target_args=[],
+                        my_argv=[], bond_id="").success:
+                raise RuntimeError(f"cannot load {kind}")
+        sub = rospy.Subscriber(f"/{ns}/system_state", SystemState, lambda m: state.update(m=m))
+        if not wait_for(lambda: "m" in state and state["m"].link_up
+                        and state["m"].control_mode == SystemState.CONTROL_MODE_CAN
+                        and state["m"].identification in ("", "decided")):
+            raise RuntimeError("the nodelet did not reach CAN command mode")
+        sub.unregister()
+        pub = rospy.Publisher(f"/{ns}/cmd_vel", Twist, queue_size=1)
+        cmd = Twist()
+        cmd.linear.x, cmd.angular.z = 0.4, 0.2
+
+        def teleop():
+            while not stop.is_set():
+                pub.publish(cmd)
+                time.sleep(0.05)
+        threading.Thread(target=teleop, daemon=True).start()
+        time.sleep(3.0)
+        pid = manager.pid
+        wall0, cpu0, threads0 = time.monotonic(), cpu_seconds(f"/proc/{pid}/stat"), thread_times(pid)
+        rss = []
+        while time.monotonic() - wall0 < duration:
+            rss.append(rss_kib(pid))
+            time.sleep(0.5)
+        cpu1, threads1 = cpu_seconds(f"/proc/{pid}/stat"), thread_times(pid)
+        wall = time.monotonic() - wall0
+        stop.set()
+        for name in (subscriber, driver):
+            unload(name=name)
+    finally:
+        stop.set()
+        manager.send_signal(signal.SIGINT)
+        try:
+            manager.wait(timeout=20)
+        except subprocess.TimeoutExpired:
+            manager.kill()
+    with open(report) as f:
+        rates = json.loads(f.read() or "{}")
+    os.unlink(report)
+
+    def share(seconds):
+        return round(100.0 * seconds / wall, 2)
+    threads = [{"tid": tid, "name": name, "cpu_percent": share(t1 - threads0.get(tid, ("", 0))[1])}
+               for tid, (name, t1) in threads1.items()]
+    chassis = next((t for t in threads if t["name"] == "ranger_sim"), None)
+    total = share(cpu1 - cpu0)
+    return {"duration_s": round(wall, 1), "manager_cpu_percent": total,
+            "chassis_cpu_percent": chassis and chassis["cpu_percent"],
+            "driver_cpu_percent": round(total - chassis["cpu_percent"], 2) if chassis else None,
+            "threads": sorted(threads, key=lambda t: -t["cpu_percent"]),
+            "rss_kib_median": int(statistics.median(rss)),
+            "subscriber_nodelet_messages_per_s": rates}
+
+
+def measure_fleet(rospy, duration, robots, params):
+    import math
+    import roslib.packages
+    from geometry_msgs.msg import Twist
+    from nav_msgs.msg import Odometry
+    from ranger_msgs.msg import SystemState
+    exe = roslib.packages.find_node("ranger_base", "ranger_base_node")[0]
+    names = [f"fleet{i + 1}" for i in range(robots)]
+    nodes = [subprocess.Popen([exe, f"__ns:=/{ns}", "_port_name:=sim", *params],
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+             for ns in names]
+    stop = threading.Event()
+    try:
+        states = {}
+        subs = [rospy.Subscriber(f"/{ns}/system_state", SystemState,
+                                 lambda m, ns=ns: states.__setitem__(ns, m)) for ns in names]
+        ok = wait_for(lambda: all(ns in states and states[ns].link_up and
+                                  states[ns].control_mode == SystemState.CONTROL_MODE_CAN and
+                                  states[ns].identification in ("", "decided") for ns in names),
+                      timeout=120)
+        for s in subs:
+            s.unregister()
+        if not ok:
+            raise RuntimeError("not every robot reached CAN command mode: " + ", ".join(
+                ns for ns in names if ns not in states or not states[ns].link_up))
+        pubs = [rospy.Publisher(f"/{ns}/cmd_vel", Twist, queue_size=1) for ns in names]
+        wait_for(lambda: all(p.get_num_connections() > 0 for p in pubs))
+        twists = []
+        for i in range(robots):  # each its own circle
+            t = Twist()
+            t.linear.x, t.angular.z = 0.3 + 0.02 * i, 0.1 + 0.02 * i
+            twists.append(t)
+
+        def teleop():
+            while not stop.is_set():
+                for p, t in zip(pubs, twists):
+                    p.publish(t)
+                time.sleep(0.1)
+        threading.Thread(target=teleop, daemon=True).start()
+        time.sleep(3.0)
+        pids = [n.pid for n in nodes]
+        wall0 = time.monotonic()
+        cpu0 = [cpu_seconds(f"/proc/{pid}/stat") for pid in pids]
+        threads0 = [thread_times(pid) for pid in pids]
+        rss = []
+        while time.monotonic() - wall0 < duration:
+            rss.append([rss_kib(pid) for pid in pids])
+            time.sleep(1.0)
+        cpu1 = [cpu_seconds(f"/proc/{pid}/stat") for pid in pids]
+        threads1 = [thread_times(pid) for pid in pids]
+        wall = time.monotonic() - wall0
+        stop.set()
+        time.sleep(0.2)
+        for p in pubs:
+            p.publish(Twist())  # stop, then compare at rest
+        time.sleep(2.0)
+        robots_out = []
+        for i, ns in enumerate(names):
+            odom = rospy.wait_for_message(f"/{ns}/odom", Odometry, timeout=10)
+            truth = rospy.wait_for_message(f"/{ns}/sim/ground_truth", Odometry, timeout=10)
+            o, g = odom.pose.pose, truth.pose.pose
+
+            def yaw(q):
+                return math.atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z))
+            err = math.hypot(o.position.x - g.position.x, o.position.y - g.position.y)
+            dyaw = math.degrees(abs(math.remainder(yaw(o.orientation) - yaw(g.orientation),
+                                                   2 * math.pi)))
+            chassis = next((t for t, (n, _) in threads1[i].items() if n == "ranger_sim"), None)
+            chassis_cpu = (threads1[i][chassis][1] - threads0[i].get(chassis, ("", 0))[1]
+                           if chassis else 0.0)
+            robots_out.append({
+                "ns": ns, "cpu_percent": round(100.0 * (cpu1[i] - cpu0[i]) / wall, 2),
+                "driver_cpu_percent": round(100.0 * (cpu1[i] - cpu0[i] - chassis_cpu) / wall, 2),
+                "rss_kib_median": int(statistics.median(r[i] for r in rss)),
+                "position_error_mm": round(1000.0 * err, 1), "heading_error_deg": round(dyaw, 3),
+                "ground_truth_from_origin_m": round(math.hypot(g.position.x, g.position.y), 3)})
+    finally:
+        stop.set()
+        for n in nodes:
+            n.send_signal(signal.SIGINT)
+        for n in nodes:
+            try:
+                n.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                n.kill()
+    total = sum(r["cpu_percent"] for r in robots_out)
+    return {"robots": robots, "duration_s": round(wall, 1),
+            "total_cpu_percent": round(total, 2),
+            "per_robot_cpu_percent_mean": round(total / robots, 2),
+            "per_robot_driver_cpu_percent_mean": round(
+                statistics.mean(r["driver_cpu_percent"] for r in robots_out), 2),
+            "total_rss_mib": round(sum(r["rss_kib_median"] for r in robots_out) / 1024.0, 1),
+            "per_robot": robots_out}
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--duration", type=float, default=30.0, help="load phase, s")
     parser.add_argument("--samples", type=int, default=400, help="latency samples")
     parser.add_argument("--json", help="also write the figures to this file")
+    parser.add_argument("--phases", default="load,floor,latency,keepalive,nodelet,fleet",
+                        help="which measurements, comma-separated")
+    parser.add_argument("--robots", type=int, default=10, help="fleet: how many robots")
     parser.add_argument("--node-arg", action="append", default=[],
                         help="extra node argument (both phases), e.g. _min_command_interval:=0.001")
     args = parser.parse_args()
@@ -275,12 +526,31 @@ def main():
                         if line.startswith("model name")), "unknown")
         figures = {"machine": {"cpu": cpu, "cores": os.cpu_count(), "kernel": platform.release()},
                    "date": time.strftime("%Y-%m-%d %H:%M:%S %Z"),
-                   "command": " ".join([os.path.relpath(sys.argv[0])] + sys.argv[1:]),
-                   "load": measure_load(rospy, args.duration, args.node_arg),
-                   "roscpp_floor": measure_load(rospy, args.duration, [], floor=True),
-                   "latency_cmd_vel_to_0x111": measure_latency(rospy, args.samples, args.node_arg)}
-        load, floor = figures["load"], figures["roscpp_floor"]
-        if load["driver_cpu_percent"] is not None:
+                   "command": " ".join([os.path.relpath(sys.argv[0])] + sys.argv[1:])}
+        phases = args.phases.split(",")
+        measurements = {
+            "load": ("load", lambda: measure_load(rospy, args.duration, args.node_arg)),
+            "floor": ("roscpp_floor", lambda: measure_load(rospy, args.duration, [], floor=True)),
+            "latency": ("latency_cmd_vel_to_0x111",
+                        lambda: measure_latency(rospy, args.samples, args.node_arg)),
+            "keepalive": ("keepalive_0x111",
+                          lambda: measure_keepalive(rospy, args.duration, args.node_arg)),
+            "nodelet": ("nodelet", lambda: measure_nodelet(rospy, args.duration, args.node_arg)),
+            "fleet": ("fleet", lambda: measure_fleet(rospy, args.duration, args.robots,
+                                                     args.node_arg)),
+        }
+        for phase in phases:
+            if phase not in measurements:
+                sys.exit(f"unknown phase {phase}: use {','.join(measurements)}")
+        for phase in phases:
+            key, measure = measurements[phase]
+            try:
+                figures[key] = measure()
+            except Exception as e:  # a benchmark: report what failed, measure the rest
+                figures[key] = {"error": f"{type(e).__name__}: {e}"}
+            print(f"== {phase}: {json.dumps(figures[key])[:200]}", file=sys.stderr, flush=True)
+        load, floor = figures.get("load", {}), figures.get("roscpp_floor", {})
+        if load.get("driver_cpu_percent") is not None and "cpu_percent" in floor:
             load["driver_over_floor_percent"] = round(load["driver_cpu_percent"]
                                                       - floor["cpu_percent"], 2)
     finally:

@@ -489,13 +489,19 @@ void RangerNode::publication_loop() {
     try {
       publish_sent();
       const auto now = Clock::now();
-      if (now >= next_motion_publication_ - motion_early) {
+      const bool motion_heard = motion_has_subscribers();
+      if (now >= next_motion_publication_ - motion_early && !motion_heard) {
+        // Nobody listens: nothing is built, and the thread sleeps until the states are due
+        // (which see a new subscriber within one state period).
+        waiting_for_snapshot = false;
+        advance(next_motion_publication_, motion_period, now);
+      } else if (now >= next_motion_publication_ - motion_early) {
         // Wanted before the snapshot is read: an iteration that ends meanwhile wakes us.
         snapshot_wanted_ = true;
         if (publish_motion(*driver_->snapshot())) {
           snapshot_wanted_ = false;
           waiting_for_snapshot = false;
-          if (sim_ && ground_truth_pub_) publish_ground_truth();
+          if (sim_ && ground_truth_pub_.getNumSubscribers() > 0) publish_ground_truth();
           advance(next_motion_publication_, motion_period, now);
         } else {
           waiting_for_snapshot = true;
@@ -515,7 +521,9 @@ void RangerNode::publication_loop() {
     // Until the next publication is due, a frame was sent, or (motion due) the driver's next
     // iteration.
     auto until = std::min(next_state_publication_ - state_early, next_diagnostics_publication_);
-    if (!waiting_for_snapshot) until = std::min(until, next_motion_publication_ - motion_early);
+    if (!waiting_for_snapshot && motion_has_subscribers()) {
+      until = std::min(until, next_motion_publication_ - motion_early);
+    }
     const auto wait = std::chrono::duration_cast<nanoseconds>(std::clamp<Clock::duration>(
         until - Clock::now(), Clock::duration::zero(), std::chrono::seconds(1)));
     const timespec ts{static_cast<time_t>(wait.count() / 1'000'000'000),
@@ -546,26 +554,38 @@ void RangerNode::publish_sent() {
 bool RangerNode::publish_motion(const ranger::DriverSnapshot& s) {
   // Publish only what is known: nothing while the chassis is not heard (never, or link lost),
   // and each estimate once, stamped with the time of the frames that produced it.
+  // A message is built only for a topic with a subscriber (in this process or another).
   if (!s.motion_known) return true;  // nothing to wait for
   bool published = false;
   if (s.odometry.stamp > last_odom_stamp_) {
     last_odom_stamp_ = s.odometry.stamp;
-    auto odom = boost::make_shared<nav_msgs::Odometry>(to_odometry(s.odometry, params_));
-    odom_pub_.publish(odom);
-    if (tf_pub_) {
-      auto tf = boost::make_shared<tf2_msgs::TFMessage>();
-      tf->transforms.push_back(to_transform(*odom));
-      tf_pub_.publish(tf);
+    const bool odom_heard = odom_pub_.getNumSubscribers() > 0;
+    const bool tf_heard = tf_pub_ && tf_pub_.getNumSubscribers() > 0;
+    if (odom_heard || tf_heard) {
+      auto odom = boost::make_shared<nav_msgs::Odometry>(to_odometry(s.odometry, params_));
+      if (tf_heard) {
+        auto tf = boost::make_shared<tf2_msgs::TFMessage>();
+        tf->transforms.push_back(to_transform(*odom));
+        tf_pub_.publish(tf);
+      }
+      if (odom_heard) odom_pub_.publish(odom);
     }
     published = true;
   }
   const ranger::Timestamp joints = joints_stamp(s.feedback);
   if ((s.joints.has_steering || s.joints.has_wheels) && joints > last_joints_stamp_) {
     last_joints_stamp_ = joints;
-    publish_shared(joint_state_pub_, to_joint_state(s.joints, to_ros_time(joints)));
+    publish_if_heard(joint_state_pub_,
+                     [&] { return to_joint_state(s.joints, to_ros_time(joints)); });
     published = true;
   }
   return published;
+}
+
+bool RangerNode::motion_has_subscribers() const {
+  return odom_pub_.getNumSubscribers() > 0 || joint_state_pub_.getNumSubscribers() > 0 ||
+         (tf_pub_ && tf_pub_.getNumSubscribers() > 0) ||
+         (ground_truth_pub_ && ground_truth_pub_.getNumSubscribers() > 0);
 }
 
 void RangerNode::publish_ground_truth() {

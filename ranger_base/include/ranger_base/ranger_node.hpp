@@ -103,7 +103,8 @@ class RangerNode {
   // Publishes what the snapshot has new; false if it has nothing new (wait for the next one).
   bool publish_motion(const ranger::DriverSnapshot& s);  // odom, TF, joint_states
   void publish_ground_truth();                           // sim/ground_truth
-  void publish_states();                                 // ranger_msgs states, battery, ultrasonic
+  bool motion_has_subscribers() const;  // odom, /tf, joint_states or sim/ground_truth
+  void publish_states();                // ranger_msgs states, battery, ultrasonic
   void publish_diagnostics();
   void log_state_changes(const ranger::DriverSnapshot& s);
   // The identification's decision or failure (once), settings learned while driving, each new
