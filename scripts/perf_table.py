@@ -127,6 +127,69 @@ def node():
         f"{t} {r} Hz" for t, r in load["subscribers_messages_per_s"].items()), "node")
 
 
+def keepalive():
+    """Publication off the CAN schedule
+    The 0x111 keep-alive's period while the node publishes to a subscriber on every topic it
+    advertises, two of them slow (0.2 s per message, on `odom` and `/tf`): one `cmd_vel`, then
+    every 0x111 is a scheduled one; deviation = |interval between consecutive `cmd_vel_out`
+    stamps (taken right after each send) - 20 ms|. Publication runs on a thread of the node's
+    own, so this does not depend on what is published."""
+    k = json.loads(read("node.json"))["keepalive_0x111"]
+    if "error" in k:
+        raise ValueError(k["error"])
+    for p in ("p50", "p90", "p99"):
+        v = k[f"deviation_{p}_ms"]
+        row(f"0x111 period deviation from 20 ms, {p}", f"{v} ms" + (
+            f" (max {k['deviation_max_ms']}, {k['intervals']} intervals, mean period "
+            f"{k['period_ms_mean']} ms, {k['topics_subscribed']} topics subscribed)"
+            if p == "p99" else ""), "node", "≤ 1 ms" if p == "p99" else "",
+            v <= 1.0 if p == "p99" else None)
+
+
+def nodelet():
+    """Nodelet
+    The driver as the nodelet `ranger_base/RangerNodelet` in a manager of its own, with the
+    subscriber nodelet `ranger_base/PerfSubscriber` on `odom`, `/tf` and `joint_states` in the
+    same manager (shared pointers: no serialisation, no socket); the virtual chassis's full
+    feedback, odometry at 50 Hz, `cmd_vel` at 20 Hz from another process."""
+    n = json.loads(read("node.json"))["nodelet"]
+    if "error" in n:
+        raise ValueError(n["error"])
+    cpu = n["driver_cpu_percent"]
+    row("Driver CPU (manager minus chassis thread; roscpp and the subscriber nodelet included)",
+        f"{cpu} % of one core", "node", "≤ 0.6 %", cpu is not None and cpu <= 0.6)
+    row("Manager process (driver + chassis + subscriber nodelet)",
+        f"{n['manager_cpu_percent']} % (chassis thread {n['chassis_cpu_percent']} %)", "node")
+    row("Per thread, % (name tid)", ", ".join(f"{t['name']} {t['tid']}: {t['cpu_percent']}"
+                                             for t in n["threads"] if t["cpu_percent"]), "node")
+    row("Received by the subscriber nodelet", ", ".join(
+        f"{t} {r} Hz" for t, r in n["subscriber_nodelet_messages_per_s"].items()), "node")
+
+
+def fleet():
+    """Fleet
+    Ten `ranger_base_node` processes at once, each with its own in-process virtual chassis
+    (`port_name:=sim`, protocol identified), each driven in a circle of its own by `cmd_vel` at
+    10 Hz, on this machine; no subscriber. Then each is stopped and its `odom` compared with its
+    chassis's `sim/ground_truth`."""
+    f = json.loads(read("node.json"))["fleet"]
+    if "error" in f:
+        raise ValueError(f["error"])
+    row(f"{f['robots']} robots: total CPU", f"{f['total_cpu_percent']} % of one core "
+        f"(machine: {os.cpu_count()} cores)", "node")
+    row("Per robot: CPU (mean)", f"{f['per_robot_cpu_percent_mean']} % (driver without its "
+        f"virtual chassis {f['per_robot_driver_cpu_percent_mean']} %)", "node")
+    row("Memory: total RSS", f"{f['total_rss_mib']} MiB (per robot "
+        f"{f['total_rss_mib'] / f['robots']:.1f} MiB)", "node")
+    worst = max(f["per_robot"], key=lambda r: r["position_error_mm"])
+    row("Odometry vs ground truth, worst robot", f"{worst['position_error_mm']} mm, "
+        f"{worst['heading_error_deg']} deg ({worst['ns']}, "
+        f"{worst['ground_truth_from_origin_m']} m from its start)", "node")
+    row("Per robot: CPU %, RSS MiB, position error mm", "; ".join(
+        f"{r['ns']} {r['cpu_percent']}, {r['rss_kib_median'] / 1024:.1f}, "
+        f"{r['position_error_mm']}" for r in f["per_robot"]), "node")
+
+
 def odometry():
     """Odometry error against ground truth
     The end-to-end suite on the in-process bus, per motion mode (lock-step, simulated clock:
@@ -152,5 +215,16 @@ section(codec, callgrind)
 section(control)
 section(bus)
 section(node)
+section(keepalive)
+section(nodelet)
+section(fleet)
 section(odometry)
+# The vendor comparison runs apart (a VM, ~10 minutes): its section is carried over as it is.
+previous = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "docs",
+                        "PERFORMANCE.md")
+if os.path.exists(previous):
+    text = open(previous).read()
+    m = re.search(r"^## Against the vendor's driver\n.*?(?=^## |\Z)", text, re.M | re.S)
+    if m:
+        out.extend(["", m.group(0).rstrip()])
 print("\n".join(out))
