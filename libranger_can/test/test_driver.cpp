@@ -126,6 +126,41 @@ TEST(Driver, ACommandGoesOutAtTheNextStepAndEverySendIsAnEvent) {
   EXPECT_FALSE(e.sent.shutdown);
 }
 
+// The driver thread wakes at next_due() or for its mailbox, never for a frame: the feedback that
+// arrived meanwhile is handled at the next wake-up, in one batch, at most one keep-alive period
+// late; a command is sent at the wake-up right after it was posted.
+TEST(Driver, FeedbackIsCoalescedIntoWakeUpsAtMostOneKeepAlivePeriodApart) {
+  DriverRig rig;
+  ASSERT_TRUE(rig.run_until([&] { return ready(*rig.snapshot()); }, 2s));
+  const auto period = ControllerConfig{}.keep_alive_period;
+  const Timestamp start = rig.clock().now();
+  std::size_t wakeups = 0;
+  while (rig.clock().now() < start + 1s) {  // as the driver thread runs
+    const Timestamp due = rig.driver().next_due();
+    ASSERT_LE(due - rig.clock().now(), period);
+    while (rig.clock().now() < due) {  // the chassis sends its feedback meanwhile
+      rig.clock().advance(1ms);
+      rig.sim().step(rig.clock().now());
+    }
+    rig.driver().step(rig.clock().now());
+    ++wakeups;
+    // Everything that arrived is handled now: the estimate is as recent as the feedback.
+    EXPECT_GE(rig.snapshot()->odometry.stamp, rig.clock().now() - period);
+  }
+  const auto s = rig.snapshot();
+  EXPECT_GT(s->frames.rate(protocol::kMotionFeedbackId, s->now), 40.0);
+  EXPECT_GT(s->frames.rate(protocol::kSystemStatusId, s->now), 40.0);
+  EXPECT_LE(wakeups, 55u) << "one wake-up per keep-alive period, not one per frame";
+
+  // A command does not wait for the next period: posted, it goes out at the next step.
+  const std::size_t before = rig.sent().size();
+  ASSERT_TRUE(rig.driver().command(MotionRequest{BodyTwist{0.3, 0, 0}, std::nullopt}).ok());
+  rig.driver().step(rig.clock().now());
+  ASSERT_GT(rig.sent().size(), before);
+  EXPECT_EQ(rig.sent().back().sent.frame.id, protocol::kMotionCommandId);
+  EXPECT_NEAR(rig.sent().back().sent.achieved.vx, 0.3, 1e-9);
+}
+
 TEST(Driver, StopSendsAZeroThatTheObserverSees) {
   DriverRig rig;
   ASSERT_TRUE(rig.run_until([&] { return ready(*rig.snapshot()); }, 2s));

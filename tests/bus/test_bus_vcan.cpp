@@ -194,4 +194,48 @@ TEST(SocketCanVcan, ReceiveTimestampsComeFromTheKernelNotFromTheReader) {
   EXPECT_LE(r->stamp, arrived_by);
 }
 
+// More frames than one recvmmsg() takes: every one arrives, in order, whatever the batches.
+TEST(SocketCanVcan, ABurstLongerThanOneBatchArrivesWholeAndInOrder) {
+  auto a = SocketCanBus::open("vcan0");
+  auto b = SocketCanBus::open("vcan0");
+  ASSERT_TRUE(a.ok() && b.ok()) << (a ? b.error().message : a.error().message);
+  const std::uint32_t n = 2 * SocketCanBus::kReceiveBatch + 3;
+  for (std::uint32_t i = 0; i < n; ++i)
+    ASSERT_TRUE((*a)->send(numbered(kDataId, i)).ok()) << i;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    auto r = (*b)->receive(std::chrono::seconds(20));
+    ASSERT_TRUE(r.ok()) << i << ": " << r.error().message;
+    EXPECT_EQ(sequence_of(*r), i);
+  }
+  auto none = (*b)->receive(std::chrono::seconds(0));
+  ASSERT_FALSE(none.ok());
+  EXPECT_EQ(none.error().code, Errc::kTimeout);
+  EXPECT_EQ((*b)->status().stats.rx_frames, n);
+}
+
+// Frames read in one batch before a filter change are handed out only if the new filter
+// passes them: a filter change takes effect at once, not after the buffered batch.
+TEST(SocketCanVcan, AFilterChangeAppliesToFramesAlreadyReadInABatch) {
+  auto a = SocketCanBus::open("vcan0");
+  auto b = SocketCanBus::open("vcan0");
+  auto witness = SocketCanBus::open("vcan0");
+  ASSERT_TRUE(a.ok() && b.ok() && witness.ok());
+  constexpr std::uint32_t kOtherId = protocol::kSystemStatusId;
+  for (std::uint32_t i = 0; i < 4; ++i)
+    ASSERT_TRUE((*a)->send(numbered(i % 2 ? kOtherId : kDataId, i)).ok());
+  // Delivered to every socket at once: when the witness has all four, so has b.
+  for (std::uint32_t i = 0; i < 4; ++i)
+    ASSERT_TRUE((*witness)->receive(std::chrono::seconds(20)).ok()) << i;
+  auto first = (*b)->receive(std::chrono::seconds(0));  // reads all four in one batch
+  ASSERT_TRUE(first.ok()) << first.error().message;
+  EXPECT_EQ(sequence_of(*first), 0u);
+  (*b)->set_filter({kDataId});
+  auto second = (*b)->receive(std::chrono::seconds(0));
+  ASSERT_TRUE(second.ok()) << second.error().message;
+  EXPECT_EQ(second->id, kDataId);
+  EXPECT_EQ(sequence_of(*second), 2u);
+  auto none = (*b)->receive(std::chrono::seconds(0));
+  EXPECT_FALSE(none.ok());
+}
+
 }  // namespace ranger::bus_test
