@@ -120,6 +120,20 @@ def test_model_protocol_and_commissioning_file_reach_the_node():
     assert p["/ranger_base_node/commissioning_file"] == "/etc/ranger/commissioned.yaml"
 
 
+def test_nodelet_manager_loads_the_driver_as_a_nodelet_with_the_same_parameters():
+    """nodelet_manager:=NAME: the same node name (so the same private parameters), started as
+    `nodelet load ranger_base/RangerNodelet NAME`; empty: the executable."""
+    def command(*args):  # without roslaunch's leading VAR=value assignments
+        words = roslaunch(["--args", "/ranger_base_node"], "ranger_minimal.launch", *args).split()
+        return [w for w in words if "=" not in w or w.startswith("__")]
+    args = command("nodelet_manager:=/manager")
+    assert os.path.basename(args[0]) == "nodelet", args
+    assert args[1:4] == ["load", "ranger_base/RangerNodelet", "/manager"], args
+    assert os.path.basename(command()[0]) == "ranger_base_node"
+    assert params("ranger_minimal.launch", "nodelet_manager:=/manager") == params(
+        "ranger_minimal.launch")
+
+
 def test_sim_variant_is_the_in_process_virtual_chassis():
     assert params("ranger_minimal.launch", "sim:=true", "sim_variant:=spin_cw")[
         "/ranger_base_node/port_name"] == "sim:spin_cw"
