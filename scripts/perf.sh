@@ -12,7 +12,8 @@
 # (in-process loopback), the e2e odometry figures (lock-step, simulated clock) and
 # ranger_base/scripts/measure_performance.py. Builds the benchmarks in build/perf, a Release
 # build of its own (figures never depend on how build/lib is configured), and the node with
-# scripts/build.sh ros. About 2 minutes of measuring; RANGER_JOBS sets the build jobs (2).
+# scripts/build.sh ros. About 5 minutes of measuring; RANGER_JOBS sets the build jobs (2).
+# RANGER_PERF_NOTE: a line for the header (e.g. what else ran on the machine meanwhile).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -80,6 +81,7 @@ fi
   echo "| Load average (1, 5, 15 min) | $(cat $raw/loadavg) at the start," \
     "$(cut -d' ' -f1-3 /proc/loadavg) at the end |"
   echo "| Builds | benchmarks: $out (Release); node: install/ (\`scripts/build.sh ros\`) |"
+  [ -z "${RANGER_PERF_NOTE:-}" ] || echo "| Note | $RANGER_PERF_NOTE |"
   /usr/bin/python3 scripts/perf_table.py $raw
 } >$raw/PERFORMANCE.md
 mv $raw/PERFORMANCE.md docs/PERFORMANCE.md

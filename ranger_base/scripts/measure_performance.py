@@ -18,7 +18,8 @@ process, as in real use, so the node serialises and sends those messages at 50 H
   3. keepalive: the 0x111 keep-alive's period with a subscriber on every topic the node
      advertises (and two slow ones, 0.2 s per message, on odom and /tf): one twist, then no
      command for --duration s (cmd_vel_timeout 60 s), so that every 0x111 is a scheduled one;
-     deviation = |interval between consecutive cmd_vel_out stamps - 20 ms|.
+     deviation = |interval between consecutive cmd_vel_out stamps - 20 ms|. keepalive_fifo: the
+     same with the driver thread under SCHED_FIFO 50 (chrt; root), as on a busy robot computer.
   4. nodelet: the driver as a nodelet (ranger_base/RangerNodelet) in a manager of its own, with
      the subscriber nodelet ranger_base/PerfSubscriber on odom, /tf and joint_states in the same
      manager (no serialisation), cmd_vel at 20 Hz: CPU of the manager process and its threads.
@@ -27,7 +28,7 @@ process, as in real use, so the node serialises and sends those messages at 50 H
      compared with its chassis's ground truth (sim/ground_truth).
 
   ranger_base/scripts/measure_performance.py [--duration 30] [--samples 400] [--json FILE]
-      [--phases load,floor,latency,keepalive,nodelet,fleet] [--robots 10]
+      [--phases load,floor,latency,keepalive,keepalive_fifo,nodelet,fleet] [--robots 10]
 
 Needs a built and sourced workspace (ranger_base_node findable by rospack).
 """
@@ -274,10 +275,17 @@ rospy.spin()
 """
 
 
-def measure_keepalive(rospy, duration, params):
+def measure_keepalive(rospy, duration, params, fifo=False):
+    """fifo: the driver thread under SCHED_FIFO 50 (`chrt`, needs root), as a robot whose
+    computer runs other work would run it; otherwise at the default priority."""
     from geometry_msgs.msg import Twist, TwistStamped
-    ns, stamps = "perf_keepalive", []
-    with Robot(rospy, ns, ["_publish_cmd:=true", "_cmd_vel_timeout:=60", *params]):
+    ns, stamps = "perf_keepalive_fifo" if fifo else "perf_keepalive", []
+    with Robot(rospy, ns, ["_publish_cmd:=true", "_cmd_vel_timeout:=60", *params]) as robot:
+        if fifo:
+            tids = [t for t, (name, _) in thread_times(robot.node.pid).items()
+                    if name in CAN_THREADS]
+            if not tids or subprocess.run(["chrt", "-f", "-p", "50", str(tids[0])]).returncode:
+                raise RuntimeError("cannot put the driver thread under SCHED_FIFO (root?)")
         extra = subprocess.Popen([sys.executable, "-c", ALL_SUBSCRIBERS, ns],
                                  stdout=subprocess.PIPE, text=True)
         try:
@@ -501,7 +509,8 @@ def main():
     parser.add_argument("--duration", type=float, default=30.0, help="load phase, s")
     parser.add_argument("--samples", type=int, default=400, help="latency samples")
     parser.add_argument("--json", help="also write the figures to this file")
-    parser.add_argument("--phases", default="load,floor,latency,keepalive,nodelet,fleet",
+    parser.add_argument("--phases",
+                        default="load,floor,latency,keepalive,keepalive_fifo,nodelet,fleet",
                         help="which measurements, comma-separated")
     parser.add_argument("--robots", type=int, default=10, help="fleet: how many robots")
     parser.add_argument("--node-arg", action="append", default=[],
@@ -535,6 +544,9 @@ def main():
                         lambda: measure_latency(rospy, args.samples, args.node_arg)),
             "keepalive": ("keepalive_0x111",
                           lambda: measure_keepalive(rospy, args.duration, args.node_arg)),
+            "keepalive_fifo": ("keepalive_0x111_fifo",
+                               lambda: measure_keepalive(rospy, args.duration, args.node_arg,
+                                                         fifo=True)),
             "nodelet": ("nodelet", lambda: measure_nodelet(rospy, args.duration, args.node_arg)),
             "fleet": ("fleet", lambda: measure_fleet(rospy, args.duration, args.robots,
                                                      args.node_arg)),
