@@ -7,6 +7,7 @@
 // complete from the remote's own driving. Lock-step under a ManualClock (1 ms: the chassis, then
 // the driver); no threads, no sleeping. Prints "[remote-odometry] ..." per segment and
 // "[remote-identification] ..." with the simulated time the identification took.
+#include <optional>
 #include <string>
 #include <vector>
 
