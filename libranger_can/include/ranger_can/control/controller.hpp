@@ -107,7 +107,7 @@ struct ControllerConfig {
   bool auto_command_mode = true;  // request CAN command mode by itself (at start-up)
   // shutdown() also hands control back: 0x421 standby after the stop (`ranger_can commission`).
   bool release_control_on_shutdown = false;
-  bool auto_reclaim_after_remote = false;  // the old behaviour: reclaim after remote hands back
+  bool auto_reclaim_after_remote = false;  // re-arm by itself when the remote hands back
   bool listen_only = false;                // never send anything (monitoring, log replay)
   std::chrono::nanoseconds link_timeout = std::chrono::milliseconds(100);
   std::chrono::nanoseconds control_mode_retry_period = std::chrono::milliseconds(100);

@@ -1,5 +1,5 @@
 // Identification: which protocol settings a chassis speaks, decided from its own frames before
-// anything moves (issue 15).
+// anything moves.
 //
 // ChassisIdentifier is pure and clock-free, like the controller: the owner feeds every received
 // frame (on_frame) and the time (tick), reads what to command (request()) and the result
