@@ -62,6 +62,7 @@ class RemoteRig {
   std::shared_ptr<const DriverSnapshot> driver() { return driver_->snapshot(); }
   Timestamp now() const { return clock_.now(); }
   double wheel_radius() const { return wheel_radius_; }
+  void rearm() { driver_->resume(); }
   // While the driver has not decided its settings: did it publish an odometry step?
   std::uint64_t steps_before_decision() const { return steps_before_decision_; }
 
@@ -205,6 +206,132 @@ INSTANTIATE_TEST_SUITE_P(LockStep, RemoteDriving,
                                            Case{"mini_v1", OdometrySource::kMotion}),
                          [](const ::testing::TestParamInfo<Case>& p) {
                            return p.param.variant + "_" + std::string(to_string(p.param.source));
+                         });
+
+}  // namespace
+}  // namespace ranger::variants
+
+namespace ranger::variants {
+namespace {
+
+// Under `protocol auto`, a chassis under its remote from the first frame: the identification
+// listens, then learns the 0x271 reading from the remote's own driving (the rigid-body fit of
+// steered rolling wheels, or the spin position) and says what it still lacks for commanding (the
+// 0x111 readings, probed at standstill once CAN command mode is granted). Until the wheels'
+// reading is decided nothing is published; from then on the odometry holds the budget. When the
+// operator hands back (SWB up), the probe runs at standstill and the identification decides,
+// the pose kept.
+struct AutoCase {
+  std::string variant;
+  // What the operator drives first: "arc" (Ackermann, steered) or "spin" at once, or "idle_arc"
+  // (the arc after 15 s at rest).
+  const char* first;
+};
+void PrintTo(const AutoCase& c, std::ostream* os) { *os << c.variant << " (" << c.first << ")"; }
+
+class RemoteIdentification : public ::testing::TestWithParam<AutoCase> {};
+
+TEST_P(RemoteIdentification, CompletesFromTheRemotesDrivingAndTheOdometryHolds) {
+  const AutoCase& c = GetParam();
+  DriverConfig config = driver_config_for(c.variant, OdometrySource::kWheels);
+  config.protocol = ProtocolChoice::kAuto;
+  ASSERT_TRUE(config.validate().ok()) << config.validate().error().message;
+  RemoteRig rig(c.variant, config);
+  const Timestamp boot = rig.now();
+  if (std::string(c.first) == "idle_arc") {
+    // The operator waits: the wheels stand straight, nothing tells their reading; nothing is
+    // published, and the identification says what it lacks (and does not time out).
+    rig.run_for(15s);
+    const auto idle = rig.driver();
+    EXPECT_EQ(idle->odometry.steps, 0u);
+    EXPECT_FALSE(idle->joints.has_steering);
+    EXPECT_EQ(idle->identification->phase, IdentificationPhase::kAwaitingControl);
+    EXPECT_NE(idle->identification->message.find("not known yet"), std::string::npos)
+        << idle->identification->message;
+  }
+  const Timestamp driving = rig.now();
+  // The operator drives.
+  const RemoteSegment first = std::string(c.first) == "spin"
+                                  ? RemoteSegment{"spin", "top", 0.0, -0.5, MotionMode::kSpin, 3}
+                                  : RemoteSegment{"arc", "top", 0.2, -0.3, MotionMode::kAckermann, 3};
+  rig.remote(std::string("remote swd ") + first.swd);
+  rig.remote("remote sticks " + std::to_string(first.left) + " " + std::to_string(first.right));
+  std::optional<Timestamp> wheels_known;
+  ASSERT_TRUE(rig.run_until(
+      [&] {
+        const auto s = rig.driver();
+        if (s->odometry.steps > 0 && !wheels_known) wheels_known = rig.now();
+        return wheels_known.has_value();
+      },
+      30s))
+      << c.variant << ": the identification never learned the wheels' reading under the remote: "
+      << rig.driver()->identification->message;
+  const auto s = rig.driver();
+  ASSERT_TRUE(s->identification);
+  // Not decided (nothing was probed), and it says what it lacks.
+  EXPECT_EQ(s->identification->phase, IdentificationPhase::kAwaitingControl);
+  EXPECT_NE(s->identification->message.find("remote"), std::string::npos)
+      << s->identification->message;
+  EXPECT_NE(s->identification->message.find("steering_unit_111"), std::string::npos)
+      << s->identification->message;
+  EXPECT_EQ(s->profile.steering_unit_271, s->identification->profile.steering_unit_271);
+  std::printf(
+      "[remote-identification] variant=%s first=%s wheels_known_after=%.3f s from boot, %.3f s "
+      "of driving (simulated)\n",
+      c.variant.c_str(), c.first, seconds(*wheels_known - boot), seconds(*wheels_known - driving));
+  std::fflush(stdout);
+  rig.remote("remote sticks 0 0");
+  ASSERT_TRUE(rig.run_until([&] { return rig.chassis().speed == 0.0; }, 5s));
+  // From here on the odometry holds the budget in every mode.
+  const std::string label = "variant=" + c.variant + " source=wheels protocol=auto";
+  for (const RemoteSegment& seg : remote_route())
+    drive_segment(rig, label, seg);
+  // Still not decided, still refusing nothing it would have to guess; no failure either (the
+  // remote in charge is not a timeout).
+  EXPECT_EQ(rig.driver()->identification->phase, IdentificationPhase::kAwaitingControl);
+  // SWB up: CAN command mode. The probe waits for the commander's re-arm (the remote's stop is
+  // latched), then runs at standstill and decides, the pose kept.
+  const Pose2D before = rig.driver()->odometry.pose;
+  rig.remote("remote can");
+  rig.run_for(3s);
+  EXPECT_EQ(rig.driver()->identification->phase, IdentificationPhase::kAwaitingControl);
+  EXPECT_NE(rig.driver()->identification->message.find("re-arm"), std::string::npos)
+      << rig.driver()->identification->message;
+  rig.rearm();
+  const Timestamp rearmed = rig.now();
+  ASSERT_TRUE(rig.run_until([&] { return rig.driver()->identification->decided_ok(); }, 15s))
+      << "phase " << to_string(rig.driver()->identification->phase) << ": "
+      << rig.driver()->identification->message << "; chassis control mode "
+      << protocol::to_string(rig.chassis().control_mode) << ", refusal "
+      << to_string(rig.driver()->controller.refusal);
+  std::printf("[remote-identification] variant=%s decided %.3f s after the re-arm (simulated)\n",
+              c.variant.c_str(), seconds(rig.now() - rearmed));
+  const Pose2D after = rig.driver()->odometry.pose;
+  EXPECT_NEAR(after.x, before.x, 1e-3);
+  EXPECT_NEAR(after.y, before.y, 1e-3);
+  // What the probe decides is the chassis's (the rest keeps the revision's preset, as ever).
+  const ProtocolProfile& got = rig.driver()->profile;
+  const ProtocolProfile want = driver_config_for(c.variant, OdometrySource::kWheels).controller.profile;
+  EXPECT_EQ(got.steering_unit_111, want.steering_unit_111);
+  EXPECT_EQ(got.steering_sign_111, want.steering_sign_111);
+  EXPECT_EQ(got.steering_unit_221, want.steering_unit_221);
+  EXPECT_EQ(got.steering_sign_221, want.steering_sign_221);
+  EXPECT_EQ(got.steering_unit_271, want.steering_unit_271);
+  EXPECT_EQ(got.steering_sign_271, want.steering_sign_271);
+  EXPECT_EQ(got.steering_reference, want.steering_reference);
+}
+
+INSTANTIATE_TEST_SUITE_P(LockStep, RemoteIdentification,
+                         ::testing::Values(AutoCase{"manual", "arc"}, AutoCase{"manual", "spin"},
+                                           AutoCase{"agx_v2", "arc"}, AutoCase{"agx_v2", "spin"},
+                                           AutoCase{"mini_v1", "arc"}, AutoCase{"mini_v1", "spin"},
+                                           AutoCase{"steer_left_positive", "arc"},
+                                           AutoCase{"inner_angle", "spin"},
+                                           AutoCase{"manual", "idle_arc"},
+                                           AutoCase{"agx_v2", "idle_arc"},
+                                           AutoCase{"mini_v1", "idle_arc"}),
+                         [](const ::testing::TestParamInfo<AutoCase>& p) {
+                           return p.param.variant + "_" + p.param.first;
                          });
 
 }  // namespace
