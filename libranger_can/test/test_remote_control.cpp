@@ -245,11 +245,16 @@ TEST(RemoteControl, BadInputIsRefusedByName) {
     const char* line;
     const char* says;
   } cases[] = {
-      {"remote sticks nan 0", "LEFT"},       {"remote sticks 0 inf", "RIGHT"},
-      {"remote sticks 1.5 0", "outside"},    {"remote sticks 0 -1.01", "outside"},
-      {"remote sticks 0.5", "usage"},        {"remote sticks x y", "not a number"},
-      {"remote swd middle", "top|bottom"},   {"remote swd left", "unknown position 'left'"},
-      {"remote swc sideways", "top|middle|bottom"}, {"remote swa", "usage"},
+      {"remote sticks nan 0", "LEFT"},
+      {"remote sticks 0 inf", "RIGHT"},
+      {"remote sticks 1.5 0", "outside"},
+      {"remote sticks 0 -1.01", "outside"},
+      {"remote sticks 0.5", "usage"},
+      {"remote sticks x y", "not a number"},
+      {"remote swd middle", "top|bottom"},
+      {"remote swd left", "unknown position 'left'"},
+      {"remote swc sideways", "top|middle|bottom"},
+      {"remote swa", "usage"},
       {"remote fly", "expected on|can|off|lost|swa|swc|swd|sticks"},
   };
   for (const auto& c : cases) {

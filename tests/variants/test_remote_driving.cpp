@@ -135,8 +135,7 @@ Figures drive_segment(RemoteRig& rig, const std::string& label, const RemoteSegm
   for (std::size_t i = 0; i < kWheelCount; ++i) {
     EXPECT_NEAR(during->joints.steering_position[i], moving.wheels[i].angle, 1.5e-3)
         << "wheel " << i;
-    EXPECT_NEAR(during->joints.wheel_velocity[i] * rig.wheel_radius(), moving.wheels[i].speed,
-                2e-3)
+    EXPECT_NEAR(during->joints.wheel_velocity[i] * rig.wheel_radius(), moving.wheels[i].speed, 2e-3)
         << "wheel " << i;
   }
   rig.remote("remote sticks 0 0");
@@ -227,7 +226,9 @@ struct AutoCase {
   // (the arc after 15 s at rest).
   const char* first;
 };
-void PrintTo(const AutoCase& c, std::ostream* os) { *os << c.variant << " (" << c.first << ")"; }
+void PrintTo(const AutoCase& c, std::ostream* os) {
+  *os << c.variant << " (" << c.first << ")";
+}
 
 class RemoteIdentification : public ::testing::TestWithParam<AutoCase> {};
 
@@ -251,9 +252,10 @@ TEST_P(RemoteIdentification, CompletesFromTheRemotesDrivingAndTheOdometryHolds) 
   }
   const Timestamp driving = rig.now();
   // The operator drives.
-  const RemoteSegment first = std::string(c.first) == "spin"
-                                  ? RemoteSegment{"spin", "top", 0.0, -0.5, MotionMode::kSpin, 3}
-                                  : RemoteSegment{"arc", "top", 0.2, -0.3, MotionMode::kAckermann, 3};
+  const RemoteSegment first =
+      std::string(c.first) == "spin"
+          ? RemoteSegment{"spin", "top", 0.0, -0.5, MotionMode::kSpin, 3}
+          : RemoteSegment{"arc", "top", 0.2, -0.3, MotionMode::kAckermann, 3};
   rig.remote(std::string("remote swd ") + first.swd);
   rig.remote("remote sticks " + std::to_string(first.left) + " " + std::to_string(first.right));
   std::optional<Timestamp> wheels_known;
@@ -311,7 +313,8 @@ TEST_P(RemoteIdentification, CompletesFromTheRemotesDrivingAndTheOdometryHolds) 
   EXPECT_NEAR(after.y, before.y, 1e-3);
   // What the probe decides is the chassis's (the rest keeps the revision's preset, as ever).
   const ProtocolProfile& got = rig.driver()->profile;
-  const ProtocolProfile want = driver_config_for(c.variant, OdometrySource::kWheels).controller.profile;
+  const ProtocolProfile want =
+      driver_config_for(c.variant, OdometrySource::kWheels).controller.profile;
   EXPECT_EQ(got.steering_unit_111, want.steering_unit_111);
   EXPECT_EQ(got.steering_sign_111, want.steering_sign_111);
   EXPECT_EQ(got.steering_unit_221, want.steering_unit_221);

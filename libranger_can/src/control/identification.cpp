@@ -693,7 +693,7 @@ bool ChassisIdentifier::judge_spin_position(const std::string& context, bool qui
     return true;
   }
   if (!quiet_if_unclear) {
-    note(context + " inconclusive: 0x271 " + (plain ? values_text(*plain) : std::string("?")) +
+    note("spin check inconclusive: 0x271 " + (plain ? values_text(*plain) : std::string("?")) +
          " fits no reading of the spin position " + deg(std::fabs(expected[0])) +
          " (best residual " + deg(rank.best_residual) + ")");
   }

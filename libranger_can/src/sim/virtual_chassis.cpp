@@ -330,9 +330,9 @@ void VirtualChassis::set_remote_swa(protocol::RemoteSwitch position) {
   if (position == remote_.swa) return;
   remote_.swa = position;
   event("remote SWA " + std::string(protocol::to_string(position)) +
-        (control_mode_ != ControlMode::kRemote
-             ? " (no effect: SWB is not in remote position)"
-             : position == protocol::RemoteSwitch::kDown ? ": lights off" : ": lights as set"));
+        (control_mode_ != ControlMode::kRemote       ? " (no effect: SWB is not in remote position)"
+         : position == protocol::RemoteSwitch::kDown ? ": lights off"
+                                                     : ": lights as set"));
 }
 
 void VirtualChassis::set_remote_swc(protocol::RemoteSwitch position) {

@@ -95,7 +95,7 @@ struct RemoteInput {
   protocol::RemoteSwitch swa = protocol::RemoteSwitch::kUp;  // lights: up on, down off
   protocol::RemoteSwitch swc = protocol::RemoteSwitch::kUp;  // middle: ultrasonic avoidance on
   protocol::RemoteSwitch swd = protocol::RemoteSwitch::kUp;  // up: Ackermann + spin; down: oblique
-  double left = 0.0;   // left stick, -1..1: + forward, - back
+  double left = 0.0;                                         // left stick, -1..1: + forward, - back
   double right = 0.0;  // right stick, -1..1: + pushed right, - pushed left
 };
 
@@ -147,7 +147,7 @@ struct ChassisSnapshot {
   bool lights_off_by_remote = false;  // SWA down under the remote: 0x231 reports both lights off
   RemoteInput remote;                 // the remote control's switches and sticks
   MotionTarget target;                // REP-103
-  double speed = 0.0;   // model speed (see MotionTarget)
+  double speed = 0.0;                 // model speed (see MotionTarget)
   double steering = 0.0;
   BodyTwist twist;
   WheelStates wheels{};
