@@ -214,27 +214,37 @@ TEST(RemoteControl, ReportsSwitchesAndSticksIn0x241AndSwaSwitchesTheLights) {
   EXPECT_EQ(rc->stick_left_v, 50);
   EXPECT_EQ(rc->stick_right_h, -25);
   EXPECT_TRUE(h.snap().ultrasonic_enabled);  // SWC middle
-  // The lights, set on by the host earlier, go off with SWA down under the remote.
-  LightCommand on;
-  on.enable = true;
-  on.front_mode = protocol::LightMode::kOn;
-  on.rear_mode = protocol::LightMode::kOn;
+  // The lights (chassis_lights.hpp): under the remote SWA decides, bottom = both off, top = both
+  // on; what the host set over CAN comes back when the remote hands back.
+  LightCommand custom;
+  custom.enable = true;
+  custom.front_mode = protocol::LightMode::kCustom;
+  custom.front_custom = 40;
+  custom.rear_mode = protocol::LightMode::kOff;
   h.apply("remote can");
-  auto f = encode(on, h.profile);
+  auto f = encode(custom, h.profile);
   ASSERT_TRUE(f.ok());
   h.chassis.on_frame(*f, h.t);
+  h.advance(50ms);
+  EXPECT_EQ(h.last<LightState>(protocol::kLightStateId)->front_mode, protocol::LightMode::kCustom);
   h.apply("remote on");
   h.advance(50ms);
   EXPECT_EQ(h.last<LightState>(protocol::kLightStateId)->front_mode, protocol::LightMode::kOn);
   h.apply("remote swa bottom");
   h.advance(50ms);
-  EXPECT_TRUE(h.snap().lights_off_by_remote);
+  EXPECT_EQ(h.snap().lights.front_mode, protocol::LightMode::kOff);
   EXPECT_EQ(h.last<LightState>(protocol::kLightStateId)->front_mode, protocol::LightMode::kOff);
   EXPECT_EQ(h.last<LightState>(protocol::kLightStateId)->rear_mode, protocol::LightMode::kOff);
   EXPECT_EQ(h.last<RemoteControlState>(protocol::kRemoteControlStateId)->swa, RemoteSwitch::kDown);
   h.apply("remote swa top");
   h.advance(50ms);
   EXPECT_EQ(h.last<LightState>(protocol::kLightStateId)->front_mode, protocol::LightMode::kOn);
+  EXPECT_EQ(h.last<LightState>(protocol::kLightStateId)->rear_mode, protocol::LightMode::kOn);
+  h.apply("remote swa bottom");
+  h.apply("remote can");
+  h.advance(50ms);
+  EXPECT_EQ(h.last<LightState>(protocol::kLightStateId)->front_mode, protocol::LightMode::kCustom);
+  EXPECT_EQ(h.last<LightState>(protocol::kLightStateId)->front_custom, 40);
   h.apply("remote swc top");
   EXPECT_FALSE(h.snap().ultrasonic_enabled);
 }

@@ -22,7 +22,7 @@ const char* const kChassisCommandHelp =
     "                           steer right by the max Ackermann (top) or oblique (bottom)\n"
     "                           angle at 1, or with LEFT centred spin clockwise at the max spin\n"
     "                           wheel speed; the chassis drives them while the remote has control\n"
-    "  remote swa top|bottom    lights: bottom = off (under the remote only), top = as set\n"
+    "  remote swa top|bottom    lights under the remote: bottom = both off, top = both on\n"
     "  remote swc top|middle|bottom  middle = ultrasonic obstacle avoidance on, else off\n"
     "  estop on|off             press / release the emergency stop\n"
     "  error BIT|NAME [on|off]  raise (default) or drop a 0x211 error bit: 0-31 or its name,\n"
@@ -35,6 +35,7 @@ const char* const kChassisCommandHelp =
     "  ultrasonic N|all MM      distance of sensor N (1-8) or all sensors, mm (-1..-4: codes)\n"
     "  ultrasonic on|off        obstacle avoidance, as the remote's SWC switch sets it\n"
     "  pose X Y YAW             move the ground truth (m, m, rad)\n"
+    "  version TEXT             the firmware version the chassis answers 0x4A1 with (agx_v2)\n"
     "  status                   print the chassis state\n";
 
 namespace {
@@ -109,14 +110,15 @@ std::string describe_chassis(const sim::ChassisSnapshot& s) {
   out += std::string(", remote SWA ") + position(s.remote.swa) + " SWC " + position(s.remote.swc) +
          " SWD " + position(s.remote.swd) + " sticks (" + fixed(s.remote.left, 2) + ", " +
          fixed(s.remote.right, 2) + ")";
-  if (s.lights_off_by_remote) out += ", lights off by the remote";
+  out += ", lights " + describe_lights(s.lights);
   if (s.silent) out += ", SILENT";
   return out;
 }
 
 Result<ChassisAction> parse_chassis_command(std::string_view line) {
   const auto w = split(line);
-  if (w.empty() || w[0][0] == '#') return ChassisAction([](VirtualChassis&) { return std::string(); });
+  if (w.empty() || w[0][0] == '#')
+    return ChassisAction([](VirtualChassis&) { return std::string(); });
   const std::string& cmd = w[0];
   auto need = [&](std::size_t n, const char* form) -> Status {
     if (w.size() != n) return usage("usage: " + std::string(form));
@@ -239,6 +241,21 @@ Result<ChassisAction> parse_chassis_command(std::string_view line) {
     if (!n) return n.error();
     return act([n = static_cast<int>(*n), raw](VirtualChassis& c) { c.set_ultrasonic(n, raw); });
   }
+  if (cmd == "version") {
+    // The rest of the line, as typed (inner spaces kept).
+    const std::string_view rest = line.substr(line.find("version") + 7);
+    const auto first = rest.find_first_not_of(" \t");
+    const auto last = rest.find_last_not_of(" \t\r\n");
+    if (first == std::string_view::npos) return usage("usage: version TEXT");
+    std::string text(rest.substr(first, last - first + 1));
+    if (text.size() > 64) return usage("version: at most 64 characters");
+    for (char ch : text) {
+      if (static_cast<unsigned char>(ch) < 0x20 || static_cast<unsigned char>(ch) > 0x7E) {
+        return usage("version: printable ASCII only");
+      }
+    }
+    return act([text](VirtualChassis& c) { c.set_version(text); });
+  }
   if (cmd == "pose") {
     if (auto s = need(4, "pose X Y YAW"); !s) return s.error();
     auto x = parse_double("pose X", w[1]);
@@ -266,9 +283,9 @@ Result<std::string> apply_chassis_command(std::string_view line, VirtualChassis&
 }
 
 const std::vector<std::string>& chassis_command_names() {
-  static const std::vector<std::string> names = {"remote",  "estop", "error",      "clear",
-                                                 "battery", "silent", "garbage", "stuck",
-                                                 "ultrasonic", "pose", "status"};
+  static const std::vector<std::string> names = {"remote",     "estop",  "error",   "clear",
+                                                 "battery",    "silent", "garbage", "stuck",
+                                                 "ultrasonic", "pose",   "version", "status"};
   return names;
 }
 

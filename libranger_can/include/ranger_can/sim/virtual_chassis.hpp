@@ -27,6 +27,12 @@
 //    CAN mode (a host that only switched modes has not lost anything); the bit describes the link,
 //    so it clears when 0x111 resumes (that 0x111 is obeyed) or on 0x441 code 0x00, which also
 //    disarms the watchdog until the next 0x111.
+//  * Park (agx_v2 mode 3) and side slip (MINI V1 mode 3, agx_v2 mode 4) are modes like the others
+//    (chassis_model.hpp). A 0x141 park is obeyed only at standstill (reading); while parked a
+//    0x111 keeps the watchdog fed and moves nothing. In side slip 0x111's lateral speed is read
+//    from bytes 4-5 with the spin sign (the MINI V1's negated field), and 0x221 reports it in
+//    bytes 0-1, left positive, with 90 deg as the angle (reading).
+//  * Lights: chassis_lights.hpp (0x121 in CAN mode, the remote's SWA while it has the chassis).
 //  * 0x141 starts a switch: the body brakes to rest, then the wheels turn for
 //    `mode_switch_duration`; meanwhile 0x291 reports the mode being left with switching = 1 and
 //    speed commands are ignored. A 0x141 naming the current mode changes nothing.
@@ -51,7 +57,7 @@
 //    sticks ask for is switched to as 0x141 would (brake to rest, turn the wheels), and the
 //    chassis drives the same model as under 0x111, so 0x221/0x271/0x281/0x291 report it as they
 //    report CAN driving. SWA down under the remote switches the lights off (0x231 reports both
-//    lights off), up gives them back to what 0x121 set;
+//    lights off), up on (ChassisLights);
 //    SWC in the middle enables the ultrasonic obstacle avoidance, up or down disables it. 0x241
 //    (vendor_frames) reports the switches and the sticks (int8, +-100 = full deflection; stick
 //    up and stick right positive).
@@ -75,6 +81,7 @@
 #include <vector>
 
 #include "ranger_can/control/geometry.hpp"
+#include "ranger_can/sim/chassis_lights.hpp"
 #include "ranger_can/sim/chassis_model.hpp"
 #include "ranger_can/sim/drivetrain_model.hpp"
 #include "ranger_can/transport/bus.hpp"
@@ -144,7 +151,6 @@ struct ChassisSnapshot {
   std::string motion_refused_reason;  // empty when allowed
   bool silent = false;
   bool ultrasonic_enabled = false;
-  bool lights_off_by_remote = false;  // SWA down under the remote: 0x231 reports both lights off
   RemoteInput remote;                 // the remote control's switches and sticks
   MotionTarget target;                // REP-103
   double speed = 0.0;                 // model speed (see MotionTarget)
@@ -155,6 +161,7 @@ struct ChassisSnapshot {
   double distance_travelled = 0.0;  // m, path length of the body centre since boot
   double yaw_travelled = 0.0;       // rad, total |rotation| since boot
   BatteryTelemetry battery;
+  LightState lights;  // what 0x231 reports (agx_v2 only sends it)
 };
 
 struct VirtualChassisCounters {
@@ -229,6 +236,9 @@ class VirtualChassis {
   void set_remote_sticks(double left, double right);
   const RemoteInput& remote() const { return remote_; }
   void set_pose(const Pose2D& pose) { motion_.set_pose(pose); }
+  // The 0x4A1 answer from now on (vendor_frames only).
+  void set_version(std::string version) { config_.version = std::move(version); }
+  const ChassisLights& lights() const { return lights_; }
 
  private:
   struct Schedule {
@@ -250,10 +260,6 @@ class VirtualChassis {
   void drive_by_remote();
   protocol::MotionMode remote_mode() const;
   MotionTarget remote_target() const;
-  bool lights_off_by_remote() const {
-    return control_mode_ == protocol::ControlMode::kRemote &&
-           remote_.swa == protocol::RemoteSwitch::kDown;
-  }
   void event(std::string text);
 
   void handle_motion_command(const MotionCommand& cmd);
@@ -292,8 +298,8 @@ class VirtualChassis {
   std::uint32_t last_reported_errors_ = 0;
   std::uint8_t status_counter_ = 0;  // 0x211 byte 7 under agx16: +1 per frame
   std::uint8_t vendor_counter_ = 0;  // 0x231 / 0x241 byte 7: +1 per frame
-  LightCommand lights_;              // what the last 0x121 set (reported in 0x231)
-  RemoteInput remote_;
+  ChassisLights lights_;             // what 0x231 reports (0x121, the remote's SWA)
+  RemoteInput remote_;               // the remote control's switches and sticks
   std::string last_refusal_;
 
   VirtualChassisCounters counters_;
