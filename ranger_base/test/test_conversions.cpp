@@ -165,12 +165,13 @@ TEST(SystemState, ReclaimBlockedSteerFirstAndBelowMinimumAreSaid) {
 TEST(SystemState, IdentifyingAndImplausibleAreSaidWithTheirReasons) {
   ranger::DriverSnapshot snap;
   auto& c = snap.controller;
-  // Listening: nothing sent, the controller deaf on purpose: "identifying", not "link_lost".
-  c.refusal = ranger::MotionRefusal::kLinkLost;
+  // Listening: nothing sent, the controller deaf on purpose: the library says "identifying".
+  c.refusal = ranger::MotionRefusal::kIdentifying;
   c.quiet = true;
-  c.identifying = "identifying the chassis: listening (0.4 s of 1.2 s)";
+  c.identifying = ranger::IdentificationPhase::kListening;
   snap.protocol = ranger::ProtocolChoice::kAuto;
   snap.identification = ranger::IdentificationStatus{};
+  snap.identification->message = "identifying the chassis: listening (0.4 s of 1.2 s)";
   auto state = to_system_state(snap, ros::Time(1.0));
   EXPECT_EQ(state.motion_inhibited_reason, "identifying");
   EXPECT_NE(state.motion_inhibited_detail.find("listening (0.4 s of 1.2 s)"), std::string::npos)
@@ -182,12 +183,13 @@ TEST(SystemState, IdentifyingAndImplausibleAreSaidWithTheirReasons) {
   c.quiet = false;
   c.link = ranger::LinkState::kConnected;
   c.refusal = ranger::MotionRefusal::kIdentifying;
-  c.identifying = "identifying the chassis: steering probe";
+  c.identifying = ranger::IdentificationPhase::kSteerProbe;
+  snap.identification->message = "identifying the chassis: steering probe";
   state = to_system_state(snap, ros::Time(1.0));
   EXPECT_EQ(state.motion_inhibited_reason, "identifying");
   EXPECT_EQ(state.motion_inhibited_detail, "identifying the chassis: steering probe");
   // A plausibility stop names the setting and the value to try.
-  c.identifying.clear();
+  c.identifying.reset();
   c.refusal = ranger::MotionRefusal::kImplausible;
   c.implausible_reason = "spin_sign: try cw (turns the other way)";
   snap.protocol = ranger::ProtocolChoice::kForced;
@@ -204,12 +206,13 @@ TEST(SystemState, IdentifyingAndImplausibleAreSaidWithTheirReasons) {
 
 // Every refusal has its words (the switch in describe_refusal is exhaustive: -Wswitch).
 TEST(SystemState, EveryRefusalIsDescribed) {
-  ranger::ControllerState c;
+  ranger::DriverSnapshot snap;
+  ranger::ControllerState& c = snap.controller;
   c.link = ranger::LinkState::kConnected;
   for (int r = static_cast<int>(ranger::MotionRefusal::kLinkLost);
        r <= static_cast<int>(ranger::MotionRefusal::kIdentifying); ++r) {
     c.refusal = static_cast<ranger::MotionRefusal>(r);
-    EXPECT_FALSE(describe_refusal(c).empty()) << ranger::to_string(c.refusal);
+    EXPECT_FALSE(describe_refusal(snap).empty()) << ranger::to_string(c.refusal);
     EXPECT_EQ(refusal_name(c), std::string(ranger::to_string(c.refusal)));
   }
 }

@@ -351,10 +351,20 @@ void ChassisController::set_implausible(std::string reason) {
   update_faults();
 }
 
-void ChassisController::set_identifying(std::string reason) {
-  if (reason == state_.identifying) return;
-  state_.identifying = std::move(reason);
-  if (state_.identifying.empty()) {
+void ChassisController::set_identifying(std::optional<IdentificationPhase> phase) {
+  if (phase == state_.identifying) return;
+  state_.identifying = phase;
+  if (!state_.identifying && !state_.standstill_probe) {
+    probe_mode_.reset();
+    state_.probe.reset();
+  }
+  command_changed_ = true;
+}
+
+void ChassisController::set_standstill_probe(bool active) {
+  if (active == state_.standstill_probe) return;
+  state_.standstill_probe = active;
+  if (!state_.identifying && !state_.standstill_probe) {
     probe_mode_.reset();
     state_.probe.reset();
   }
@@ -513,6 +523,9 @@ void ChassisController::run_ultrasonic(Timestamp now) {
 
 MotionRefusal ChassisController::evaluate_refusal() const {
   const StopCauses active = state_.active_causes;
+  const bool identifying = state_.identifying.has_value() || state_.standstill_probe;
+  // Listening: the driver withholds every frame on purpose, so the link is not what is missing.
+  if (state_.quiet && identifying) return MotionRefusal::kIdentifying;
   if (state_.link != LinkState::kConnected) return MotionRefusal::kLinkLost;
   if (has(active, StopCause::kRemote)) return MotionRefusal::kRemote;
   if (has(active, StopCause::kEstop)) return MotionRefusal::kEstop;
@@ -523,7 +536,7 @@ MotionRefusal ChassisController::evaluate_refusal() const {
   if (state_.latched_causes != 0) return MotionRefusal::kRearmRequired;
   if (state_.control_mode != ControlMode::kCan) return MotionRefusal::kStandby;
   if (!state_.motion_mode) return MotionRefusal::kModeUnknown;
-  if (!state_.identifying.empty()) return MotionRefusal::kIdentifying;
+  if (identifying) return MotionRefusal::kIdentifying;
   if (state_.cmd_timed_out) return MotionRefusal::kCmdTimeout;
   if (selector_.below_minimum(state_.requested.twist)) return MotionRefusal::kBelowMinimum;
   return MotionRefusal::kNone;
@@ -571,7 +584,8 @@ void ChassisController::run_motion(Timestamp now) {
   MotionRefusal refusal = evaluate_refusal();
   // A switch that failed goes on retrying at its bounded rate (it stops nothing else).
   // The identification's probe: zero speed, a steering angle, possibly in another mode.
-  const bool probing = refusal == MotionRefusal::kIdentifying && state_.probe.has_value();
+  const bool probing = refusal == MotionRefusal::kIdentifying && state_.probe.has_value() &&
+                       state_.motion_mode.has_value() && !state_.quiet;
   const bool may_drive =
       ((refusal == MotionRefusal::kNone || refusal == MotionRefusal::kModeSwitchFailed) &&
        state_.has_command) ||

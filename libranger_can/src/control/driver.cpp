@@ -58,6 +58,30 @@ std::string hex2(std::uint8_t v) {
 
 }  // namespace
 
+std::string_view to_string(RequestOutcome::Kind k) {
+  switch (k) {
+    case RequestOutcome::Kind::kClearErrors:
+      return "clear_errors";
+    case RequestOutcome::Kind::kUltrasonic:
+      return "ultrasonic";
+    case RequestOutcome::Kind::kResume:
+      return "resume";
+  }
+  return "unknown";
+}
+
+std::string RequestOutcome::what() const {
+  switch (kind) {
+    case Kind::kClearErrors:
+      return "clear_errors " + hex2(code);
+    case Kind::kUltrasonic:
+      return std::string("ultrasonic ") + (enable ? "on" : "off");
+    case Kind::kResume:
+      break;
+  }
+  return std::string(to_string(kind));
+}
+
 std::string_view to_string(RequestOutcome::State s) {
   switch (s) {
     case RequestOutcome::State::kPending:
@@ -106,13 +130,7 @@ struct Driver::Mail {
   bool zero_seen = false;                // a zero twist came before the latest (it re-arms)
   std::optional<std::optional<protocol::MotionMode>> mode;
   std::optional<std::optional<StandstillProbe>> probe;
-  struct Action {
-    enum Kind { kClearErrors, kUltrasonic, kResume } kind;
-    std::uint64_t id;
-    std::uint8_t code;
-    bool enable;
-  };
-  std::vector<Action> actions;
+  std::vector<RequestOutcome> actions;  // requests to carry out, in order
 };
 
 Driver::Driver(DriverConfig config, std::shared_ptr<BusSource> source, const Clock& clock)
@@ -190,14 +208,17 @@ void Driver::set_motion_mode(std::optional<protocol::MotionMode> mode) {
   wake();
 }
 
-RequestOutcome& Driver::add_request(std::string what) {
+std::uint64_t Driver::add_request(RequestOutcome::Kind kind, std::uint8_t code, bool enable) {
   RequestOutcome r;
   r.id = next_request_id_++;
-  r.what = std::move(what);
-  requests_.push_back(std::move(r));
+  r.kind = kind;
+  r.code = code;
+  r.enable = enable;
+  requests_.push_back(r);
   while (requests_.size() > kMaxRequests)
     requests_.pop_front();
-  return requests_.back();
+  mail_->actions.push_back(r);
+  return r.id;
 }
 
 Result<std::uint64_t> Driver::clear_errors(std::uint8_t code) {
@@ -209,8 +230,7 @@ Result<std::uint64_t> Driver::clear_errors(std::uint8_t code) {
   std::uint64_t id = 0;
   {
     std::lock_guard<std::mutex> lock(mail_mutex_);
-    id = add_request("clear_errors " + hex2(code)).id;
-    mail_->actions.push_back({Mail::Action::kClearErrors, id, code, false});
+    id = add_request(RequestOutcome::Kind::kClearErrors, code);
   }
   wake();
   return id;
@@ -220,8 +240,7 @@ std::uint64_t Driver::set_ultrasonic(bool enable) {
   std::uint64_t id = 0;
   {
     std::lock_guard<std::mutex> lock(mail_mutex_);
-    id = add_request(std::string("ultrasonic ") + (enable ? "on" : "off")).id;
-    mail_->actions.push_back({Mail::Action::kUltrasonic, id, 0, enable});
+    id = add_request(RequestOutcome::Kind::kUltrasonic, 0, enable);
   }
   wake();
   return id;
@@ -239,8 +258,7 @@ std::uint64_t Driver::resume() {
   std::uint64_t id = 0;
   {
     std::lock_guard<std::mutex> lock(mail_mutex_);
-    id = add_request("resume").id;
-    mail_->actions.push_back({Mail::Action::kResume, id, 0, false});
+    id = add_request(RequestOutcome::Kind::kResume);
   }
   wake();
   return id;
@@ -303,7 +321,7 @@ void Driver::try_open(Timestamp now) {
     identifier_.emplace(config_.identification, config_.controller.geometry,
                         config_.identify_revision, source_->read_only());
     controller_->set_quiet(true);
-    controller_->set_identifying("identifying the chassis: listening");
+    controller_->set_identifying(IdentificationPhase::kListening);
   }
   std::lock_guard<std::mutex> lock(mail_mutex_);
   opened_once_ = true;
@@ -349,16 +367,16 @@ void Driver::apply_mail(Timestamp now) {
     }
     controller_->set_command(*mail.command, now);
   }
-  for (const Mail::Action& a : mail.actions) {
+  for (const RequestOutcome& a : mail.actions) {
     Status st = ok_status();
     switch (a.kind) {
-      case Mail::Action::kClearErrors:
+      case RequestOutcome::Kind::kClearErrors:
         st = controller_->clear_errors(a.code, now);
         break;
-      case Mail::Action::kUltrasonic:
+      case RequestOutcome::Kind::kUltrasonic:
         st = controller_->set_ultrasonic(a.enable, now);
         break;
-      case Mail::Action::kResume:
+      case RequestOutcome::Kind::kResume:
         // The operator takes a plausibility stop on: the monitors start over (and trip again
         // if the mismatch persists).
         if (!applied_stop_.empty()) {
@@ -376,7 +394,7 @@ void Driver::apply_mail(Timestamp now) {
       if (!st) {
         r.state = RequestOutcome::State::kFailed;
         r.message = st.error().message;
-      } else if (a.kind == Mail::Action::kResume) {
+      } else if (a.kind == RequestOutcome::Kind::kResume) {
         r.state = RequestOutcome::State::kAnswered;
         r.message = "re-armed";
       } else {
@@ -392,7 +410,7 @@ void Driver::update_requests(Timestamp now) {
   std::lock_guard<std::mutex> lock(mail_mutex_);
   for (RequestOutcome& r : requests_) {
     if (r.state != RequestOutcome::State::kSent) continue;
-    if (r.what.rfind("clear_errors", 0) == 0) {
+    if (r.kind == RequestOutcome::Kind::kClearErrors) {
       if (status && status->received >= r.sent + kAnswerDelay) {
         r.state = RequestOutcome::State::kAnswered;
         r.error_word = c.error_bits;
@@ -404,8 +422,8 @@ void Driver::update_requests(Timestamp now) {
         r.message = "the chassis did not answer (no 0x211) within " +
                     std::to_string(seconds(config_.request_answer_timeout)) + " s";
       }
-    } else if (r.what.rfind("ultrasonic", 0) == 0) {
-      const bool want = r.what == "ultrasonic on";
+    } else if (r.kind == RequestOutcome::Kind::kUltrasonic) {
+      const bool want = r.enable;
       if (c.ultrasonic_failed) {
         r.state = RequestOutcome::State::kFailed;
         r.message = "the chassis did not confirm the ultrasonic setting (0x45A)";
@@ -508,20 +526,20 @@ void Driver::run_identification(Timestamp now) {
     use_profile(st.profile);
     controller_->set_probe(std::nullopt, std::nullopt);
     controller_->set_quiet(false);
-    controller_->set_identifying("");
+    controller_->set_identifying(std::nullopt);
     return;
   }
   if (st.phase == IdentificationPhase::kFailed) {
     // At rest, and saying why: the refusal stays, with the message naming what to set.
     controller_->set_probe(std::nullopt, std::nullopt);
-    controller_->set_identifying(st.message);
+    controller_->set_identifying(IdentificationPhase::kFailed);
     return;
   }
   const IdentificationRequest r = identifier_->request();
   if (r.profile) use_profile(*r.profile);
   controller_->set_quiet(r.quiet);
   controller_->set_probe(r.mode, r.probe);
-  controller_->set_identifying(st.message);
+  controller_->set_identifying(st.phase);
 }
 
 void Driver::run_standstill_probe() {
@@ -529,16 +547,12 @@ void Driver::run_standstill_probe() {
   if (probe_) {
     MotionCommand c;
     c.steering_angle = interpretation::manual_from_rep103_command_steering(probe_->steering);
-    char what[96];
-    std::snprintf(what, sizeof what, "standstill probe: %s, %.1f deg",
-                  std::string(protocol::to_string(probe_->mode)).c_str(),
-                  probe_->steering * 180.0 / M_PI);
-    controller_->set_identifying(what);
+    controller_->set_standstill_probe(true);
     controller_->set_probe(probe_->mode, c);
     probe_active_ = true;
   } else if (probe_active_) {
     controller_->set_probe(std::nullopt, std::nullopt);
-    controller_->set_identifying("");
+    controller_->set_standstill_probe(false);
     probe_active_ = false;
   }
 }

@@ -706,7 +706,7 @@ struct ScenarioRunner::Impl {
         text = "outcome unknown (no longer tracked)";
       } else if (r->state == RequestOutcome::State::kAnswered ||
                  r->state == RequestOutcome::State::kFailed) {
-        text = r->what + " " + std::string(to_string(r->state));
+        text = r->what() + " " + std::string(to_string(r->state));
         if (!r->message.empty()) text += ": " + r->message;
       } else {
         return false;

@@ -80,15 +80,21 @@ struct DriverConfig {
 
 // What became of a request posted through the mailbox.
 struct RequestOutcome {
+  enum class Kind { kClearErrors, kUltrasonic, kResume };
   enum class State { kPending, kSent, kAnswered, kFailed };
   std::uint64_t id = 0;
-  std::string what;  // "clear_errors 0x00", "ultrasonic on", "resume"
+  Kind kind = Kind::kResume;
+  std::uint8_t code = 0;  // kClearErrors: the 0x441 code
+  bool enable = false;    // kUltrasonic: on (true) or off
   State state = State::kPending;
   std::string message;  // why it failed, or what the answer was
   // clear_errors: the 0x211 error word the chassis reported after it received the 0x441.
   std::optional<std::uint32_t> error_word;
   Timestamp sent{0};  // driver clock
+
+  std::string what() const;  // "clear_errors 0x00", "ultrasonic on", "resume"
 };
+std::string_view to_string(RequestOutcome::Kind k);   // "clear_errors", "ultrasonic", "resume"
 std::string_view to_string(RequestOutcome::State s);  // "pending", "sent", "answered", "failed"
 
 // A zero-speed probe at standstill (`ranger_can commission`): the wheels stand in `mode` at
@@ -181,8 +187,8 @@ class Driver {
   std::uint64_t set_ultrasonic(bool enable);
   // Also clears a plausibility stop (the operator takes it on): the monitors start over.
   std::uint64_t resume();
-  // While set (after the identification, if any): speed is refused (kIdentifying, "standstill
-  // probe ...") and the probe is commanded; nullopt ends it.
+  // While set (after the identification, if any): speed is refused (kIdentifying, with
+  // ControllerState::standstill_probe) and the probe is commanded; nullopt ends it.
   void standstill_probe(std::optional<StandstillProbe> probe);
 
   // Blocks the calling thread until request `id` is answered or failed, or `timeout` passes
@@ -213,7 +219,8 @@ class Driver {
   void update_requests(Timestamp now);
   void publish(Timestamp now);
   void deliver_events();
-  RequestOutcome& add_request(std::string what);  // mail lock held
+  // Records a request and posts it to the driver thread (mail lock held).
+  std::uint64_t add_request(RequestOutcome::Kind kind, std::uint8_t code = 0, bool enable = false);
 
   const DriverConfig config_;
   const std::shared_ptr<BusSource> source_;
