@@ -144,21 +144,21 @@ TEST(SystemState, ReArmNamesTheLatchedCausesAndWhatToDo) {
 }
 
 TEST(SystemState, ReclaimBlockedSteerFirstAndBelowMinimumAreSaid) {
-  ranger::ControllerState c;
+  ranger::DriverSnapshot snap;
+  ranger::ControllerState& c = snap.controller;
   c.link = ranger::LinkState::kConnected;
   c.refusal = ranger::MotionRefusal::kStandby;
   c.reclaim_blocked = true;
-  EXPECT_EQ(describe_refusal(c), "remote control had the chassis: call resume to take CAN control");
+  EXPECT_EQ(describe_refusal(snap),
+            "remote control had the chassis: call resume to take CAN control");
   c.reclaim_blocked = false;
   c.refusal = ranger::MotionRefusal::kBelowMinimum;
-  EXPECT_NE(describe_refusal(c).find("below_minimum"), std::string::npos);
+  EXPECT_NE(describe_refusal(snap).find("below_minimum"), std::string::npos);
   c.refusal = ranger::MotionRefusal::kNone;
-  EXPECT_EQ(describe_refusal(c), "");
+  EXPECT_EQ(describe_refusal(snap), "");
   c.steer_first_factor = 0.25;
-  EXPECT_NE(describe_refusal(c).find("steering first"), std::string::npos);
-  EXPECT_NE(describe_refusal(c).find("25 %"), std::string::npos) << describe_refusal(c);
-  ranger::DriverSnapshot snap;
-  snap.controller = c;
+  EXPECT_NE(describe_refusal(snap).find("steering first"), std::string::npos);
+  EXPECT_NE(describe_refusal(snap).find("25 %"), std::string::npos) << describe_refusal(snap);
   EXPECT_FLOAT_EQ(to_system_state(snap, ros::Time(1.0)).steer_first_factor, 0.25f);
 }
 
