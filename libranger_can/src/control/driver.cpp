@@ -56,7 +56,74 @@ std::string hex2(std::uint8_t v) {
   return std::string("0x") + digits[v >> 4] + digits[v & 0xF];
 }
 
+double axis(std::int8_t raw) {
+  return std::clamp(raw / protocol::kRemoteAxisFullScale, -1.0, 1.0);
+}
+
+std::string light_text(protocol::LightMode mode, std::uint8_t brightness) {
+  std::string out(protocol::to_string(mode));
+  if (mode == protocol::LightMode::kCustom) out += " " + std::to_string(brightness);
+  return out;
+}
+
+bool lights_match(const LightsState& s, const LightsRequest& r) {
+  auto same = [](protocol::LightMode m1, std::uint8_t b1, protocol::LightMode m2, std::uint8_t b2) {
+    return m1 == m2 && (m1 != protocol::LightMode::kCustom || b1 == b2);
+  };
+  return same(s.front, s.front_brightness, r.front, r.front_brightness) &&
+         same(s.rear, s.rear_brightness, r.rear, r.rear_brightness);
+}
+
 }  // namespace
+
+std::string_view to_string(VendorFrames v) {
+  switch (v) {
+    case VendorFrames::kUnknown:
+      return "unknown";
+    case VendorFrames::kPresent:
+      return "present";
+    case VendorFrames::kAbsent:
+      return "absent";
+  }
+  return "unknown";
+}
+
+std::string_view to_string(FirmwareVersion::State s) {
+  switch (s) {
+    case FirmwareVersion::State::kNotAsked:
+      return "not_asked";
+    case FirmwareVersion::State::kAsked:
+      return "asked";
+    case FirmwareVersion::State::kAnswered:
+      return "answered";
+    case FirmwareVersion::State::kUnanswered:
+      return "unanswered";
+    case FirmwareVersion::State::kUnsupported:
+      return "unsupported";
+  }
+  return "unknown";
+}
+
+RemoteState remote_state_from(const RemoteControlState& rc, Timestamp received) {
+  RemoteState r;
+  r.swa = rc.swa;
+  r.swb = rc.swb;
+  r.swc = rc.swc;
+  r.swd = rc.swd;
+  r.left_vertical = axis(rc.stick_left_v);
+  r.left_horizontal = axis(rc.stick_left_h);
+  r.right_vertical = axis(rc.stick_right_v);
+  r.right_horizontal = axis(rc.stick_right_h);
+  r.knob = axis(rc.var_a);
+  r.received = received;
+  return r;
+}
+
+std::string describe(protocol::LightMode front, std::uint8_t front_brightness,
+                     protocol::LightMode rear, std::uint8_t rear_brightness) {
+  return "front " + light_text(front, front_brightness) + ", rear " +
+         light_text(rear, rear_brightness);
+}
 
 std::string_view to_string(RequestOutcome::Kind k) {
   switch (k) {
@@ -66,20 +133,14 @@ std::string_view to_string(RequestOutcome::Kind k) {
       return "ultrasonic";
     case RequestOutcome::Kind::kResume:
       return "resume";
+    case RequestOutcome::Kind::kLights:
+      return "lights";
+    case RequestOutcome::Kind::kPark:
+      return "park";
+    case RequestOutcome::Kind::kFirmwareVersion:
+      return "firmware_version";
   }
   return "unknown";
-}
-
-std::string RequestOutcome::what() const {
-  switch (kind) {
-    case Kind::kClearErrors:
-      return "clear_errors " + hex2(code);
-    case Kind::kUltrasonic:
-      return std::string("ultrasonic ") + (enable ? "on" : "off");
-    case Kind::kResume:
-      break;
-  }
-  return std::string(to_string(kind));
 }
 
 std::string_view to_string(RequestOutcome::State s) {
@@ -110,9 +171,11 @@ Status DriverConfig::validate() const {
       if (auto p = protocol_preset(*identify_revision); !p) return p.error();
     }
   }
-  if (reconnect_interval.count() <= 0 || request_answer_timeout.count() <= 0) {
+  if (reconnect_interval.count() <= 0 || request_answer_timeout.count() <= 0 ||
+      vendor_frames_wait.count() <= 0) {
     return Error{Errc::kOutOfRange,
-                 "driver: reconnect_interval and request_answer_timeout must be > 0"};
+                 "driver: reconnect_interval, request_answer_timeout and vendor_frames_wait must "
+                 "be > 0"};
   }
   return ok_status();
 }
@@ -130,7 +193,14 @@ struct Driver::Mail {
   bool zero_seen = false;                // a zero twist came before the latest (it re-arms)
   std::optional<std::optional<protocol::MotionMode>> mode;
   std::optional<std::optional<StandstillProbe>> probe;
-  std::vector<RequestOutcome> actions;  // requests to carry out, in order
+  struct Action {
+    RequestOutcome::Kind kind;  // kClearErrors, kUltrasonic, kPark or kResume
+    std::uint64_t id;
+    std::uint8_t code;
+    bool enable;
+  };
+  std::vector<Action> actions;
+  std::vector<DriverVendorAction> vendor;  // lights, version
 };
 
 Driver::Driver(DriverConfig config, std::shared_ptr<BusSource> source, const Clock& clock)
@@ -208,17 +278,16 @@ void Driver::set_motion_mode(std::optional<protocol::MotionMode> mode) {
   wake();
 }
 
-std::uint64_t Driver::add_request(RequestOutcome::Kind kind, std::uint8_t code, bool enable) {
+RequestOutcome& Driver::add_request(RequestOutcome::Kind kind, std::string what, bool on) {
   RequestOutcome r;
   r.id = next_request_id_++;
   r.kind = kind;
-  r.code = code;
-  r.enable = enable;
-  requests_.push_back(r);
+  r.on = on;
+  r.what = std::move(what);
+  requests_.push_back(std::move(r));
   while (requests_.size() > kMaxRequests)
     requests_.pop_front();
-  mail_->actions.push_back(r);
-  return r.id;
+  return requests_.back();
 }
 
 Result<std::uint64_t> Driver::clear_errors(std::uint8_t code) {
@@ -230,7 +299,8 @@ Result<std::uint64_t> Driver::clear_errors(std::uint8_t code) {
   std::uint64_t id = 0;
   {
     std::lock_guard<std::mutex> lock(mail_mutex_);
-    id = add_request(RequestOutcome::Kind::kClearErrors, code);
+    id = add_request(RequestOutcome::Kind::kClearErrors, "clear_errors " + hex2(code)).id;
+    mail_->actions.push_back({RequestOutcome::Kind::kClearErrors, id, code, false});
   }
   wake();
   return id;
@@ -240,7 +310,10 @@ std::uint64_t Driver::set_ultrasonic(bool enable) {
   std::uint64_t id = 0;
   {
     std::lock_guard<std::mutex> lock(mail_mutex_);
-    id = add_request(RequestOutcome::Kind::kUltrasonic, 0, enable);
+    id = add_request(RequestOutcome::Kind::kUltrasonic,
+                     std::string("ultrasonic ") + (enable ? "on" : "off"), enable)
+             .id;
+    mail_->actions.push_back({RequestOutcome::Kind::kUltrasonic, id, 0, enable});
   }
   wake();
   return id;
@@ -258,7 +331,48 @@ std::uint64_t Driver::resume() {
   std::uint64_t id = 0;
   {
     std::lock_guard<std::mutex> lock(mail_mutex_);
-    id = add_request(RequestOutcome::Kind::kResume);
+    id = add_request(RequestOutcome::Kind::kResume, "resume").id;
+    mail_->actions.push_back({RequestOutcome::Kind::kResume, id, 0, false});
+  }
+  wake();
+  return id;
+}
+
+Result<std::uint64_t> Driver::set_lights(const LightsRequest& lights) {
+  if (lights.front_brightness > 100 || lights.rear_brightness > 100) {
+    return Error{Errc::kInvalidArgument, "lights: brightness is 0..100"};
+  }
+  std::uint64_t id = 0;
+  {
+    std::lock_guard<std::mutex> lock(mail_mutex_);
+    id = add_request(RequestOutcome::Kind::kLights,
+                     "lights " + describe(lights.front, lights.front_brightness, lights.rear,
+                                          lights.rear_brightness))
+             .id;
+    mail_->vendor.push_back({DriverVendorAction::Kind::kLights, id, lights});
+  }
+  wake();
+  return id;
+}
+
+std::uint64_t Driver::set_park(bool on) {
+  std::uint64_t id = 0;
+  {
+    std::lock_guard<std::mutex> lock(mail_mutex_);
+    id =
+        add_request(RequestOutcome::Kind::kPark, std::string("park ") + (on ? "on" : "off"), on).id;
+    mail_->actions.push_back({RequestOutcome::Kind::kPark, id, 0, on});
+  }
+  wake();
+  return id;
+}
+
+std::uint64_t Driver::request_firmware_version() {
+  std::uint64_t id = 0;
+  {
+    std::lock_guard<std::mutex> lock(mail_mutex_);
+    id = add_request(RequestOutcome::Kind::kFirmwareVersion, "firmware_version").id;
+    mail_->vendor.push_back({DriverVendorAction::Kind::kVersion, id, {}});
   }
   wake();
   return id;
@@ -347,7 +461,11 @@ void Driver::handle_frame(const CanFrame& frame, Timestamp now) {
     controller_->on_frame(frame, now);  // counts and records the decode error
     return;
   }
-  if (std::holds_alternative<SystemStatus>(*message)) ++status_frames_;
+  if (std::holds_alternative<SystemStatus>(*message)) {
+    ++status_frames_;
+    if (!first_status_) first_status_ = now;
+  }
+  if (std::holds_alternative<VersionResponse>(*message)) last_version_frame_ = now;
   controller_->on_message(*message, frame.stamp, now);
   odometry_.on_message(*message, frame.stamp);
   joints_.on_message(*message, frame.stamp);
@@ -367,7 +485,7 @@ void Driver::apply_mail(Timestamp now) {
     }
     controller_->set_command(*mail.command, now);
   }
-  for (const RequestOutcome& a : mail.actions) {
+  for (const Mail::Action& a : mail.actions) {
     Status st = ok_status();
     switch (a.kind) {
       case RequestOutcome::Kind::kClearErrors:
@@ -375,6 +493,9 @@ void Driver::apply_mail(Timestamp now) {
         break;
       case RequestOutcome::Kind::kUltrasonic:
         st = controller_->set_ultrasonic(a.enable, now);
+        break;
+      case RequestOutcome::Kind::kPark:
+        st = controller_->request_park(a.enable, now);
         break;
       case RequestOutcome::Kind::kResume:
         // The operator takes a plausibility stop on: the monitors start over (and trip again
@@ -402,6 +523,99 @@ void Driver::apply_mail(Timestamp now) {
       }
     }
   }
+  for (const DriverVendorAction& a : mail.vendor)
+    deferred_.push_back(a);
+}
+
+bool Driver::apply_vendor_action(const DriverVendorAction& a, Timestamp now) {
+  if (vendor_frames_ == VendorFrames::kUnknown) return false;
+  Status st = ok_status();
+  if (vendor_frames_ == VendorFrames::kAbsent) {
+    st = Error{
+        Errc::kInvalidArgument,
+        std::string(a.kind == DriverVendorAction::Kind::kLights ? "lights" : "firmware version") +
+            ": unsupported by protocol " + profile_.revision +
+            ": the chassis sends none of the vendor's frames (0x231 light state, 0x241 "
+            "remote state)"};
+  } else if (a.kind == DriverVendorAction::Kind::kLights) {
+    LightCommand c;
+    c.enable = true;
+    c.front_mode = a.lights.front;
+    c.front_custom = a.lights.front_brightness;
+    c.rear_mode = a.lights.rear;
+    c.rear_custom = a.lights.rear_brightness;
+    st = controller_->set_lights(c, now);
+    if (st) sent_lights_.emplace_back(a.id, a.lights);
+  } else {
+    st = controller_->request_version(now);
+    if (st) {
+      firmware_ = FirmwareVersion{FirmwareVersion::State::kAsked, ""};
+      version_asked_ = now;
+    }
+  }
+  std::lock_guard<std::mutex> lock(mail_mutex_);
+  for (RequestOutcome& r : requests_) {
+    if (r.id != a.id) continue;
+    r.sent = now;
+    if (!st) {
+      r.state = RequestOutcome::State::kFailed;
+      r.message = st.error().message;
+    } else {
+      r.state = RequestOutcome::State::kSent;
+    }
+  }
+  return true;
+}
+
+void Driver::update_vendor(Timestamp now) {
+  const ChassisFeedback& fb = controller_->feedback();
+  if (fb.remote_control_state) {
+    remote_ = remote_state_from(fb.remote_control_state->value, fb.remote_control_state->received);
+  }
+  if (fb.light_state) {
+    const LightState& l = fb.light_state->value;
+    lights_ = LightsState{l.enable,    l.front_mode,  l.front_custom,
+                          l.rear_mode, l.rear_custom, fb.light_state->received};
+  }
+  if (fb.light_state || fb.remote_control_state) {
+    vendor_frames_ = VendorFrames::kPresent;
+  } else if (first_status_ && now - *first_status_ >= config_.vendor_frames_wait) {
+    vendor_frames_ = VendorFrames::kAbsent;
+  }
+  // The version: asked once the chassis is heard speaking the vendor's revision, and we speak.
+  const ControllerState& c = controller_->state();
+  using VS = FirmwareVersion::State;
+  if (firmware_.state == VS::kNotAsked) {
+    if (vendor_frames_ == VendorFrames::kAbsent) {
+      firmware_.state = VS::kUnsupported;
+    } else if (vendor_frames_ == VendorFrames::kPresent && c.link == LinkState::kConnected &&
+               !c.quiet && !config_.controller.listen_only && !(source_ && source_->read_only())) {
+      if (controller_->request_version(now)) {
+        firmware_.state = VS::kAsked;
+        version_asked_ = now;
+      }
+    }
+  }
+  if (firmware_.state == VS::kAsked) {
+    firmware_.text = fb.version;
+    if (!fb.version.empty() && now - last_version_frame_ >= kAnswerDelay) {
+      firmware_.state = VS::kAnswered;
+    } else if (fb.version.empty() && now - version_asked_ > config_.request_answer_timeout) {
+      firmware_.state = VS::kUnanswered;
+    }
+  }
+  // A replayed log answers nothing, but may hold the answers of the session it recorded.
+  if (firmware_.state != VS::kAsked && !fb.version.empty()) {
+    firmware_.text = fb.version;
+    if (firmware_.state != VS::kAnswered && now - last_version_frame_ >= kAnswerDelay) {
+      firmware_.state = VS::kAnswered;
+    }
+  }
+  std::vector<DriverVendorAction> waiting;
+  for (const DriverVendorAction& a : deferred_) {
+    if (!apply_vendor_action(a, now)) waiting.push_back(a);
+  }
+  deferred_.swap(waiting);
 }
 
 void Driver::update_requests(Timestamp now) {
@@ -422,8 +636,71 @@ void Driver::update_requests(Timestamp now) {
         r.message = "the chassis did not answer (no 0x211) within " +
                     std::to_string(seconds(config_.request_answer_timeout)) + " s";
       }
+    } else if (r.kind == RequestOutcome::Kind::kLights) {
+      auto it = std::find_if(sent_lights_.begin(), sent_lights_.end(),
+                             [&](const auto& p) { return p.first == r.id; });
+      if (it == sent_lights_.end()) continue;
+      const bool fresh = lights_ && lights_->received >= r.sent + kAnswerDelay;
+      if (fresh && lights_match(*lights_, it->second)) {
+        r.state = RequestOutcome::State::kAnswered;
+        r.message = "the chassis reports " + describe(lights_->front, lights_->front_brightness,
+                                                      lights_->rear, lights_->rear_brightness);
+      } else if (now - r.sent > config_.request_answer_timeout) {
+        r.state = RequestOutcome::State::kFailed;
+        r.message = fresh ? "the chassis reports " +
+                                describe(lights_->front, lights_->front_brightness, lights_->rear,
+                                         lights_->rear_brightness) +
+                                (c.control_mode == protocol::ControlMode::kRemote
+                                     ? " (the remote control has the chassis)"
+                                     : "")
+                          : "the chassis did not report its lights (no 0x231) within " +
+                                std::to_string(seconds(config_.request_answer_timeout)) + " s";
+      }
+      if (r.state != RequestOutcome::State::kSent) sent_lights_.erase(it);
+    } else if (r.kind == RequestOutcome::Kind::kPark && r.on) {
+      const auto limit =
+          config_.controller.mode_switch_timeout * config_.controller.mode_switch_max_attempts +
+          config_.request_answer_timeout;
+      if (c.parked()) {
+        r.state = RequestOutcome::State::kAnswered;
+        r.message = "parked (0x291 reports park): motion is refused until park is released";
+      } else if (!c.park_requested) {
+        r.state = RequestOutcome::State::kFailed;
+        r.message = "park was released before the chassis reported it";
+      } else if (now - r.sent > limit) {
+        r.state = RequestOutcome::State::kFailed;
+        r.message = "the chassis did not report park (0x291) within " +
+                    std::to_string(seconds(limit)) + " s" +
+                    (c.refusal != MotionRefusal::kParked
+                         ? std::string(" (") + std::string(to_string(c.refusal)) + ")"
+                         : std::string());
+      }
+    } else if (r.kind == RequestOutcome::Kind::kPark) {
+      if (c.park_requested) {
+        r.state = RequestOutcome::State::kFailed;
+        r.message = "park was requested again";
+      } else if (c.chassis_mode != protocol::MotionMode::kPark) {
+        r.state = RequestOutcome::State::kAnswered;
+        r.message = "park released: motion allowed";
+      } else if (now - r.sent > config_.controller.mode_switch_timeout *
+                                        config_.controller.mode_switch_max_attempts +
+                                    config_.request_answer_timeout) {
+        r.state = RequestOutcome::State::kAnswered;
+        r.message =
+            "park released: motion allowed (the chassis still reports park; the next "
+            "motion switches it out)";
+      }
+    } else if (r.kind == RequestOutcome::Kind::kFirmwareVersion) {
+      if (firmware_.state == FirmwareVersion::State::kAnswered) {
+        r.state = RequestOutcome::State::kAnswered;
+        r.message = firmware_.text;
+      } else if (firmware_.state == FirmwareVersion::State::kUnanswered) {
+        r.state = RequestOutcome::State::kFailed;
+        r.message = "the chassis did not answer the version request (0x4A1) within " +
+                    std::to_string(seconds(config_.request_answer_timeout)) + " s";
+      }
     } else if (r.kind == RequestOutcome::Kind::kUltrasonic) {
-      const bool want = r.enable;
+      const bool want = r.on;
       if (c.ultrasonic_failed) {
         r.state = RequestOutcome::State::kFailed;
         r.message = "the chassis did not confirm the ultrasonic setting (0x45A)";
@@ -457,6 +734,10 @@ void Driver::publish(Timestamp now) {
   if (identifier_) s->identification = identifier_->status();
   s->plausibility = monitor_.status();
   s->loop_iterations = loop_iterations_;
+  s->vendor_frames = vendor_frames_;
+  s->remote = remote_;
+  s->lights = lights_;
+  s->firmware = firmware_;
   {
     std::lock_guard<std::mutex> lock(mail_mutex_);
     s->requests.assign(requests_.begin(), requests_.end());
@@ -490,6 +771,7 @@ void Driver::step(Timestamp now) {
     apply_mail(now);
     run_identification(now);
     run_standstill_probe();
+    update_vendor(now);
     controller_->tick(now);
     run_plausibility(now);
     update_requests(now);
@@ -518,12 +800,29 @@ void Driver::use_profile(const ProtocolProfile& profile, bool reset_odometry) {
   monitor_.set_profile(profile);
 }
 
+ProtocolProfile Driver::with_configured_settings(const IdentificationStatus& st) const {
+  // What the identification kept from its revision's preset, the configured profile (a model's
+  // own readings: the MINI V1's mode numbering, spin field and sign) has a better value for,
+  // when it is of the same revision.
+  ProtocolProfile p = st.profile;
+  const ProtocolProfile& configured = config_.controller.profile;
+  if (configured.revision != p.revision) return p;
+  for (const ProfileSetting& setting : profile_settings()) {
+    const bool decided =
+        std::any_of(st.decided.begin(), st.decided.end(),
+                    [&](const IdentifiedSetting& d) { return d.name == setting.name; });
+    if (decided) continue;
+    if (auto v = get_setting(configured, setting.name)) set_setting(p, setting.name, *v);
+  }
+  return p;
+}
+
 void Driver::run_identification(Timestamp now) {
   if (!identifier_ || identifier_->status().done()) return;
   identifier_->tick(now);
   const IdentificationStatus& st = identifier_->status();
   if (st.decided_ok()) {
-    use_profile(st.profile);
+    use_profile(with_configured_settings(st));
     controller_->set_probe(std::nullopt, std::nullopt);
     controller_->set_quiet(false);
     controller_->set_identifying(std::nullopt);
@@ -567,7 +866,7 @@ void Driver::run_plausibility(Timestamp now) {
   // Auto: a setting the identification could not decide at rest is learned here. The stop stays
   // latched (a zero twist or resume re-arms); the cause itself is gone with the setting.
   if (identifier_ && identifier_->adopt(stop->setting, stop->try_value, stop->detail)) {
-    use_profile(identifier_->status().profile, /*reset_odometry=*/false);
+    use_profile(with_configured_settings(identifier_->status()), /*reset_odometry=*/false);
     controller_->set_implausible("");
     applied_stop_.clear();
   }

@@ -26,6 +26,7 @@ const char* const kChassisCommandHelp =
     "  ultrasonic N|all MM      distance of sensor N (1-8) or all sensors, mm (-1..-4: codes)\n"
     "  ultrasonic on|off        obstacle avoidance, as the remote's SWC switch sets it\n"
     "  pose X Y YAW             move the ground truth (m, m, rad)\n"
+    "  version TEXT             the firmware version the chassis answers 0x4A1 with (agx_v2)\n"
     "  status                   print the chassis state\n";
 
 namespace {
@@ -92,13 +93,15 @@ std::string describe_chassis(const sim::ChassisSnapshot& s) {
   for (std::size_t i = 0; i < names.size(); ++i)
     out += (i ? "," : "") + names[i];
   out += s.motion_allowed ? ", motion allowed" : ", motion refused: " + s.motion_refused_reason;
+  out += ", lights " + describe_lights(s.lights);
   if (s.silent) out += ", SILENT";
   return out;
 }
 
 Result<ChassisAction> parse_chassis_command(std::string_view line) {
   const auto w = split(line);
-  if (w.empty() || w[0][0] == '#') return ChassisAction([](VirtualChassis&) { return std::string(); });
+  if (w.empty() || w[0][0] == '#')
+    return ChassisAction([](VirtualChassis&) { return std::string(); });
   const std::string& cmd = w[0];
   auto need = [&](std::size_t n, const char* form) -> Status {
     if (w.size() != n) return usage("usage: " + std::string(form));
@@ -195,6 +198,21 @@ Result<ChassisAction> parse_chassis_command(std::string_view line) {
     if (!n) return n.error();
     return act([n = static_cast<int>(*n), raw](VirtualChassis& c) { c.set_ultrasonic(n, raw); });
   }
+  if (cmd == "version") {
+    // The rest of the line, as typed (inner spaces kept).
+    const std::string_view rest = line.substr(line.find("version") + 7);
+    const auto first = rest.find_first_not_of(" \t");
+    const auto last = rest.find_last_not_of(" \t\r\n");
+    if (first == std::string_view::npos) return usage("usage: version TEXT");
+    std::string text(rest.substr(first, last - first + 1));
+    if (text.size() > 64) return usage("version: at most 64 characters");
+    for (char ch : text) {
+      if (static_cast<unsigned char>(ch) < 0x20 || static_cast<unsigned char>(ch) > 0x7E) {
+        return usage("version: printable ASCII only");
+      }
+    }
+    return act([text](VirtualChassis& c) { c.set_version(text); });
+  }
   if (cmd == "pose") {
     if (auto s = need(4, "pose X Y YAW"); !s) return s.error();
     auto x = parse_double("pose X", w[1]);
@@ -222,9 +240,9 @@ Result<std::string> apply_chassis_command(std::string_view line, VirtualChassis&
 }
 
 const std::vector<std::string>& chassis_command_names() {
-  static const std::vector<std::string> names = {"remote",  "estop", "error",      "clear",
-                                                 "battery", "silent", "garbage", "stuck",
-                                                 "ultrasonic", "pose", "status"};
+  static const std::vector<std::string> names = {"remote",     "estop",  "error",   "clear",
+                                                 "battery",    "silent", "garbage", "stuck",
+                                                 "ultrasonic", "pose",   "version", "status"};
   return names;
 }
 

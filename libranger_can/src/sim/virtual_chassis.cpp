@@ -32,6 +32,8 @@ constexpr std::uint8_t kBmsUnderVoltage = protocol::bms_status::kUnderVoltage;
 
 constexpr double kLowBatteryCutoffSoc = 10.0;   // manual: under 10 % the drivers lose power
 constexpr double kLowBatteryWarningSoc = 15.0;  // manual: under 15 % the lights flash
+// Reading: a 0x141 park is obeyed when the body is slower than this (m/s).
+constexpr double kParkStandstillSpeed = 0.01;
 constexpr std::size_t kMaxEvents = 1000;
 
 std::string names_of(std::uint32_t bits, ErrorWordLayout layout) {
@@ -217,6 +219,7 @@ std::string VirtualChassis::refusal_reason() const {
     return "critical error: " + names_of(errors, layout);
   }
   if (motion_.switching()) return "switching motion mode";
+  if (motion_.mode() == MotionMode::kPark) return "parked";
   return {};
 }
 
@@ -321,7 +324,10 @@ void VirtualChassis::on_frame(const CanFrame& frame, Timestamp now) {
     if (!clear_errors(m->code)) ++counters_.frames_ignored;
   }
   if (auto* m = std::get_if<UltrasonicSettingCommand>(&msg)) handle_ultrasonic_setting(*m);
-  if (auto* m = std::get_if<LightCommand>(&msg)) lights_ = *m;
+  if (auto* m = std::get_if<LightCommand>(&msg)) {
+    lights_.command(*m);
+    if (lights_.take_changed()) event("lights: " + describe_lights(lights_.report()) + " (0x121)");
+  }
   update_conditions(now_);
   apply_motion_policy();
 }
@@ -340,7 +346,14 @@ void VirtualChassis::handle_motion_command(const MotionCommand& cmd) {
   const MotionMode mode = motion_.mode();
   const ProtocolProfile& p = config_.profile;
   const VehicleGeometry& g = motion_.geometry();
-  if (mode == MotionMode::kSpin) {
+  if (mode == MotionMode::kPark) {  // parked: 0x111 keeps the link, it moves nothing
+    ++counters_.frames_ignored;
+    return;
+  }
+  if (mode == MotionMode::kSideSlip) {
+    // Reading (MINI V1): the lateral speed is the spin field of bytes 4-5, with the spin sign.
+    commanded_ = {interpretation::spin_ccw_from_wire(cmd.spin_speed, p), 0.0};
+  } else if (mode == MotionMode::kSpin) {
     // Only the profile's spin field moves the chassis; the other one is ignored.
     const double wheel_speed =
         p.spin_field == SpinField::kYawRate
@@ -377,11 +390,12 @@ void VirtualChassis::handle_motion_mode(const MotionModeCommand& cmd) {
     event("0x141 with unknown motion mode " + std::to_string(cmd.mode_raw) + " ignored");
     return;
   }
-  if (cmd.mode != MotionMode::kAckermann && cmd.mode != MotionMode::kOblique &&
-      cmd.mode != MotionMode::kSpin) {
+  // Park only at standstill (reading: the wheels cannot lock a rolling chassis); a 0x141 park
+  // while moving is ignored.
+  if (cmd.mode == MotionMode::kPark && !motion_.switching() && motion_.mode() != cmd.mode &&
+      std::abs(motion_.speed()) > kParkStandstillSpeed) {
     ++counters_.frames_ignored;
-    event("0x141 motion mode " + std::string(protocol::to_string(cmd.mode)) +
-          " is not simulated: ignored");
+    event("0x141 park ignored: the chassis is moving");
     return;
   }
   if (motion_.begin_mode_switch(cmd.mode, seconds(config_.mode_switch_duration))) {
@@ -404,6 +418,8 @@ void VirtualChassis::set_control_mode(ControlMode mode, const std::string& why) 
   event("control mode " + std::string(protocol::to_string(control_mode_)) + " -> " +
         std::string(protocol::to_string(mode)) + " (" + why + ")");
   control_mode_ = mode;
+  lights_.set_remote(mode == ControlMode::kRemote, remote_swa_);
+  if (lights_.take_changed()) event("lights: " + describe_lights(lights_.report()));
   commanded_.speed = 0.0;
   watchdog_armed_ = false;  // arms with the first 0x111 in CAN mode
 }
@@ -629,9 +645,15 @@ Message VirtualChassis::motion_feedback() const {
       fb.steering_angle = interpretation::manual_from_rep103_steering(mean_angle);
       break;
     }
+    case MotionMode::kSideSlip:
+      // Reading (the vendor's odometry integrates it at +90 deg): the lateral speed in bytes 0-1,
+      // left positive, the wheels' 90 deg as the angle.
+      fb.steering_angle = interpretation::manual_from_rep103_steering(M_PI / 2.0);
+      fb.speed = twist.vy;
+      break;
     default: {
-      // Spin: the fixed angle (mean of |angles|) and (point 9) the signed tangential speed, in
-      // the profile's spin field.
+      // Spin (and park, where nothing moves): the fixed angle (mean of |angles|) and (point 9) the
+      // signed tangential speed, in the profile's spin field.
       if (config_.spin_angle_reported) {
         for (const auto& s : w)
           fb.steering_angle += std::abs(s.angle) / kWheelCount;
@@ -697,17 +719,12 @@ void VirtualChassis::send_due(ScheduleId which, Timestamp t) {
       if (config_.vendor_frames) {
         // 0x231 and 0x241 at 20 ms, the period the vendor's manuals of the same family give
         // (assumed for the RANGER), each with its counter.
-        LightState light;
-        light.enable = lights_.enable;
-        light.front_mode = lights_.front_mode;
-        light.front_custom = lights_.front_custom;
-        light.rear_mode = lights_.rear_mode;
-        light.rear_custom = lights_.rear_custom;
+        LightState light = lights_.report();
         light.counter = vendor_counter_;
         send(light, t);
         // The remote control on, SWB up (command mode) unless the remote is in charge.
         RemoteControlState rc;
-        rc.swa = protocol::RemoteSwitch::kUp;
+        rc.swa = remote_swa_;
         rc.swb = control_mode_ == ControlMode::kRemote ? protocol::RemoteSwitch::kMiddle
                                                        : protocol::RemoteSwitch::kUp;
         rc.swc = protocol::RemoteSwitch::kUp;
@@ -799,6 +816,7 @@ ChassisSnapshot VirtualChassis::snapshot() const {
   s.distance_travelled = motion_.distance_travelled();
   s.yaw_travelled = motion_.yaw_travelled();
   s.battery = drivetrain_.pack();
+  s.lights = lights_.report();
   return s;
 }
 

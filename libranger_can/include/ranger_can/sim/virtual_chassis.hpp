@@ -27,6 +27,12 @@
 //    CAN mode (a host that only switched modes has not lost anything); the bit describes the link,
 //    so it clears when 0x111 resumes (that 0x111 is obeyed) or on 0x441 code 0x00, which also
 //    disarms the watchdog until the next 0x111.
+//  * Park (agx_v2 mode 3) and side slip (MINI V1 mode 3, agx_v2 mode 4) are modes like the others
+//    (chassis_model.hpp). A 0x141 park is obeyed only at standstill (reading); while parked a
+//    0x111 keeps the watchdog fed and moves nothing. In side slip 0x111's lateral speed is read
+//    from bytes 4-5 with the spin sign (the MINI V1's negated field), and 0x221 reports it in
+//    bytes 0-1, left positive, with 90 deg as the angle (reading).
+//  * Lights: chassis_lights.hpp (0x121 in CAN mode, the remote's SWA while it has the chassis).
 //  * 0x141 starts a switch: the body brakes to rest, then the wheels turn for
 //    `mode_switch_duration`; meanwhile 0x291 reports the mode being left with switching = 1 and
 //    speed commands are ignored. A 0x141 naming the current mode changes nothing.
@@ -61,6 +67,7 @@
 #include <vector>
 
 #include "ranger_can/control/geometry.hpp"
+#include "ranger_can/sim/chassis_lights.hpp"
 #include "ranger_can/sim/chassis_model.hpp"
 #include "ranger_can/sim/drivetrain_model.hpp"
 #include "ranger_can/transport/bus.hpp"
@@ -125,6 +132,7 @@ struct ChassisSnapshot {
   double distance_travelled = 0.0;  // m, path length of the body centre since boot
   double yaw_travelled = 0.0;       // rad, total |rotation| since boot
   BatteryTelemetry battery;
+  LightState lights;  // what 0x231 reports (agx_v2 only sends it)
 };
 
 struct VirtualChassisCounters {
@@ -190,6 +198,9 @@ class VirtualChassis {
   void set_ultrasonic(int sensor, std::int16_t raw);  // sensor 1..8
   void set_ultrasonic_enabled(bool enabled);          // the remote's SWC switch (no 0x451 involved)
   void set_pose(const Pose2D& pose) { motion_.set_pose(pose); }
+  // The 0x4A1 answer from now on (vendor_frames only).
+  void set_version(std::string version) { config_.version = std::move(version); }
+  const ChassisLights& lights() const { return lights_; }
 
  private:
   struct Schedule {
@@ -245,7 +256,8 @@ class VirtualChassis {
   std::uint32_t last_reported_errors_ = 0;
   std::uint8_t status_counter_ = 0;  // 0x211 byte 7 under agx16: +1 per frame
   std::uint8_t vendor_counter_ = 0;  // 0x231 / 0x241 byte 7: +1 per frame
-  LightCommand lights_;              // what the last 0x121 set (reported in 0x231)
+  ChassisLights lights_;             // what 0x231 reports (0x121, the remote's SWA)
+  protocol::RemoteSwitch remote_swa_ = protocol::RemoteSwitch::kUp;  // the remote's SWA
   std::string last_refusal_;
 
   VirtualChassisCounters counters_;
