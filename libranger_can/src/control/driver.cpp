@@ -507,6 +507,9 @@ void Driver::apply_mail(Timestamp now) {
         }
         st = controller_->resume(now);
         break;
+      case RequestOutcome::Kind::kLights:
+      case RequestOutcome::Kind::kFirmwareVersion:
+        break;  // vendor actions (Mail::vendor, apply_vendor_action)
     }
     std::lock_guard<std::mutex> lock(mail_mutex_);
     for (RequestOutcome& r : requests_) {
