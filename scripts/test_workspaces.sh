@@ -103,6 +103,25 @@ EOF
   )
 }
 
+# CMake 3.16.8 (Ubuntu 20.04's, the oldest we declare) from PyPI, in a venv cached under build/;
+# its cmake and ctest alone in build/cmake-3.16/tools (the venv's python3 must not shadow the
+# system one the ROS tools need).
+cmake316=$root/build/cmake-3.16
+cmake316_tools() {
+  if [ ! -x "$cmake316/bin/cmake" ]; then
+    /usr/bin/python3 -m venv "$cmake316" && "$cmake316/bin/pip" install -q cmake==3.16.8 || return 1
+  fi
+  mkdir -p "$cmake316/tools"
+  ln -sf ../bin/cmake "$cmake316/tools/cmake" && ln -sf ../bin/ctest "$cmake316/tools/ctest"
+}
+# CMake < 3.17 ignores the CMAKE_CXX_COMPILER_LAUNCHER environment variable (e.g. ccache).
+launcher_args=()
+[ -n "${CMAKE_CXX_COMPILER_LAUNCHER:-}" ] &&
+  launcher_args=(-DCMAKE_CXX_COMPILER_LAUNCHER="$CMAKE_CXX_COMPILER_LAUNCHER")
+
+# The ROS tools run the system's CMake: Debian's catkin finds GoogleTest through the targets of
+# CMake >= 3.20 (Noetic's catkin on Ubuntu 20.04 does not), so catkin with CMake 3.16 is a
+# combination no user has.
 step_catkin_make() {
   local ws=$work/catkin_make
   fresh_workspace "$ws"
@@ -131,25 +150,23 @@ step_colcon() {
 }
 
 step_cmake316() {
-  local venv=$root/build/cmake-3.16 build=$root/build/cmake316
-  if [ ! -x "$venv/bin/cmake" ]; then
-    /usr/bin/python3 -m venv "$venv" && "$venv/bin/pip" install -q cmake==3.16.8 || return 1
-  fi
-  "$venv/bin/cmake" --version | head -1
+  local build=$root/build/cmake316 tools=$cmake316/tools
+  cmake316_tools || return 1
+  "$tools/cmake" --version | head -1
   rm -rf "$build"
   local generator=()
   command -v ninja >/dev/null && generator=(-G Ninja)
-  checked_build "$build.configure.log" "$venv/bin/cmake" -S . -B "$build" "${generator[@]}" \
-    -DCMAKE_BUILD_TYPE=RelWithDebInfo || return 1
+  checked_build "$build.configure.log" "$tools/cmake" -S . -B "$build" "${generator[@]}" \
+    -DCMAKE_BUILD_TYPE=RelWithDebInfo "${launcher_args[@]}" || return 1
   if [ "${RANGER_CMAKE316_FULL:-0}" = 1 ]; then
-    checked_build "$build.build.log" "$venv/bin/cmake" --build "$build" -j "$jobs" || return 1
-    (cd "$build" && "$venv/bin/ctest" -LE vcan -j "$jobs" --output-on-failure)
+    checked_build "$build.build.log" "$tools/cmake" --build "$build" -j "$jobs" || return 1
+    (cd "$build" && "$tools/ctest" -LE vcan -j "$jobs" --output-on-failure)
   else
     # A unit test of the library (GTest::Main, the test support library) and a system suite
     # (tests/): linked and discovered as CMake 3.16 does it.
-    checked_build "$build.build.log" "$venv/bin/cmake" --build "$build" -j "$jobs" \
+    checked_build "$build.build.log" "$tools/cmake" --build "$build" -j "$jobs" \
       --target ranger_can_tool test_codec test_bus_loopback || return 1
-    (cd "$build" && "$venv/bin/ctest" -R '^(Codec|LoopbackNetwork|Loopback/)' -j "$jobs" \
+    (cd "$build" && "$tools/ctest" -R '^(Codec|LoopbackNetwork|Loopback/)' -j "$jobs" \
       --output-on-failure)
   fi
 }
