@@ -5,7 +5,8 @@
 #
 #   scripts/test_workspaces.sh [STEP...]     (default: lint catkin_make colcon cmake316)
 #
-#   lint                  catkin_lint -W1 over the repository: no error, no warning
+#   lint                  catkin_lint -W1 over the repository: no error, no warning; the catkin
+#                         tools find each package once (not again in build/ or install/)
 #   catkin_make           `catkin_make` in build/workspaces/catkin_make, then the driver from its
 #                         devel space: `source devel/setup.bash; roslaunch ranger_bringup
 #                         ranger_minimal.launch sim:=true` until it reaches CAN command mode
@@ -57,8 +58,16 @@ checked_build() {  # log command...
   echo "ok: $* ($((SECONDS - start)) s)"
 }
 
+# catkin_lint, and the packages as the catkin tools find them in this checkout, build/ and
+# install/ included: each once (catkin_pkg refuses a name found twice), with CATKIN_IGNORE as the
+# only marker (older catkin_pkg, e.g. Noetic's, knows no COLCON_IGNORE).
 step_lint() {
-  catkin_lint -W1 --strict . 2>&1 | grep -v "rosdep" ; return "${PIPESTATUS[0]}"
+  catkin_lint -W1 --strict . 2>&1 | grep -v "rosdep"
+  [ "${PIPESTATUS[0]}" -eq 0 ] || return 1
+  python3 -c 'from catkin_pkg.packages import find_packages
+names = sorted(p.name for p in find_packages(".", ignore_markers={"CATKIN_IGNORE"}).values())
+print("catkin finds:", " ".join(names))
+assert len(names) == 5, names'
 }
 
 # The driver from a sourced workspace: ranger_minimal.launch sim:=true on a master of its own,
