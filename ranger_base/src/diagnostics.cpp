@@ -56,6 +56,11 @@ void diagnose_link(const DriverSnapshot& s, DiagnosticStatusWrapper& out) {
   const auto& c = s.controller;
   out.add("Chassis link", std::string(ranger::to_string(c.link)));
   out.add("Chassis link losses", c.counters.link_losses);
+  out.add("Firmware version",
+          s.firmware.state == ranger::FirmwareVersion::State::kAnswered
+              ? s.firmware.text
+              : "unknown (" + std::string(ranger::to_string(s.firmware.state)) + ")");
+  out.add("Vendor frames (0x231, 0x241)", std::string(ranger::to_string(s.vendor_frames)));
   out.add("Odometry published", s.motion_known ? "yes" : "no (chassis not heard)");
   out.add("Undecodable frames", c.counters.decode_errors);
   out.add("Send failures", c.counters.send_failures);
@@ -110,6 +115,12 @@ void diagnose_control(const DriverSnapshot& s, DiagnosticStatusWrapper& out) {
   out.add("Motion mode pinned",
           c.mode_override ? std::string(protocol::to_string(*c.mode_override)) : "automatic");
   out.add("Mode switch", std::string(ranger::to_string(c.mode_switch.phase)));
+  out.add("Park", c.park_requested ? (c.parked() ? "parked" : "parking") : "released");
+  if (s.lights) {
+    out.add("Lights", ranger::describe(s.lights->front, s.lights->front_brightness, s.lights->rear,
+                                       s.lights->rear_brightness) +
+                          (s.lights->can_control ? " (CAN)" : " (the chassis's own)"));
+  }
   out.add("Motion refused because", std::string(ranger::to_string(c.refusal)));
   out.add("Re-arm required", c.rearm_required() ? "yes" : "no");
   out.add("Latched stop causes", join(cause_names(c.latched_causes)));
@@ -159,8 +170,8 @@ void diagnose_control(const DriverSnapshot& s, DiagnosticStatusWrapper& out) {
 
 void diagnose_protocol(const DriverSnapshot& s, const ProtocolContext& context,
                        DiagnosticStatusWrapper& out) {
-  out.add("Settings from", context.source.empty() ? std::string(ranger::to_string(s.protocol))
-                                                  : context.source);
+  out.add("Settings from",
+          context.source.empty() ? std::string(ranger::to_string(s.protocol)) : context.source);
   out.add("Settings in use", ranger::describe(s.profile));
   for (const ranger::ProfileSetting& setting : ranger::profile_settings()) {
     const auto value = ranger::get_setting(s.profile, setting.name);
@@ -213,10 +224,10 @@ void diagnose_protocol(const DriverSnapshot& s, const ProtocolContext& context,
   if (plausibility.stop) out.add("Plausibility stop", plausibility.stop->text());
 
   if (plausibility.stop) {
-    out.summary(DiagnosticStatus::ERROR,
-                "stopped: the chassis contradicts the protocol settings: " +
-                    plausibility.stop->text() +
-                    ". Set that parameter (or load a commissioning file); resume tries again");
+    out.summary(
+        DiagnosticStatus::ERROR,
+        "stopped: the chassis contradicts the protocol settings: " + plausibility.stop->text() +
+            ". Set that parameter (or load a commissioning file); resume tries again");
   } else if (failed) {
     out.summary(DiagnosticStatus::ERROR, *failed);
   } else {
