@@ -471,7 +471,13 @@ def drive_one_robot(session, cmd, match):
 INJECTED_STATE = {
     "estop on": [("vehicle_status", 1), ("motion_inhibited_reason", "estop")],
     "estop off": [("vehicle_status", 0), ("rearm_required", True)],
+    "remote on": [("control_mode", 3), ("motion_inhibited_reason", "remote")],
+    "remote sticks 0.2 -0.3": [("control_mode", 3), ("motion_mode", 0)],
+    "remote swd bottom": [("control_mode", 3), ("motion_mode", 1)],
+    "remote can": [("control_mode", 1), ("rearm_required", True)],
 }
+# ... and the sim/inject lines after which the robot moves (its ground truth).
+INJECTED_MOVES = {"remote sticks 0.2 -0.3"}
 
 
 def inject_fault(session, cmd, match):
@@ -484,9 +490,12 @@ def inject_fault(session, cmd, match):
         f"`{cmd.text}`: say in INJECTED_STATE what '{line}' shows in system_state")
     run_ok(session, cmd, match)
     topic = f"/{ns}/system_state" if ns else "/system_state"
-    session.probe(session.running[-1], [
-        {"topic": topic, "type": "ranger_msgs/SystemState", "field": f, "equals": v}
-        for f, v in INJECTED_STATE[line]])
+    conditions = [{"topic": topic, "type": "ranger_msgs/SystemState", "field": f, "equals": v}
+                  for f, v in INJECTED_STATE[line]]
+    if line in INJECTED_MOVES:
+        conditions.append({"topic": f"/{ns}/sim/ground_truth" if ns else "/sim/ground_truth",
+                           "type": "nav_msgs/Odometry", "moved_more_than": 0.05})
+    session.probe(session.running[-1], conditions)
 
 
 def call_resume(session, cmd, match):

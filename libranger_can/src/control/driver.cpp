@@ -443,8 +443,22 @@ void Driver::handle_frame(const CanFrame& frame, Timestamp now) {
   }
   if (std::holds_alternative<VersionResponse>(*message)) last_version_frame_ = now;
   controller_->on_message(*message, frame.stamp, now);
-  odometry_.on_message(*message, frame.stamp);
-  joints_.on_message(*message, frame.stamp);
+  if (odometry_readable()) {
+    odometry_.on_message(*message, frame.stamp);
+    odometry_fed_ = true;
+  }
+  if (joints_readable()) joints_.on_message(*message, frame.stamp);
+}
+
+bool Driver::joints_readable() const {
+  return !identifier_ || identifier_->wheel_angles_known();
+}
+
+bool Driver::odometry_readable() const {
+  if (!identifier_ || identifier_->status().decided_ok()) return true;
+  // The wheels' odometry reads 0x271 and 0x281 (whose unit no revision changes); 0x221's needs
+  // the whole decision.
+  return config_.odometry.source == OdometrySource::kWheels && identifier_->wheel_angles_known();
 }
 
 void Driver::apply_mail(Timestamp now) {
@@ -795,10 +809,29 @@ ProtocolProfile Driver::with_configured_settings(const IdentificationStatus& st)
 
 void Driver::run_identification(Timestamp now) {
   if (!identifier_ || identifier_->status().done()) return;
+  // The probe is motion the controller would refuse for a cause of the commander's (a re-arm
+  // after the remote control or a stop, an e-stop): it waits for that, not for the chassis.
+  const MotionRefusal refusal = controller_->state().refusal;
+  switch (refusal) {
+    case MotionRefusal::kRearmRequired:
+      identifier_->hold_probe("motion needs the re-arm (call resume, or send a zero twist)");
+      break;
+    case MotionRefusal::kRemote:  // (as of the last tick: the hand-back is being heard now)
+    case MotionRefusal::kEstop:
+    case MotionRefusal::kCriticalError:
+    case MotionRefusal::kLowBattery:
+    case MotionRefusal::kImplausible:
+      identifier_->hold_probe("motion is refused (" + std::string(to_string(refusal)) + ")");
+      break;
+    default:
+      identifier_->hold_probe("");
+      break;
+  }
   identifier_->tick(now);
   const IdentificationStatus& st = identifier_->status();
   if (st.decided_ok()) {
-    use_profile(with_configured_settings(st));
+    // A chassis driven (by its remote) before the decision keeps the pose it reached.
+    use_profile(with_configured_settings(st), /*reset_odometry=*/!odometry_fed_);
     controller_->set_probe(std::nullopt, std::nullopt);
     controller_->set_quiet(false);
     controller_->set_identifying("");
@@ -811,7 +844,7 @@ void Driver::run_identification(Timestamp now) {
     return;
   }
   const IdentificationRequest r = identifier_->request();
-  if (r.profile) use_profile(*r.profile);
+  if (r.profile) use_profile(*r.profile, /*reset_odometry=*/!odometry_fed_);
   controller_->set_quiet(r.quiet);
   controller_->set_probe(r.mode, r.probe);
   controller_->set_identifying(st.message);

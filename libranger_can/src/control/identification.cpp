@@ -341,6 +341,7 @@ void ChassisIdentifier::start(Timestamp now) {
   if (started_) return;
   started_ = true;
   status_.started = now;
+  timeout_from_ = now;
   status_.finished = now;
 }
 
@@ -532,7 +533,13 @@ void ChassisIdentifier::tick(Timestamp now) {
   start(now);
   if (status_.done()) return;
   status_.finished = now;
-  if (now - status_.started >= config_.timeout) {
+  // Under the remote control the operator drives: waiting for CAN command mode is no failure,
+  // and the time for the probe counts from when the remote hands back.
+  if (status_.phase == IdentificationPhase::kAwaitingControl &&
+      (under_remote() || !probe_hold_.empty())) {
+    timeout_from_ = now;
+  }
+  if (now - timeout_from_ >= config_.timeout) {
     std::string why;
     switch (status_.phase) {
       case IdentificationPhase::kListening:
@@ -572,10 +579,17 @@ void ChassisIdentifier::tick(Timestamp now) {
       break;
     case IdentificationPhase::kAwaitingControl:
       if (control_mode_raw_ == static_cast<std::uint8_t>(protocol::ControlMode::kCan) && mode_ &&
-          !switching_) {
+          !switching_ && !probe_hold_.empty()) {
+        status_.message = "identifying the chassis: the steering probe waits: " + probe_hold_;
+      } else if (control_mode_raw_ == static_cast<std::uint8_t>(protocol::ControlMode::kCan) &&
+                 mode_ && !switching_) {
         begin_step(config_.spin_check && !verdict_271_ ? IdentificationPhase::kSpinCheck
                                                        : IdentificationPhase::kSteerProbe,
                    now);
+      } else if (under_remote()) {
+        observe_remote_driving(now);
+      } else {
+        status_.message = "identifying the chassis: waiting for CAN command mode";
       }
       break;
     case IdentificationPhase::kSpinCheck:
@@ -645,6 +659,11 @@ bool ChassisIdentifier::settled(Timestamp now) const {
 }
 
 void ChassisIdentifier::evaluate_spin(Timestamp now) {
+  judge_spin_position("spin position at standstill", /*quiet_if_unclear=*/false);
+  begin_step(IdentificationPhase::kSteerProbe, now);
+}
+
+bool ChassisIdentifier::judge_spin_position(const std::string& context, bool quiet_if_unclear) {
   const auto expected =
       wheel_angles_for_command(MotionCommand{}, MotionMode::kSpin, geometry_, status_.profile);
   Ranking rank;
@@ -663,7 +682,7 @@ void ChassisIdentifier::evaluate_spin(Timestamp now) {
     const Hypothesis271 v{kUnits[rank.best / 2], kSigns[rank.best % 2]};
     verdict_271_ = v;
     min_margin_ = std::min(min_margin_, rank.confidence());
-    const std::string read = std::string("spin position at standstill: 0x271 read ") +
+    const std::string read = context + ": 0x271 read " +
                              (plain ? values_text(*plain) + " in 0.01 deg" : "beyond 100 deg") +
                              ", expected +-" + deg(std::fabs(expected[0])) +
                              " (atan(wheelbase/track), RF +, RR -, LR +, LF - in REP-103)";
@@ -671,12 +690,43 @@ void ChassisIdentifier::evaluate_spin(Timestamp now) {
         read + ": the unit is " + std::string(to_string(v.unit)));
     set("steering_sign_271", to_string(v.sign),
         "spin position sign pattern: " + std::string(to_string(v.sign)));
-  } else {
+    return true;
+  }
+  if (!quiet_if_unclear) {
     note("spin check inconclusive: 0x271 " + (plain ? values_text(*plain) : std::string("?")) +
          " fits no reading of the spin position " + deg(std::fabs(expected[0])) +
          " (best residual " + deg(rank.best_residual) + ")");
   }
-  begin_step(IdentificationPhase::kSteerProbe, now);
+  return false;
+}
+
+bool ChassisIdentifier::under_remote() const {
+  return control_mode_raw_ == static_cast<std::uint8_t>(protocol::ControlMode::kRemote);
+}
+
+void ChassisIdentifier::observe_remote_driving(Timestamp now) {
+  // The remote's own driving tells the 0x271 reading: steered wheels rolling (the rigid-body
+  // fit), or the wheels held at the spin position while the remote spins.
+  if (!verdict_271_) judge_rigid_body(/*quiet_if_unclear=*/true);
+  if (!verdict_271_ && mode_ == MotionMode::kSpin && !switching_ && angles_ &&
+      now - angles_changed_ >= config_.settle_time) {
+    judge_spin_position("spin position while the remote control spins", true);
+  }
+  std::string text = "identifying the chassis under the remote control: ";
+  if (verdict_271_) {
+    text += "the wheels' reading is decided (steering_unit_271 " +
+            std::string(to_string(verdict_271_->unit)) + ", steering_sign_271 " +
+            std::string(to_string(verdict_271_->sign)) + ": odometry and joint states follow)";
+  } else {
+    text +=
+        "the wheels' reading (steering_unit_271, steering_sign_271) is not known yet: odometry "
+        "and joint states wait for the remote to drive with the wheels steered, or to spin";
+  }
+  text +=
+      "; still lacking for commands: steering_unit_111, steering_sign_111, steering_reference, "
+      "steering_unit_221, steering_sign_221 (probed at standstill once CAN command mode is "
+      "granted)";
+  status_.message = text;
 }
 
 void ChassisIdentifier::evaluate_steer(Timestamp now) {
@@ -834,6 +884,10 @@ void ChassisIdentifier::decide_passive(Timestamp now) {
   } else if (bms_frames_ == 0) {
     note("no BMS frame (0x361) with a battery voltage to compare: bms_voltage_scale kept");
   }
+  judge_rigid_body(/*quiet_if_unclear=*/false);
+}
+
+bool ChassisIdentifier::judge_rigid_body(bool quiet_if_unclear) {
   // Rigid-body fits while the wheels rolled.
   if (rigid_samples_ >= kMinRigidSamples) {
     Ranking rank;
@@ -852,11 +906,14 @@ void ChassisIdentifier::decide_passive(Timestamp now) {
                               fmt("%.3f", rank.second_residual) + ")";
       set("steering_unit_271", to_string(verdict_271_->unit), why);
       set("steering_sign_271", to_string(verdict_271_->sign), why);
-    } else {
+      return true;
+    }
+    if (!quiet_if_unclear) {
       note("rolling wheels seen (" + std::to_string(rigid_samples_) +
            " samples) but no 0x271 reading fits them clearly");
     }
   }
+  return false;
 }
 
 void ChassisIdentifier::fail(std::string why, Timestamp now) {

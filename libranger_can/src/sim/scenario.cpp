@@ -45,6 +45,9 @@ const char* const kExpectHelp =
     "  expect control_mode standby|can|remote|null\n"
     "  expect motion_mode ackermann|oblique|spin|park|side_slip|null   (the chassis's 0x291)\n"
     "  expect rearm_required true|false\n"
+    "  expect identification listening|awaiting_control|spin_check|steer_probe|returning|\n"
+    "                           decided|failed|none   the identification's phase (none: the\n"
+    "                           protocol was given)\n"
     "  expect moving | still    ground truth: the fastest point of the chassis (body centre or a\n"
     "                           wheel) is faster than 1 mm/s | not faster\n"
     "  expect fault NAME | no-fault NAME | no-faults\n"
@@ -154,6 +157,21 @@ const std::vector<std::string>& control_mode_names() {
       std::string(protocol::to_string(ControlMode::kStandby)),
       std::string(protocol::to_string(ControlMode::kCan)),
       std::string(protocol::to_string(ControlMode::kRemote)), "null"};
+  return names;
+}
+
+// The identification's phases (protocol auto), and "none" for a protocol that was given.
+const std::vector<std::string>& identification_names() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> out;
+    for (auto p : {IdentificationPhase::kListening, IdentificationPhase::kAwaitingControl,
+                   IdentificationPhase::kSpinCheck, IdentificationPhase::kSteerProbe,
+                   IdentificationPhase::kReturning, IdentificationPhase::kDecided,
+                   IdentificationPhase::kFailed})
+      out.emplace_back(to_string(p));
+    out.emplace_back("none");
+    return out;
+  }();
   return names;
 }
 
@@ -296,7 +314,8 @@ Result<Expectation> parse_expect(const std::vector<std::string>& w) {
   // w[0] == "expect"
   const std::string usage =
       "expect: give one of: refusal NAME, control_mode NAME, motion_mode NAME, rearm_required "
-      "true|false, moving, still, fault NAME, no-fault NAME, no-faults, FIELD OP NUMBER";
+      "true|false, identification PHASE, moving, still, fault NAME, no-fault NAME, no-faults, "
+      "FIELD OP NUMBER";
   if (w.size() < 2) return problem(usage);
   const std::string& what = w[1];
   Expectation e;
@@ -330,7 +349,8 @@ Result<Expectation> parse_expect(const std::vector<std::string>& w) {
   } text_fields[] = {{"refusal", refusal_names()},
                      {"control_mode", control_mode_names()},
                      {"motion_mode", motion_mode_names()},
-                     {"rearm_required", bool_names()}};
+                     {"rearm_required", bool_names()},
+                     {"identification", identification_names()}};
   for (const auto& f : text_fields) {
     if (what != f.field) continue;
     if (auto st = need(3, what + " " + join(f.valid, "|")); !st) return st.error();
@@ -675,6 +695,8 @@ std::string to_json(const ScenarioSample& s) {
   append_list(out, s.latched);
   out += ',';
   num("steer_first_factor", s.steer_first_factor);
+  out += ",\"identification\":";
+  append_string(out, s.identification);
   out += '}';
   return out;
 }
@@ -762,6 +784,8 @@ struct ScenarioRunner::Impl {
       start = end + 1;
     }
     s.steer_first_factor = c.steer_first_factor;
+    s.identification =
+        snap->identification ? std::string(to_string(snap->identification->phase)) : "none";
     return s;
   }
 
@@ -775,6 +799,7 @@ struct ScenarioRunner::Impl {
         if (e.field == "control_mode") got = s.control_mode.value_or("null");
         if (e.field == "motion_mode") got = s.motion_mode.value_or("null");
         if (e.field == "rearm_required") got = s.rearm_required ? "true" : "false";
+        if (e.field == "identification") got = s.identification;
         if (got == e.text) return std::nullopt;
         return got;
       }

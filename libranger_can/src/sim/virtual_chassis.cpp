@@ -209,17 +209,23 @@ std::string VirtualChassis::refusal_reason() const {
   if (control_mode_ != ControlMode::kCan) {
     return std::string("control mode is ") + std::string(protocol::to_string(control_mode_));
   }
+  if (std::string r = drive_refusal(); !r.empty()) return r;
+  if (motion_.switching()) return "switching motion mode";
+  if (motion_.mode() == MotionMode::kPark) return "parked";
+  return {};
+}
+
+std::string VirtualChassis::drive_refusal() const {
   if (emergency_stop_) return "emergency stop";
   const std::uint32_t errors = error_word();
   const ErrorWordLayout layout = config_.profile.error_word;
   if (errors & bit(Fault::kBatteryUnderVoltage)) return "battery under-voltage: drive power cut";
   if (ultrasonic_triggered()) return "ultrasonic obstacle avoidance triggered";
-  if (host_link_lost_) return "host communication lost";
+  // The host link matters only to the host's commands.
+  if (host_link_lost_ && control_mode_ == ControlMode::kCan) return "host communication lost";
   if (protocol::is_critical_error(errors, layout)) {
     return "critical error: " + names_of(errors, layout);
   }
-  if (motion_.switching()) return "switching motion mode";
-  if (motion_.mode() == MotionMode::kPark) return "parked";
   return {};
 }
 
@@ -250,19 +256,109 @@ void VirtualChassis::update_conditions(Timestamp) {
 }
 
 void VirtualChassis::apply_motion_policy() {
-  const std::string reason = refusal_reason();
-  if (reason != last_refusal_) {
-    event(reason.empty() ? std::string("motion allowed") : "motion refused: " + reason);
-    last_refusal_ = reason;
+  const bool remote = control_mode_ == ControlMode::kRemote;
+  const std::string reason = remote ? drive_refusal() : refusal_reason();
+  const std::string shown = remote && reason.empty() ? std::string("(remote)") : reason;
+  if (shown != last_refusal_) {
+    event(!reason.empty() ? "motion refused: " + reason
+                          : (remote ? std::string("motion by the remote control")
+                                    : std::string("motion allowed")));
+    last_refusal_ = shown;
   }
   if (!reason.empty()) {
     commanded_.speed = 0.0;
     const bool power_cut =
         emergency_stop_ || (error_word() & bit(Fault::kBatteryUnderVoltage)) != 0;
     motion_.stop(power_cut);
+  } else if (remote) {
+    drive_by_remote();
   } else {
     motion_.set_target(commanded_);
   }
+}
+
+// ---- the remote control -----------------------------------------------------------------------
+
+namespace {
+
+double stick(double v) {
+  if (!std::isfinite(v) || std::abs(v) < kRemoteStickDeadband) return 0.0;
+  return std::clamp(v, -1.0, 1.0);
+}
+
+std::int8_t stick_wire(double v) {
+  return static_cast<std::int8_t>(std::lround(stick(v) * kRemoteStickFullScale));
+}
+
+}  // namespace
+
+MotionMode VirtualChassis::remote_mode() const {
+  if (remote_.swd == protocol::RemoteSwitch::kDown) return MotionMode::kOblique;
+  if (stick(remote_.left) != 0.0) return MotionMode::kAckermann;
+  if (stick(remote_.right) != 0.0) return MotionMode::kSpin;
+  // Both sticks centred: a spin stays a spin (at rest), anything else is Ackermann.
+  const MotionMode heading = motion_.switching() ? motion_.switch_target() : motion_.mode();
+  return heading == MotionMode::kSpin ? MotionMode::kSpin : MotionMode::kAckermann;
+}
+
+MotionTarget VirtualChassis::remote_target() const {
+  const MotionLimits& l = motion_.limits();
+  const double left = stick(remote_.left);
+  const double right = stick(remote_.right);
+  // Stick right steers right: a negative REP-103 angle, a clockwise spin.
+  switch (motion_.mode()) {
+    case MotionMode::kAckermann:
+      return {left * l.max_linear_speed, -right * l.max_ackermann_angle};
+    case MotionMode::kOblique:
+      return {left * l.max_linear_speed, -right * l.max_oblique_angle};
+    case MotionMode::kSpin:
+      return {-right * l.max_spin_speed, 0.0};
+    default:
+      return {};
+  }
+}
+
+void VirtualChassis::drive_by_remote() {
+  const MotionMode want = remote_mode();
+  const MotionMode heading = motion_.switching() ? motion_.switch_target() : motion_.mode();
+  if (want != heading && motion_.begin_mode_switch(want, seconds(config_.mode_switch_duration))) {
+    event("remote control: switching motion mode " +
+          std::string(protocol::to_string(motion_.mode())) + " -> " +
+          std::string(protocol::to_string(want)));
+  }
+  motion_.set_target(remote_target());  // ignored while switching
+}
+
+void VirtualChassis::set_remote_swa(protocol::RemoteSwitch position) {
+  if (position == remote_.swa) return;
+  remote_.swa = position;
+  event("remote SWA " + std::string(protocol::to_string(position)) +
+        (control_mode_ != ControlMode::kRemote ? " (no effect: SWB is not in remote position)"
+                                               : ""));
+  lights_.set_remote(control_mode_ == ControlMode::kRemote, remote_.swa);
+  if (lights_.take_changed()) event("lights: " + describe_lights(lights_.report()));
+}
+
+void VirtualChassis::set_remote_swc(protocol::RemoteSwitch position) {
+  if (position == remote_.swc) return;
+  remote_.swc = position;
+  event("remote SWC " + std::string(protocol::to_string(position)));
+  set_ultrasonic_enabled(position == protocol::RemoteSwitch::kMiddle);
+}
+
+void VirtualChassis::set_remote_swd(protocol::RemoteSwitch position) {
+  if (position == remote_.swd) return;
+  remote_.swd = position;
+  event("remote SWD " + std::string(protocol::to_string(position)));
+  update_conditions(now_);
+  apply_motion_policy();
+}
+
+void VirtualChassis::set_remote_sticks(double left, double right) {
+  remote_.left = std::isfinite(left) ? std::clamp(left, -1.0, 1.0) : 0.0;
+  remote_.right = std::isfinite(right) ? std::clamp(right, -1.0, 1.0) : 0.0;
+  update_conditions(now_);
+  apply_motion_policy();
 }
 
 void VirtualChassis::event(std::string text) {
@@ -418,7 +514,7 @@ void VirtualChassis::set_control_mode(ControlMode mode, const std::string& why) 
   event("control mode " + std::string(protocol::to_string(control_mode_)) + " -> " +
         std::string(protocol::to_string(mode)) + " (" + why + ")");
   control_mode_ = mode;
-  lights_.set_remote(mode == ControlMode::kRemote, remote_swa_);
+  lights_.set_remote(mode == ControlMode::kRemote, remote_.swa);
   if (lights_.take_changed()) event("lights: " + describe_lights(lights_.report()));
   commanded_.speed = 0.0;
   watchdog_armed_ = false;  // arms with the first 0x111 in CAN mode
@@ -722,14 +818,16 @@ void VirtualChassis::send_due(ScheduleId which, Timestamp t) {
         LightState light = lights_.report();
         light.counter = vendor_counter_;
         send(light, t);
-        // The remote control on, SWB up (command mode) unless the remote is in charge.
+        // The remote control on, SWB up (command mode) unless the remote is in charge; the
+        // sticks as the operator holds them (centred within the dead band).
         RemoteControlState rc;
-        rc.swa = remote_swa_;
+        rc.swa = remote_.swa;
         rc.swb = control_mode_ == ControlMode::kRemote ? protocol::RemoteSwitch::kMiddle
                                                        : protocol::RemoteSwitch::kUp;
-        rc.swc = protocol::RemoteSwitch::kUp;
-        rc.swd = motion_.mode() == MotionMode::kOblique ? protocol::RemoteSwitch::kDown
-                                                        : protocol::RemoteSwitch::kUp;
+        rc.swc = remote_.swc;
+        rc.swd = remote_.swd;
+        rc.stick_left_v = stick_wire(remote_.left);
+        rc.stick_right_h = stick_wire(remote_.right);
         rc.counter = vendor_counter_;
         send(rc, t);
         ++vendor_counter_;
@@ -807,6 +905,7 @@ ChassisSnapshot VirtualChassis::snapshot() const {
   s.motion_allowed = s.motion_refused_reason.empty();
   s.silent = silent_;
   s.ultrasonic_enabled = ultrasonic_enabled_;
+  s.remote = remote_;
   s.target = motion_.target();
   s.speed = motion_.speed();
   s.steering = motion_.steering();

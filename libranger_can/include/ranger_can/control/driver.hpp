@@ -308,6 +308,10 @@ class Driver {
   void run_plausibility(Timestamp now);
   void run_standstill_probe();
   void use_profile(const ProtocolProfile& profile, bool reset_odometry = true);
+  // Under protocol auto, before the decision: whether what the joint states / the odometry read
+  // is decided (nothing is published that would be a guess).
+  bool joints_readable() const;
+  bool odometry_readable() const;
   void update_requests(Timestamp now);
   void update_vendor(Timestamp now);
   // Applies a lights or version action; false while the vendor frames are not known yet.
@@ -333,6 +337,7 @@ class Driver {
   std::optional<StandstillProbe> probe_;
   bool probe_active_ = false;
   Odometry odometry_;
+  bool odometry_fed_ = false;  // the odometry has integrated frames (a new profile keeps its pose)
   WheelJointTracker joints_;
   FrameStats frames_;
   std::string bus_error_;

@@ -152,6 +152,7 @@ struct ScenarioSample {
   bool rearm_required = false;
   std::vector<std::string> latched;  // the latched stop causes
   double steer_first_factor = 1.0;
+  std::string identification = "none";  // its phase under protocol auto, else "none"
 };
 
 // The sample as one JSON object (no newline), with fixed formatting: seconds with 3 decimals,
