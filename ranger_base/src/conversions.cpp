@@ -329,6 +329,10 @@ std::string describe_refusal(const ranger::DriverSnapshot& snapshot) {
       return c.awaiting_command_mode ? "standby: requesting CAN command mode"
                                      : "standby (auto_command_mode is off)";
     case R::kModeUnknown:
+      if (c.chassis_mode == protocol::MotionMode::kPark) {
+        return "the chassis is in park mode (parked before this driver ran): call park with "
+               "data = false to leave it";
+      }
       return "motion mode unknown (no motion-mode feedback yet)";
     case R::kSwitching:
       return "motion-mode switch in progress";

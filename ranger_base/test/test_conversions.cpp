@@ -232,6 +232,14 @@ TEST(SystemState, ParkAndTheFirmwareVersion) {
   EXPECT_EQ(m.firmware_version_state, "answered");
 }
 
+TEST(SystemState, AChassisFoundInParkSaysHowToLeaveIt) {
+  ranger::ControllerState c;
+  c.link = ranger::LinkState::kConnected;
+  c.refusal = ranger::MotionRefusal::kModeUnknown;
+  c.chassis_mode = ranger::protocol::MotionMode::kPark;
+  EXPECT_NE(describe_refusal(c).find("call park with data = false"), std::string::npos);
+}
+
 // ---- the vendor's additions
 // ----------------------------------------------------------------------
 

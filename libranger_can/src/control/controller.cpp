@@ -350,7 +350,14 @@ Status ChassisController::request_park(bool on, Timestamp now) {
                                              config_.profile.revision +
                                              " (its motion-mode numbering has no park mode)"};
   }
-  if (on == state_.park_requested) return ok_status();
+  if (on == state_.park_requested) {
+    // A chassis found in park (parked before this driver ran): releasing switches it out.
+    if (!on && state_.chassis_mode == MotionMode::kPark && !leave_park_) {
+      leave_park_ = true;
+      command_changed_ = true;
+    }
+    return ok_status();
+  }
   state_.park_requested = on;
   leave_park_ = !on;
   mode_switch_.cancel();  // towards park, or out of it: a switch under way is abandoned
