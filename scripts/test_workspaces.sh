@@ -3,7 +3,8 @@
 # built with the standard tools; the driver run from catkin_make's devel space; the plain CMake
 # build (tests included) configured and built with the oldest CMake we declare; catkin_lint.
 #
-#   scripts/test_workspaces.sh [STEP...]     (default: lint catkin_make colcon cmake316)
+#   scripts/test_workspaces.sh [STEP...]     (default: lint catkin_make catkin_build colcon
+#                                             cmake316)
 #
 #   lint                  catkin_lint -W1 over the repository: no error, no warning; the catkin
 #                         tools find each package once (not again in build/ or install/)
@@ -27,7 +28,7 @@ cd "$(dirname "$0")/.."
 root=$(pwd)
 work=$root/build/workspaces
 jobs=${RANGER_JOBS:-$(nproc)}
-steps=${*:-lint catkin_make colcon cmake316}
+steps=${*:-lint catkin_make catkin_build colcon cmake316}
 export PATH=/usr/bin:$PATH  # the ROS tools need Debian's python3, not a pyenv one
 if [ -f /opt/ros/noetic/setup.bash ]; then set +u; source /opt/ros/noetic/setup.bash; set -u; fi
 mkdir -p "$work" && touch "$root/build/COLCON_IGNORE" "$root/build/CATKIN_IGNORE"

@@ -233,11 +233,12 @@ TEST(SystemState, ParkAndTheFirmwareVersion) {
 }
 
 TEST(SystemState, AChassisFoundInParkSaysHowToLeaveIt) {
-  ranger::ControllerState c;
+  ranger::DriverSnapshot snap;
+  ranger::ControllerState& c = snap.controller;
   c.link = ranger::LinkState::kConnected;
   c.refusal = ranger::MotionRefusal::kModeUnknown;
   c.chassis_mode = ranger::protocol::MotionMode::kPark;
-  EXPECT_NE(describe_refusal(c).find("call park with data = false"), std::string::npos);
+  EXPECT_NE(describe_refusal(snap).find("call park with data = false"), std::string::npos);
 }
 
 // ---- the vendor's additions

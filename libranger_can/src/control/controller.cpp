@@ -7,6 +7,7 @@
 #include <utility>
 #include <variant>
 
+#include "ranger_can/control/parameters.hpp"
 #include "ranger_can/transport/error_frame.hpp"
 #include "ranger_can/wire/interpretation.hpp"
 
@@ -124,13 +125,13 @@ Status ControllerConfig::validate() const {
   if (!std::isfinite(standstill_speed) || standstill_speed < 0.0) {
     return Error{Errc::kOutOfRange, "controller: standstill_speed must be finite and >= 0"};
   }
-  if (!std::isfinite(steer_first_threshold) || steer_first_threshold < 0.0 ||
-      steer_first_threshold > M_PI / 2) {
-    return Error{Errc::kOutOfRange,
-                 "controller: steer_first_threshold must be in [0, pi/2] rad (0 disables)"};
-  }
-  if (!std::isfinite(low_battery_soc) || low_battery_soc < 0.0 || low_battery_soc > 100.0) {
-    return Error{Errc::kOutOfRange, "controller: low_battery_soc must be in [0, 100] %"};
+  // The ranges the parameter table gives (control/parameters.hpp).
+  for (const auto& [name, value] :
+       {std::pair<const char*, double>{"steer_first_threshold", steer_first_threshold},
+        {"low_battery_soc", low_battery_soc}}) {
+    if (Status st = check_value(*find_driver_parameter(name), value); !st) {
+      return Error{st.error().code, "controller: " + st.error().message};
+    }
   }
   return ok_status();
 }
