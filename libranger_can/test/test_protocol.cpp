@@ -162,7 +162,6 @@ TEST(ProtocolIds, AllIdsAscendingWithTheirLayoutLength) {
   for (std::uint32_t id : ids) {
     EXPECT_TRUE(is_known_id(id));
     EXPECT_NE(frame_name(id), "unknown") << id;
-    EXPECT_EQ(expected_dlc(id), layout_dlc(id)) << "the deprecated name is an alias";
   }
   const std::pair<std::uint32_t, int> dlcs[] = {
       {0x111, 8}, {0x141, 1}, {0x421, 1}, {0x441, 1}, {0x451, 1}, {0x211, 8}, {0x221, 8},
@@ -304,13 +303,20 @@ TEST(ProtocolMotionModes, EachNumberingMapsItsWireValues) {
 
 // ---- The agx_v2 16-bit error word --------------------------------------------------------------
 
+// The vendor's bits (PROTOCOL_AGX_V2.md) carry the name of their meaning, the manual layout's name
+// where the manual has the same fault.
 TEST(ProtocolErrorBits, Agx16BitsByName) {
   const std::pair<std::uint32_t, const char*> rows[] = {
-      {0x0001, "battery_fault"},        {0x0002, "battery_warning"},
-      {0x0004, "remote_signal_lost"},   {0x0008, "motor1_communication"},
-      {0x0010, "motor2_communication"}, {0x0020, "motor3_communication"},
-      {0x0040, "motor4_communication"}, {0x0080, "steering_encoder"},
-      {0x0100, "motor_driver"},         {0x0200, "host_communication_lost"},
+      {0x0001, "battery_under_voltage"},               // battery fault
+      {0x0002, "battery_warning"},                     // battery warning
+      {0x0004, "remote_control_lost"},                 // remote-control signal lost
+      {0x0008, "motor_driver_1_communication_fault"},  // motor 1 communication
+      {0x0010, "motor_driver_2_communication_fault"},
+      {0x0020, "motor_driver_3_communication_fault"},
+      {0x0040, "motor_driver_4_communication_fault"},
+      {0x0080, "steering_encoder_fault"},  // steering encoder
+      {0x0100, "driver_status_error"},     // motor driver fault
+      {0x0200, "host_communication_lost"},
   };
   const auto& table = system_error_bits(ErrorWordLayout::kAgxV2_16);
   ASSERT_EQ(table.size(), std::size(rows));
@@ -403,6 +409,29 @@ TEST(ProtocolFaults, EveryFaultHasANameAndEveryBitIsNamedInItsLayout) {
     }
   }
   EXPECT_EQ(to_string(static_cast<Fault>(kFaultCount)), "unknown");
+}
+
+TEST(ProtocolFaults, TheTableHasOneRowPerMeaningAndOneBitPerRowAndLayout) {
+  std::set<std::string_view> names;
+  for (const FaultInfo& f : kFaultTable) {
+    EXPECT_TRUE(names.insert(f.name).second) << f.name;
+    EXPECT_TRUE(f.manual_bit != kNoBit || f.agx16_bit != kNoBit) << f.name;
+    EXPECT_EQ(find_fault(f.name), &f);
+    EXPECT_EQ(find_fault(f.fault, f.motor), &f) << f.name;
+    for (const auto layout : {ErrorWordLayout::kManual32, ErrorWordLayout::kAgxV2_16}) {
+      if (f.bit(layout) == kNoBit) continue;
+      EXPECT_LT(f.bit(layout), error_word_bits(layout)) << f.name;
+      EXPECT_EQ(fault_at(layout, f.bit(layout)), &f) << f.name << ": two rows on one bit";
+      EXPECT_EQ(is_critical_error(1u << f.bit(layout), layout), f.critical) << f.name;
+    }
+  }
+  // Every fault of the enum has a row.
+  for (const Fault f : kAllFaults) {
+    bool found = false;
+    for (const FaultInfo& row : kFaultTable)
+      found = found || row.fault == f;
+    EXPECT_TRUE(found) << to_string(f);
+  }
 }
 
 TEST(ProtocolFaults, TheCriticalSetIsMadeOfFaults) {

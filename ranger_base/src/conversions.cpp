@@ -201,6 +201,8 @@ const std::map<std::string_view, SystemErrorField>& system_error_fields() {
       RANGER_FIELD(SystemErrors, motor_driver_2_communication_fault),
       RANGER_FIELD(SystemErrors, motor_driver_3_communication_fault),
       RANGER_FIELD(SystemErrors, motor_driver_4_communication_fault),
+      RANGER_FIELD(SystemErrors, battery_warning),
+      RANGER_FIELD(SystemErrors, steering_encoder_fault),
   };
   return fields;
 }
@@ -242,7 +244,14 @@ void fill_bits(std::uint32_t word, const std::vector<protocol::NamedBit>& bits,
 
 void fill_system_errors(std::uint32_t error_word, ranger::ErrorWordLayout layout,
                         ranger_msgs::SystemErrors& out) {
-  fill_bits(error_word, protocol::system_error_bits(layout), system_error_fields(), out);
+  // By meaning: each fault-table row with a bit in this layout sets the field of its name.
+  const auto& fields = system_error_fields();
+  for (const protocol::FaultInfo& f : protocol::kFaultTable) {
+    const int bit = f.bit(layout);
+    const auto it = fields.find(f.name);
+    if (bit == protocol::kNoBit || it == fields.end()) continue;
+    out.*(it->second) = ((error_word >> bit) & 1u) != 0;
+  }
 }
 
 ranger_msgs::DriverStatus to_driver_status(std::uint8_t status) {
@@ -305,8 +314,9 @@ std::string describe_refusal(const ranger::ControllerState& c) {
       return "";
     case R::kLinkLost:
       if (listening(c)) {
-        return c.identifying + " (nothing is sent until the chassis has been heard; motion waits "
-                               "for the identification)";
+        return c.identifying +
+               " (nothing is sent until the chassis has been heard; motion waits "
+               "for the identification)";
       }
       return c.link == ranger::LinkState::kNeverConnected
                  ? "no chassis heard yet (waiting for its system status)"

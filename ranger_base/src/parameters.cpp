@@ -536,8 +536,15 @@ NodeParameters read_all(Reader& r) {
   const double ultrasonic_m =
       r.number("sim/ultrasonic_range", s.ultrasonic[0] / 1000.0, closed(0.0, 32.767), "m");
   s.ultrasonic.fill(static_cast<std::int16_t>(std::lround(ultrasonic_m * 1000.0)));
+  // Error bits by index or name, in the error-word layout of the port's variant.
+  ranger::ErrorWordLayout layout = s.profile.error_word;
+  if (const auto kind = ranger::bus_kind(p.port_name);
+      kind && *kind == ranger::BusKind::kSim && p.port_name.size() > 4) {
+    if (auto v = ranger::sim::apply_variant(p.port_name.substr(4), {}))
+      layout = v->profile.error_word;
+  }
   for (const auto& name : r.text_list("sim/errors")) {
-    if (auto bit = ranger::sim::parse_error_bit(name)) {
+    if (auto bit = ranger::sim::parse_error_bit(name, layout)) {
       p.sim.boot_error_bits |= 1u << *bit;
     } else {
       r.fail("sim/errors", "contains \"" + name + "\": " + bit.error().message);

@@ -31,9 +31,14 @@
 #include <std_srvs/Trigger.h>
 #include <tf2/utils.h>
 
+#include <ranger_base/conversions.hpp>
+#include <ranger_base/diagnostics.hpp>
+#include <ranger_can/wire/protocol.hpp>
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <deque>
 #include <functional>
 #include <limits>
@@ -631,7 +636,6 @@ class Safety : public NodeSim {
         inject(line);
     }
   };
-
 };
 
 TEST_F(Safety, EmergencyStopLatchesUntilResume) {
@@ -842,6 +846,60 @@ TEST_F(Faults, ClearErrorsAnswersThenTheLatchHoldsUntilResume) {
   stop_and_settle();
 }
 
+// ---- node_sim_fault_bits*.test: every error bit of the chassis's layout, by meaning ------------
+
+class FaultBits : public Faults {
+ protected:
+  // The error-word layout of the chassis (the test's private parameter): "manual" or "agx_v2".
+  static ranger::ErrorWordLayout layout() {
+    std::string name = "manual";
+    ros::param::get("~layout", name);
+    return name == "agx_v2" ? ranger::ErrorWordLayout::kAgxV2_16
+                            : ranger::ErrorWordLayout::kManual32;
+  }
+
+  // The value /diagnostics' error status gives `key` (empty when absent).
+  static std::string diagnostic_value(const std::string& key) {
+    std::lock_guard<std::mutex> lock(commands_mutex_);
+    for (const auto& [name, status] : diagnostics_) {
+      if (name.size() < std::strlen(ranger_base::kDiagErrors) ||
+          name.compare(name.size() - std::strlen(ranger_base::kDiagErrors), std::string::npos,
+                       ranger_base::kDiagErrors) != 0) {
+        continue;
+      }
+      for (const auto& kv : status.values) {
+        if (kv.key == key) return kv.value;
+      }
+    }
+    return "";
+  }
+};
+
+// Each bit the layout defines, raised on the virtual chassis through sim/inject, shows the
+// SystemErrors field of its meaning (and no other) true in system_state, and its name active in
+// /diagnostics; dropped, it clears.
+TEST_F(FaultBits, EveryBitOfTheLayoutShowsTheFieldOfItsMeaning) {
+  const auto& fields = ranger_base::system_error_fields();
+  const auto& bits = ranger::protocol::system_error_bits(layout());
+  ASSERT_FALSE(bits.empty());
+  for (const auto& bit : bits) {
+    const std::string name(bit.name);
+    const auto field = fields.at(bit.name);
+    inject("error " + std::to_string(bit.index));
+    ASSERT_TRUE(wait_for([&] { return state_.get()->errors.*field != 0; })) << name;
+    const auto s = *state_.get();
+    EXPECT_EQ(s.error_word, 1u << bit.index) << name;
+    for (const auto& [other, other_field] : fields) {
+      EXPECT_EQ(s.errors.*other_field != 0, other == bit.name) << name << ": field " << other;
+    }
+    EXPECT_TRUE(contains(s.active_errors, name)) << name;
+    EXPECT_TRUE(wait_for([&] { return diagnostic_value(name) == "active"; })) << name;
+    inject("error " + std::to_string(bit.index) + " off");
+    ASSERT_TRUE(wait_for([] { return state_.get()->error_word == 0; })) << name;
+    EXPECT_FALSE(state_.get()->errors.*field) << name;
+  }
+}
+
 // ---- node_sim_identify*.test: protocol auto (the default) -------------------------------------
 
 class Identification : public NodeSim {
@@ -870,7 +928,8 @@ TEST_F(Identification, NothingIsDrivenBeforeTheDecisionThenCmdVelDrives) {
   EXPECT_NE(first.identification, "decided")
       << "the node decided before the test saw it identify: start-up too slow to observe";
   const auto arc = twist(0.4, 0.0, 0.2);
-  ASSERT_TRUE(drive_until(arc, [] { return state_.get()->identification == "decided"; }, 30.0))
+  ASSERT_TRUE(drive_until(
+      arc, [] { return state_.get()->identification == "decided"; }, 30.0))
       << "identification: " << state_.get()->identification << ", "
       << state_.get()->motion_inhibited_detail;
 
@@ -926,8 +985,8 @@ TEST_F(Identification, NothingIsDrivenBeforeTheDecisionThenCmdVelDrives) {
 // sim:undecidable: no reading explains it. The node stays at rest and says what to set.
 TEST_F(Identification, AChassisThatCannotBeIdentifiedStaysAtRestAndSaysWhatToSet) {
   ASSERT_TRUE(wait_for(ready_for_commands, 30.0)) << "no system_state from the node";
-  ASSERT_TRUE(drive_until(twist(0.4, 0, 0), [] { return state_.get()->identification == "failed"; },
-                          30.0))
+  ASSERT_TRUE(drive_until(
+      twist(0.4, 0, 0), [] { return state_.get()->identification == "failed"; }, 30.0))
       << state_.get()->identification;
   ASSERT_TRUE(drive_for_states(twist(0.4, 0, 0), 10));
   EXPECT_LT(speed(*truth_.get()), 1e-3);
@@ -945,9 +1004,9 @@ TEST_F(Identification, AChassisThatCannotBeIdentifiedStaysAtRestAndSaysWhatToSet
     return d && d->level == diagnostic_msgs::DiagnosticStatus::ERROR;
   }));
   const auto d = *diagnostic("Protocol");
-  for (const char* expected : {"could not be identified", "protocol: manual", "identify_timeout",
-                               "ranger_can commission IFACE --wheels-lifted",
-                               "commissioning_file"}) {
+  for (const char* expected :
+       {"could not be identified", "protocol: manual", "identify_timeout",
+        "ranger_can commission IFACE --wheels-lifted", "commissioning_file"}) {
     EXPECT_NE(d.message.find(expected), std::string::npos) << expected << " in " << d.message;
   }
   EXPECT_EQ(value_of(d, "Identification"), "failed");
@@ -989,7 +1048,8 @@ TEST_F(Implausible, AWrongSpinSignIsStoppedAndSaid) {
   cmd_pub_.publish(twist(0, 0, 0));
   const auto resumed = call_resume();
   EXPECT_TRUE(resumed.success) << resumed.message;
-  EXPECT_TRUE(wait_for([] { return state_.get()->motion_inhibited_reason != "implausible_feedback"; }));
+  EXPECT_TRUE(
+      wait_for([] { return state_.get()->motion_inhibited_reason != "implausible_feedback"; }));
 }
 
 // sim:inner_angle with protocol manual: the arc is steered on the wrong reference; a subtle
@@ -1004,8 +1064,8 @@ TEST_F(Implausible, AWrongSteeringReferenceIsWarnedThenStopped) {
             std::string::npos)
       << state_.get()->motion_inhibited_detail;
   ASSERT_TRUE(drive_until(arc, [] { return speed(*truth_.get()) < 1e-3; }));
-  ASSERT_TRUE(logged("plausibility: steering_reference: try inner_front", t0,
-                     rosgraph_msgs::Log::WARN));
+  ASSERT_TRUE(
+      logged("plausibility: steering_reference: try inner_front", t0, rosgraph_msgs::Log::WARN));
   ASSERT_TRUE(logged("plausibility stop: steering_reference: try inner_front", t0,
                      rosgraph_msgs::Log::ERROR));
   // The warning came first, once.

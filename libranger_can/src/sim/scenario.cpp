@@ -13,6 +13,7 @@
 #include "ranger_can/control/rearm.hpp"
 #include "ranger_can/parse.hpp"
 #include "ranger_can/sim/sim_bus_source.hpp"
+#include "ranger_can/text.hpp"
 #include "ranger_can/wire/protocol.hpp"
 
 namespace ranger::sim {
@@ -78,12 +79,7 @@ Error problem(const std::string& what) {
   return Error{Errc::kParseError, what};
 }
 
-std::string join(const std::vector<std::string>& names, const char* sep = ", ") {
-  std::string out;
-  for (const auto& n : names)
-    out += (out.empty() ? "" : sep) + n;
-  return out;
-}
+using text::join;
 
 std::vector<std::string> split(std::string_view text) {
   std::vector<std::string> words;
@@ -131,53 +127,37 @@ std::string printable(const std::string& text) {
 // ---- names the checks accept ----
 
 const std::vector<std::string>& refusal_names() {
-  static const std::vector<std::string> names = [] {
-    std::vector<std::string> n;
-    for (MotionRefusal r :
-         {MotionRefusal::kNone, MotionRefusal::kLinkLost, MotionRefusal::kRemote,
-          MotionRefusal::kEstop, MotionRefusal::kCriticalError, MotionRefusal::kLowBattery,
-          MotionRefusal::kModeSwitchFailed, MotionRefusal::kImplausible,
-          MotionRefusal::kRearmRequired, MotionRefusal::kStandby, MotionRefusal::kModeUnknown,
-          MotionRefusal::kSwitching, MotionRefusal::kCmdTimeout, MotionRefusal::kBelowMinimum}) {
-      n.emplace_back(to_string(r));
-    }
-    return n;
-  }();
+  static const std::vector<std::string> names = text::names_of(kAllMotionRefusals);
+  return names;
+}
+
+// An `all` list's names and "null" (the field has no value yet).
+template <typename Enum, std::size_t N>
+std::vector<std::string> names_or_null(const Enum (&all)[N]) {
+  std::vector<std::string> names = text::names_of(all);
+  names.emplace_back("null");
   return names;
 }
 
 const std::vector<std::string>& control_mode_names() {
-  static const std::vector<std::string> names = {
-      std::string(protocol::to_string(ControlMode::kStandby)),
-      std::string(protocol::to_string(ControlMode::kCan)),
-      std::string(protocol::to_string(ControlMode::kRemote)), "null"};
+  static const std::vector<std::string> names = names_or_null(protocol::kAllControlModes);
   return names;
 }
 
 const std::vector<std::string>& motion_mode_names() {
-  static const std::vector<std::string> names = {
-      std::string(protocol::to_string(MotionMode::kAckermann)),
-      std::string(protocol::to_string(MotionMode::kOblique)),
-      std::string(protocol::to_string(MotionMode::kSpin)), "null"};
+  static const std::vector<std::string> names = names_or_null(protocol::kAllMotionModes);
   return names;
 }
 
-// Every name ControllerState::faults can hold: the 0x211 error bits (reserved ones as
-// "reserved_bit_N") and the controller's own (controller.cpp, update_faults).
+// Every name ControllerState::faults can hold: the controller's own, the fault table's (either
+// layout) and a reserved bit's "reserved_bit_N".
 const std::vector<std::string>& fault_names() {
   static const std::vector<std::string> names = [] {
-    std::vector<std::string> n = {"link_lost",
-                                  "emergency_stop",
-                                  "vehicle_abnormal",
-                                  "vehicle_status_unknown",
-                                  "low_battery",
-                                  "motion_mode_switch_failed",
-                                  "implausible_feedback",
-                                  "ultrasonic_setting_unconfirmed"};
-    for (int bit = 0; bit < 32; ++bit) {
-      for (auto& name : protocol::error_bit_names(1u << bit))
-        n.push_back(std::move(name));
-    }
+    std::vector<std::string> n = text::names_of(kAllControllerFaults);
+    for (const protocol::FaultInfo& f : protocol::kFaultTable)
+      n.emplace_back(f.name);
+    for (int bit = 0; bit < 32; ++bit)
+      n.push_back("reserved_bit_" + std::to_string(bit));
     return n;
   }();
   return names;

@@ -80,10 +80,6 @@ int layout_dlc(std::uint32_t id) {
   return -1;
 }
 
-int expected_dlc(std::uint32_t id) {
-  return layout_dlc(id);
-}
-
 bool is_version_request(const CanFrame& f) {
   if (f.dlc < 1 || f.data[0] != kVersionRequestValue) return false;
   const std::size_t n = std::min<std::size_t>(f.dlc, CanFrame::kMaxDlc);
@@ -292,74 +288,14 @@ int error_word_bits(ErrorWordLayout layout) {
 
 namespace {
 
-const std::vector<NamedBit>& manual_error_bits() {
-  // Wheel order of the manual (RF, RR, LR, LF), named as in geometry.hpp's joint names.
-  static const std::vector<NamedBit> bits = {
-      // byte 7 (least significant)
-      {error_bit_index(7, 0), "battery_under_voltage", "battery under-voltage"},
-      {error_bit_index(7, 1), "ultrasonic_obstacle_triggered",
-       "ultrasonic obstacle avoidance triggered"},
-      {error_bit_index(7, 2), "remote_control_lost", "remote control lost-connection protection"},
-      {error_bit_index(7, 3), "motor_driver_1_communication_fault",
-       "communication fault of motor driver 1 (front-right wheel)"},
-      {error_bit_index(7, 4), "motor_driver_2_communication_fault",
-       "communication fault of motor driver 2 (rear-right wheel)"},
-      {error_bit_index(7, 5), "motor_driver_3_communication_fault",
-       "communication fault of motor driver 3 (rear-left wheel)"},
-      {error_bit_index(7, 6), "motor_driver_4_communication_fault",
-       "communication fault of motor driver 4 (front-left wheel)"},
-      // byte 6
-      {error_bit_index(6, 0), "driver_status_error", "motor driver status error"},
-      {error_bit_index(6, 1), "host_communication_lost",
-       "communication with the upper layer (host) lost"},
-      {error_bit_index(6, 2), "motor_driver_5_communication_fault",
-       "communication fault of motor driver 5 (front-right steering)"},
-      {error_bit_index(6, 3), "motor_driver_6_communication_fault",
-       "communication fault of motor driver 6 (rear-right steering)"},
-      {error_bit_index(6, 4), "motor_driver_7_communication_fault",
-       "communication fault of motor driver 7 (rear-left steering)"},
-      {error_bit_index(6, 5), "motor_driver_8_communication_fault",
-       "communication fault of motor driver 8 (front-left steering)"},
-      {error_bit_index(6, 6), "over_temperature", "over-temperature protection"},
-      {error_bit_index(6, 7), "over_current", "over-current protection"},
-      // byte 5
-      {error_bit_index(5, 0), "steering_calibration_fault_front_right",
-       "steering zero-point calibration fault, front-right"},
-      {error_bit_index(5, 1), "steering_calibration_fault_rear_right",
-       "steering zero-point calibration fault, rear-right"},
-      {error_bit_index(5, 2), "steering_calibration_fault_rear_left",
-       "steering zero-point calibration fault, rear-left"},
-      {error_bit_index(5, 3), "steering_calibration_fault_front_left",
-       "steering zero-point calibration fault, front-left"},
-      {error_bit_index(5, 4), "steering_calibration_timeout", "steering calibration timeout"},
-      {error_bit_index(5, 5), "safety_edge_collision", "safety edge (bumper) collision"},
-      // byte 4 (most significant)
-      {error_bit_index(4, 0), "steering_servo_warning_front_right",
-       "steering servo warning, front-right"},
-      {error_bit_index(4, 1), "steering_servo_warning_rear_right",
-       "steering servo warning, rear-right"},
-      {error_bit_index(4, 2), "steering_servo_warning_rear_left",
-       "steering servo warning, rear-left"},
-      {error_bit_index(4, 3), "steering_servo_warning_front_left",
-       "steering servo warning, front-left"},
-  };
-  return bits;
-}
-
-const std::vector<NamedBit>& agx16_error_bits() {
-  // PROTOCOL_AGX_V2.md: generic to the vendor's chassis family.
-  static const std::vector<NamedBit> bits = {
-      {0, "battery_fault", "battery fault"},
-      {1, "battery_warning", "battery warning"},
-      {2, "remote_signal_lost", "remote-control signal lost"},
-      {3, "motor1_communication", "communication fault of motor 1 (front-right wheel)"},
-      {4, "motor2_communication", "communication fault of motor 2 (rear-right wheel)"},
-      {5, "motor3_communication", "communication fault of motor 3 (rear-left wheel)"},
-      {6, "motor4_communication", "communication fault of motor 4 (front-left wheel)"},
-      {7, "steering_encoder", "steering encoder fault"},
-      {8, "motor_driver", "motor driver fault"},
-      {9, "host_communication_lost", "communication with the host lost"},
-  };
+// A layout's rows of the fault table as named bits, in ascending bit order.
+std::vector<NamedBit> layout_bits(ErrorWordLayout layout) {
+  std::vector<NamedBit> bits;
+  for (const FaultInfo& f : kFaultTable) {
+    if (f.bit(layout) != kNoBit) bits.push_back({f.bit(layout), f.name, f.description});
+  }
+  std::sort(bits.begin(), bits.end(),
+            [](const NamedBit& x, const NamedBit& y) { return x.index < y.index; });
   return bits;
 }
 
@@ -381,18 +317,16 @@ std::vector<std::string> names_of_set_bits(std::uint32_t word, int width,
   return names;
 }
 
-std::uint32_t manual_bit(int byte, int bit) {
-  return 1u << error_bit_index(byte, bit);
-}
-
 }  // namespace
 
 const std::vector<NamedBit>& system_error_bits(ErrorWordLayout layout) {
-  return layout == ErrorWordLayout::kAgxV2_16 ? agx16_error_bits() : manual_error_bits();
+  static const std::vector<NamedBit> manual = layout_bits(ErrorWordLayout::kManual32);
+  static const std::vector<NamedBit> agx16 = layout_bits(ErrorWordLayout::kAgxV2_16);
+  return layout == ErrorWordLayout::kAgxV2_16 ? agx16 : manual;
 }
 
 const std::vector<NamedBit>& system_error_bits() {
-  return manual_error_bits();
+  return system_error_bits(ErrorWordLayout::kManual32);
 }
 
 std::vector<std::string> error_bit_names(std::uint32_t error_word, ErrorWordLayout layout) {
@@ -445,59 +379,30 @@ std::string_view to_string(Fault f) {
   return "unknown";
 }
 
+const FaultInfo* find_fault(Fault fault, int motor) {
+  for (const FaultInfo& f : kFaultTable) {
+    if (f.fault == fault && (f.motor == 0 || f.motor == motor)) return &f;
+  }
+  return nullptr;
+}
+
+const FaultInfo* find_fault(std::string_view name) {
+  for (const FaultInfo& f : kFaultTable) {
+    if (f.name == name) return &f;
+  }
+  return nullptr;
+}
+
+const FaultInfo* fault_at(ErrorWordLayout layout, int index) {
+  for (const FaultInfo& f : kFaultTable) {
+    if (index != kNoBit && f.bit(layout) == index) return &f;
+  }
+  return nullptr;
+}
+
 std::uint32_t fault_bit(Fault fault, ErrorWordLayout layout, int motor) {
-  const bool steering_motor = motor >= 5 && motor <= kMotorCount;
-  if (layout == ErrorWordLayout::kAgxV2_16) {
-    switch (fault) {
-      case Fault::kBatteryUnderVoltage:
-        return 0x0001;
-      case Fault::kBatteryWarning:
-        return 0x0002;
-      case Fault::kRemoteSignalLost:
-        return 0x0004;
-      case Fault::kMotorCommunication:
-        return motor >= 1 && motor <= 4 ? 0x0008u << (motor - 1) : 0;
-      case Fault::kSteeringEncoder:
-        return 0x0080;
-      case Fault::kDriverStatusError:
-        return 0x0100;
-      case Fault::kHostCommunicationLost:
-        return 0x0200;
-      default:
-        return 0;
-    }
-  }
-  switch (fault) {
-    case Fault::kBatteryUnderVoltage:
-      return manual_bit(7, 0);
-    case Fault::kUltrasonicTriggered:
-      return manual_bit(7, 1);
-    case Fault::kRemoteSignalLost:
-      return manual_bit(7, 2);
-    case Fault::kMotorCommunication:
-      if (motor >= 1 && motor <= 4) return manual_bit(7, 2 + motor);
-      return steering_motor ? manual_bit(6, motor - 3) : 0;
-    case Fault::kDriverStatusError:
-      return manual_bit(6, 0);
-    case Fault::kHostCommunicationLost:
-      return manual_bit(6, 1);
-    case Fault::kOverTemperature:
-      return manual_bit(6, 6);
-    case Fault::kOverCurrent:
-      return manual_bit(6, 7);
-    case Fault::kSteeringCalibration:
-      return steering_motor ? manual_bit(5, motor - 5) : 0;
-    case Fault::kSteeringCalibrationTimeout:
-      return manual_bit(5, 4);
-    case Fault::kSafetyEdge:
-      return manual_bit(5, 5);
-    case Fault::kSteeringServoWarning:
-      return steering_motor ? manual_bit(4, motor - 5) : 0;
-    case Fault::kBatteryWarning:
-    case Fault::kSteeringEncoder:
-      return 0;
-  }
-  return 0;
+  const FaultInfo* f = find_fault(fault, motor);
+  return f != nullptr && f->bit(layout) != kNoBit ? 1u << f->bit(layout) : 0u;
 }
 
 // ---- 0x261-0x268 driver status bits -----------------------------------------------------------

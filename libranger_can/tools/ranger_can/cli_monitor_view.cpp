@@ -95,7 +95,7 @@ void ChassisMonitor::on_frame(const CanFrame& frame, Timestamp now) {
     return;
   }
   auto decoded = decode(frame, profile_);
-  stats_.record(frame.id, now, decoded.ok(), frame.dlc - protocol::expected_dlc(frame.id));
+  stats_.record(frame.id, now, decoded.ok(), protocol::extra_bytes(frame));
   if (!decoded) {
     ++decode_errors_;
     return;

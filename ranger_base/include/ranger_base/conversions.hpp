@@ -78,8 +78,8 @@ std::vector<std::string> cause_names(ranger::StopCauses causes);
 
 ranger_msgs::SystemState to_system_state(const ranger::DriverSnapshot& snapshot,
                                          const ros::Time& stamp);
-// Sets every SystemErrors field from the chassis's error word, through libranger_can's bit names
-// for the word's layout (the protocol profile's).
+// Sets the SystemErrors fields by meaning: each row of the fault table (protocol::kFaultTable)
+// with a bit in `layout` sets the field of its name from that bit; the others stay as they are.
 void fill_system_errors(std::uint32_t error_word, ranger::ErrorWordLayout layout,
                         ranger_msgs::SystemErrors& out);
 ranger_msgs::DriverStatus to_driver_status(std::uint8_t status);

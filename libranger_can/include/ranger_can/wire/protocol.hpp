@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <iterator>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -59,8 +60,6 @@ bool is_known_id(std::uint32_t id);
 // frame may be longer (its extra bytes are ignored), never shorter. 0x4A1: 1 (the request; an
 // answer's text is as long as the frame).
 int layout_dlc(std::uint32_t id);
-// Deprecated: the old name of layout_dlc (the DLC used to be the only one accepted).
-int expected_dlc(std::uint32_t id);
 // Bytes of `frame` past its layout that a decoder ignores (0 for an unknown ID, an error frame, a
 // frame not longer than its layout, or a 0x4A1 answer, whose text is the whole frame).
 int extra_bytes(const CanFrame& frame);
@@ -129,11 +128,24 @@ enum class ErrorClearCode : std::uint8_t {
 };
 inline constexpr std::uint8_t kMaxErrorClearCode = 0x10;
 
+// Names (snake_case, stable) and every enumerator of each, in wire order: what the scenario
+// language, the CLI and the ROS node accept and print.
 std::string_view to_string(MotionMode m);
 std::string_view to_string(ControlMode m);
 std::string_view to_string(VehicleStatus s);
 std::string_view to_string(RemoteSwitch s);
 std::string_view to_string(LightMode m);
+inline constexpr MotionMode kAllMotionModes[] = {MotionMode::kAckermann, MotionMode::kOblique,
+                                                 MotionMode::kSpin, MotionMode::kPark,
+                                                 MotionMode::kSideSlip};
+inline constexpr ControlMode kAllControlModes[] = {ControlMode::kStandby, ControlMode::kCan,
+                                                   ControlMode::kUart, ControlMode::kRemote};
+inline constexpr VehicleStatus kAllVehicleStatuses[] = {
+    VehicleStatus::kNormal, VehicleStatus::kEmergencyStop, VehicleStatus::kAbnormal};
+inline constexpr RemoteSwitch kAllRemoteSwitches[] = {
+    RemoteSwitch::kUndefined, RemoteSwitch::kMiddle, RemoteSwitch::kUp, RemoteSwitch::kDown};
+inline constexpr LightMode kAllLightModes[] = {LightMode::kOff, LightMode::kOn,
+                                               LightMode::kBreathing, LightMode::kCustom};
 // Describes what a 0x441 code clears ("all non-critical faults", "motor driver 3 communication
 // fault").
 std::string error_clear_description(std::uint8_t code);
@@ -156,7 +168,8 @@ struct NamedBit {
   std::string_view description;
 };
 
-// Every defined error bit of a layout, in ascending bit order (reserved bits are absent).
+// Every defined error bit of a layout: the rows of the fault table (below) with a bit in it, in
+// ascending bit order (reserved bits are absent). A fault's name is the same in either layout.
 const std::vector<NamedBit>& system_error_bits(ErrorWordLayout layout);
 const std::vector<NamedBit>& system_error_bits();  // the manual's (kManual32)
 // Names of the bits set in `error_word`; reserved bits that are set appear as "reserved_bit_N".
@@ -168,28 +181,105 @@ std::vector<std::string> error_bit_names(std::uint32_t error_word);  // kManual3
 bool is_critical_error(std::uint32_t error_word, ErrorWordLayout layout);
 bool is_critical_error(std::uint32_t error_word);  // kManual32
 
-// Faults by meaning, so that the controller and the virtual chassis never write a bit position:
-// fault_bit() gives a fault's bit in a layout's word, 0 when the layout has no such bit. `motor`
-// numbers the motor for the faults marked so (protocol numbering, 1..8); 0 otherwise.
+// Faults by meaning, so that the controller, the virtual chassis and the ROS node never write a
+// bit position. `motor` numbers the motor of a motor-numbered fault (protocol numbering, 1..8: the
+// wheels 1-4 and steering motors 5-8 in the manual's wheel order RF, RR, LR, LF); 0 otherwise.
 enum class Fault {
-  kBatteryUnderVoltage,         // manual: byte 7 bit 0; agx16: 0x0001 battery fault
-  kBatteryWarning,              // agx16: 0x0002; manual: none
-  kUltrasonicTriggered,         // manual: byte 7 bit 1; agx16: none
-  kRemoteSignalLost,            // manual: byte 7 bit 2; agx16: 0x0004
-  kHostCommunicationLost,       // manual: byte 6 bit 1; agx16: 0x0200
-  kDriverStatusError,           // manual: byte 6 bit 0; agx16: 0x0100 motor driver
-  kOverTemperature,             // manual: byte 6 bit 6; agx16: none
-  kOverCurrent,                 // manual: byte 6 bit 7; agx16: none
-  kMotorCommunication,          // motor 1..8; manual: byte 7 bits 3-6, byte 6 bits 2-5;
-                                // agx16: motors 1..4 only, 0x0008..0x0040
-  kSteeringCalibration,         // steering motor 5..8; manual: byte 5 bits 0-3; agx16: none
-  kSteeringCalibrationTimeout,  // manual: byte 5 bit 4; agx16: none
-  kSafetyEdge,                  // manual: byte 5 bit 5; agx16: none
-  kSteeringServoWarning,        // steering motor 5..8; manual: byte 4 bits 0-3; agx16: none
-  kSteeringEncoder,             // agx16: 0x0080; manual: none
+  kBatteryUnderVoltage,
+  kBatteryWarning,
+  kUltrasonicTriggered,
+  kRemoteSignalLost,
+  kHostCommunicationLost,
+  kDriverStatusError,
+  kOverTemperature,
+  kOverCurrent,
+  kMotorCommunication,   // motor-numbered
+  kSteeringCalibration,  // motor-numbered (steering motors 5..8)
+  kSteeringCalibrationTimeout,
+  kSafetyEdge,
+  kSteeringServoWarning,  // motor-numbered (steering motors 5..8)
+  kSteeringEncoder,
 };
-inline constexpr int kFaultCount = 14;
+inline constexpr Fault kAllFaults[] = {
+    Fault::kBatteryUnderVoltage,
+    Fault::kBatteryWarning,
+    Fault::kUltrasonicTriggered,
+    Fault::kRemoteSignalLost,
+    Fault::kHostCommunicationLost,
+    Fault::kDriverStatusError,
+    Fault::kOverTemperature,
+    Fault::kOverCurrent,
+    Fault::kMotorCommunication,
+    Fault::kSteeringCalibration,
+    Fault::kSteeringCalibrationTimeout,
+    Fault::kSafetyEdge,
+    Fault::kSteeringServoWarning,
+    Fault::kSteeringEncoder,
+};
+inline constexpr int kFaultCount = static_cast<int>(std::size(kAllFaults));
 std::string_view to_string(Fault f);  // "battery_under_voltage", ...
+
+// ---- The fault table
+// ----------------------------------------------------------------------------- One row per fault
+// the chassis reports in 0x211, by meaning: its bit in each error-word layout (kNoBit when the
+// layout has none), its stable snake_case name (ControllerState::faults, the ROS message's
+// SystemErrors field, diagnostics, the scenario language: the same name on both revisions), whether
+// it is critical (the chassis does not drive until it is cleared: our reading, interpretation.hpp)
+// and a description. Every bit position of either layout is written here and nowhere else.
+inline constexpr int kNoBit = -1;
+struct FaultInfo {
+  Fault fault;
+  int motor;       // 1..8 for a motor-numbered fault, 0 otherwise
+  int manual_bit;  // position in the kManual32 word (error_bit_index(byte, bit)) or kNoBit
+  int agx16_bit;   // position in the kAgxV2_16 word or kNoBit
+  bool critical;
+  std::string_view name;
+  std::string_view description;
+
+  constexpr int bit(ErrorWordLayout layout) const {
+    return layout == ErrorWordLayout::kAgxV2_16 ? agx16_bit : manual_bit;
+  }
+};
+// clang-format off
+inline constexpr FaultInfo kFaultTable[] = {
+  // fault                             motor manual bit              agx16  critical
+  {Fault::kBatteryUnderVoltage,         0, error_bit_index(7, 0),     0, true,  "battery_under_voltage", "battery under-voltage (agx_v2: battery fault)"},
+  {Fault::kBatteryWarning,              0, kNoBit,                    1, false, "battery_warning", "battery warning"},
+  {Fault::kUltrasonicTriggered,         0, error_bit_index(7, 1), kNoBit, false, "ultrasonic_obstacle_triggered", "ultrasonic obstacle avoidance triggered"},
+  {Fault::kRemoteSignalLost,            0, error_bit_index(7, 2),     2, false, "remote_control_lost", "remote control lost-connection protection"},
+  {Fault::kMotorCommunication,          1, error_bit_index(7, 3),     3, true,  "motor_driver_1_communication_fault", "communication fault of motor driver 1 (front-right wheel)"},
+  {Fault::kMotorCommunication,          2, error_bit_index(7, 4),     4, true,  "motor_driver_2_communication_fault", "communication fault of motor driver 2 (rear-right wheel)"},
+  {Fault::kMotorCommunication,          3, error_bit_index(7, 5),     5, true,  "motor_driver_3_communication_fault", "communication fault of motor driver 3 (rear-left wheel)"},
+  {Fault::kMotorCommunication,          4, error_bit_index(7, 6),     6, true,  "motor_driver_4_communication_fault", "communication fault of motor driver 4 (front-left wheel)"},
+  {Fault::kDriverStatusError,           0, error_bit_index(6, 0),     8, true,  "driver_status_error", "motor driver status error (agx_v2: motor driver fault)"},
+  {Fault::kHostCommunicationLost,       0, error_bit_index(6, 1),     9, false, "host_communication_lost", "communication with the upper layer (host) lost"},
+  {Fault::kMotorCommunication,          5, error_bit_index(6, 2), kNoBit, true,  "motor_driver_5_communication_fault", "communication fault of motor driver 5 (front-right steering)"},
+  {Fault::kMotorCommunication,          6, error_bit_index(6, 3), kNoBit, true,  "motor_driver_6_communication_fault", "communication fault of motor driver 6 (rear-right steering)"},
+  {Fault::kMotorCommunication,          7, error_bit_index(6, 4), kNoBit, true,  "motor_driver_7_communication_fault", "communication fault of motor driver 7 (rear-left steering)"},
+  {Fault::kMotorCommunication,          8, error_bit_index(6, 5), kNoBit, true,  "motor_driver_8_communication_fault", "communication fault of motor driver 8 (front-left steering)"},
+  {Fault::kOverTemperature,             0, error_bit_index(6, 6), kNoBit, true,  "over_temperature", "over-temperature protection"},
+  {Fault::kOverCurrent,                 0, error_bit_index(6, 7), kNoBit, true,  "over_current", "over-current protection"},
+  {Fault::kSteeringCalibration,         5, error_bit_index(5, 0), kNoBit, true,  "steering_calibration_fault_front_right", "steering zero-point calibration fault, front-right"},
+  {Fault::kSteeringCalibration,         6, error_bit_index(5, 1), kNoBit, true,  "steering_calibration_fault_rear_right", "steering zero-point calibration fault, rear-right"},
+  {Fault::kSteeringCalibration,         7, error_bit_index(5, 2), kNoBit, true,  "steering_calibration_fault_rear_left", "steering zero-point calibration fault, rear-left"},
+  {Fault::kSteeringCalibration,         8, error_bit_index(5, 3), kNoBit, true,  "steering_calibration_fault_front_left", "steering zero-point calibration fault, front-left"},
+  {Fault::kSteeringCalibrationTimeout,  0, error_bit_index(5, 4), kNoBit, true,  "steering_calibration_timeout", "steering calibration timeout"},
+  {Fault::kSafetyEdge,                  0, error_bit_index(5, 5), kNoBit, true,  "safety_edge_collision", "safety edge (bumper) collision"},
+  {Fault::kSteeringServoWarning,        5, error_bit_index(4, 0), kNoBit, false, "steering_servo_warning_front_right", "steering servo warning, front-right"},
+  {Fault::kSteeringServoWarning,        6, error_bit_index(4, 1), kNoBit, false, "steering_servo_warning_rear_right", "steering servo warning, rear-right"},
+  {Fault::kSteeringServoWarning,        7, error_bit_index(4, 2), kNoBit, false, "steering_servo_warning_rear_left", "steering servo warning, rear-left"},
+  {Fault::kSteeringServoWarning,        8, error_bit_index(4, 3), kNoBit, false, "steering_servo_warning_front_left", "steering servo warning, front-left"},
+  {Fault::kSteeringEncoder,             0, kNoBit,                    7, true,  "steering_encoder_fault", "steering encoder fault"},
+};
+// clang-format on
+
+// The row of `fault` (and `motor`, for a motor-numbered fault); nullptr when the table has none.
+const FaultInfo* find_fault(Fault fault, int motor = 0);
+// The row named `name`; nullptr when no row has that name.
+const FaultInfo* find_fault(std::string_view name);
+// The row whose bit in `layout`'s word is `index`; nullptr for a reserved bit.
+const FaultInfo* fault_at(ErrorWordLayout layout, int index);
+// The fault's bit (a one-bit mask) in a layout's word, 0 when the layout has no such bit.
 std::uint32_t fault_bit(Fault fault, ErrorWordLayout layout, int motor = 0);
 
 // ---- 0x261-0x268 driver status bits -----------------------------------------------------------
