@@ -89,11 +89,11 @@ TEST(NamedBits, EveryErrorBitOfEveryLayoutOnTheVirtualChassisSetsTheFieldOfItsMe
       ranger::sim::VirtualChassis chassis(*chassis_bus, *config, ranger::Timestamp{});
       chassis.set_error_bit(bit, true);
       chassis.step(ranger::Timestamp{} + 100ms);
-      std::optional<ranger::wire::SystemStatus> status;
+      std::optional<ranger::SystemStatus> status;
       while (auto f = host_bus->receive(std::chrono::nanoseconds(0))) {
         if (f->id != protocol::kSystemStatusId) continue;
-        if (auto m = ranger::wire::decode(*f, config->profile)) {
-          if (auto* s = std::get_if<ranger::wire::SystemStatus>(&*m)) status = *s;
+        if (auto m = ranger::decode(*f, config->profile)) {
+          if (auto* s = std::get_if<ranger::SystemStatus>(&*m)) status = *s;
         }
       }
       ASSERT_TRUE(status.has_value()) << variant << " bit " << bit;
