@@ -2,6 +2,7 @@
 
 #include <diagnostic_msgs/DiagnosticStatus.h>
 
+#include <ranger_can/text.hpp>
 #include <ranger_can/transport/bus_source.hpp>
 
 #include <algorithm>
@@ -16,17 +17,10 @@ namespace {
 using diagnostic_msgs::DiagnosticStatus;
 namespace protocol = ranger::protocol;
 
-std::string hex(std::uint32_t v, int width) {
-  char buf[16];
-  std::snprintf(buf, sizeof buf, "0x%0*X", width, v);
-  return buf;
-}
+using ranger::text::hex;
 
 std::string join(const std::vector<std::string>& names) {
-  std::string out;
-  for (const auto& n : names)
-    out += (out.empty() ? "" : ", ") + n;
-  return out.empty() ? "none" : out;
+  return names.empty() ? "none" : ranger::text::join(names);
 }
 
 // A fault that stops the chassis is an ERROR; anything else it reports is a WARN.
@@ -159,8 +153,8 @@ void diagnose_control(const DriverSnapshot& s, DiagnosticStatusWrapper& out) {
 
 void diagnose_protocol(const DriverSnapshot& s, const ProtocolContext& context,
                        DiagnosticStatusWrapper& out) {
-  out.add("Settings from", context.source.empty() ? std::string(ranger::to_string(s.protocol))
-                                                  : context.source);
+  out.add("Settings from",
+          context.source.empty() ? std::string(ranger::to_string(s.protocol)) : context.source);
   out.add("Settings in use", ranger::describe(s.profile));
   for (const ranger::ProfileSetting& setting : ranger::profile_settings()) {
     const auto value = ranger::get_setting(s.profile, setting.name);
@@ -213,10 +207,10 @@ void diagnose_protocol(const DriverSnapshot& s, const ProtocolContext& context,
   if (plausibility.stop) out.add("Plausibility stop", plausibility.stop->text());
 
   if (plausibility.stop) {
-    out.summary(DiagnosticStatus::ERROR,
-                "stopped: the chassis contradicts the protocol settings: " +
-                    plausibility.stop->text() +
-                    ". Set that parameter (or load a commissioning file); resume tries again");
+    out.summary(
+        DiagnosticStatus::ERROR,
+        "stopped: the chassis contradicts the protocol settings: " + plausibility.stop->text() +
+            ". Set that parameter (or load a commissioning file); resume tries again");
   } else if (failed) {
     out.summary(DiagnosticStatus::ERROR, *failed);
   } else {

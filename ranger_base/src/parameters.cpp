@@ -12,6 +12,7 @@
 
 #include <ranger_can/control/commissioning.hpp>
 #include <ranger_can/sim/chassis_commands.hpp>
+#include <ranger_can/text.hpp>
 #include <ranger_can/transport/bus_source.hpp>
 
 namespace ranger_base {
@@ -68,12 +69,7 @@ std::string show(const XmlRpc::XmlRpcValue& v) {
   }
 }
 
-std::string join(const std::vector<std::string>& items, const char* separator = ", ") {
-  std::string out;
-  for (const auto& i : items)
-    out += (out.empty() ? "" : separator) + i;
-  return out;
-}
+using ranger::text::join;
 
 std::optional<double> as_number(const XmlRpc::XmlRpcValue& v) {
   XmlRpc::XmlRpcValue copy = v;
