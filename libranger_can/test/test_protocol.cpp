@@ -301,6 +301,45 @@ TEST(ProtocolMotionModes, EachNumberingMapsItsWireValues) {
   EXPECT_FALSE(motion_mode_from_wire(3, ModeNumbering::kManual).has_value());
 }
 
+// ---- The frame table
+// ------------------------------------------------------------------------------
+
+TEST(ProtocolFrames, EveryIdentifierHasOneRowAndTheRowsAgreeWithTheLists) {
+  for (std::uint32_t id = 0; id < 0x800; ++id) {
+    int rows = 0;
+    for (const FrameInfo& f : kFrameTable)
+      rows += f.holds(id) ? 1 : 0;
+    EXPECT_LE(rows, 1) << std::hex << id;
+    EXPECT_EQ(rows == 1, is_known_id(id)) << std::hex << id;
+  }
+  for (const FrameInfo& f : kFrameTable) {
+    EXPECT_GT(f.length, 0) << f.name;
+    EXPECT_LE(f.length, 8) << f.name;
+    EXPECT_NE(f.revisions & kInAgxV2, 0) << f.name << ": the vendor's revision has every frame";
+    EXPECT_TRUE(f.period_ms == 0 || f.direction != Direction::kBoth) << f.name;
+  }
+  // Periods: the manual's feedback rates, 0x231/0x241 at the fast rate, the host's keep-alive.
+  EXPECT_EQ(frame_period_ms(kSystemStatusId), 20);
+  EXPECT_EQ(frame_period_ms(kUltrasonic5to8Id), 50);
+  EXPECT_EQ(frame_period_ms(kMotorLowSpeedBaseId + 8), 100);
+  EXPECT_EQ(frame_period_ms(kBmsBaseId + 9), 500);
+  EXPECT_EQ(frame_period_ms(kRemoteControlStateId), 20);
+  EXPECT_EQ(kKeepAlivePeriodMs, 20);
+  EXPECT_EQ(frame_period_ms(0x7FF), 0);
+  // Chassis frames: feedback and 0x4A1 answers, never the host's commands or its request.
+  CanFrame f;
+  f.id = kVersionId;
+  f.dlc = 1;
+  f.data[0] = kVersionRequestValue;
+  EXPECT_FALSE(is_chassis_frame(f));
+  f.data[0] = 'V';
+  EXPECT_TRUE(is_chassis_frame(f));
+  f.id = kMotionCommandId;
+  EXPECT_FALSE(is_chassis_frame(f));
+  f.id = kOdometerId;
+  EXPECT_TRUE(is_chassis_frame(f));
+}
+
 // ---- The agx_v2 16-bit error word --------------------------------------------------------------
 
 // The vendor's bits (PROTOCOL_AGX_V2.md) carry the name of their meaning, the manual layout's name

@@ -9,6 +9,7 @@
 #include <limits>
 
 #include <ranger_can/control/geometry.hpp>
+#include <ranger_can/text.hpp>
 
 namespace ranger_base {
 namespace {
@@ -298,12 +299,7 @@ std::string refusal_name(const ranger::ControllerState& c) {
 
 std::string describe_refusal(const ranger::ControllerState& c) {
   using R = ranger::MotionRefusal;
-  const auto join = [](const std::vector<std::string>& names) {
-    std::string out;
-    for (const auto& n : names)
-      out += (out.empty() ? "" : ", ") + n;
-    return out;
-  };
+  using ranger::text::join;
   switch (c.refusal) {
     case R::kNone:
       if (c.steer_first_factor < 1.0) {
@@ -443,7 +439,7 @@ ranger_msgs::BmsStateArray to_bms_state(const ranger::ChassisFeedback& feedback,
     ranger_msgs::BmsState s;
     s.battery = static_cast<std::uint8_t>(b);
     const auto& data = feedback.bms[i];
-    s.present = fresh(data, now, protocol::kBmsPeriodMs);
+    s.present = fresh(data, now, protocol::frame_period_ms(protocol::kBmsBaseId));
     if (data) {
       s.header.stamp = to_ros_time(data->stamp);
       s.soc = static_cast<float>(data->value.soc);
@@ -479,7 +475,7 @@ sensor_msgs::BatteryState to_battery_state(const ranger::ChassisFeedback& fb, Ti
   out.location = "pack";
 
   const auto& pack = fb.bms[0];
-  if (fresh(pack, now, protocol::kBmsPeriodMs)) {
+  if (fresh(pack, now, protocol::frame_period_ms(protocol::kBmsBaseId))) {
     out.header.stamp = to_ros_time(pack->stamp);
     out.present = true;
     out.voltage = static_cast<float>(pack->value.voltage);
@@ -514,7 +510,7 @@ sensor_msgs::BatteryState to_battery_state(const ranger::ChassisFeedback& fb, Ti
   }
   for (int b = 1; b <= protocol::kBatteryCount; ++b) {
     const auto& slot = fb.bms[static_cast<std::size_t>(b)];
-    const bool present = fresh(slot, now, protocol::kBmsPeriodMs);
+    const bool present = fresh(slot, now, protocol::frame_period_ms(protocol::kBmsBaseId));
     out.cell_voltage.push_back(present ? static_cast<float>(slot->value.voltage) : kNaN);
     out.cell_temperature.push_back(present ? static_cast<float>(slot->value.temperature) : kNaN);
   }

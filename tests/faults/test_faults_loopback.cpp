@@ -513,7 +513,8 @@ TEST_F(Faults, KilledDriverChassisStopsWithinFiveHundredMillisecondsOfTheLastCom
   ASSERT_FALSE(commands.empty());
   const Timestamp t_last = commands.back().stamp;
   const auto watchdog = std::chrono::milliseconds(protocol::kChassisCommandTimeoutMs);
-  const auto period = std::chrono::milliseconds(protocol::kFastPeriodMs);
+  const auto period =
+      std::chrono::milliseconds(protocol::frame_period_ms(protocol::kSystemStatusId));
 
   // Until the watchdog expires the chassis keeps the last command (manual 3.2)...
   const auto feedback = rig_.wire(protocol::kMotionFeedbackId, t_last);

@@ -27,7 +27,7 @@ constexpr std::size_t kMaxRequests = 16;
 // A 0x211 that arrives this soon after a request was sent may have left the chassis before the
 // request reached it: the answer is the first one after this.
 constexpr std::chrono::nanoseconds kAnswerDelay =
-    std::chrono::milliseconds(protocol::kFastPeriodMs);
+    std::chrono::milliseconds(protocol::frame_period_ms(protocol::kSystemStatusId));
 
 bool finite(const BodyTwist& t) {
   return std::isfinite(t.vx) && std::isfinite(t.vy) && std::isfinite(t.wz);

@@ -207,22 +207,17 @@ void ChassisIdentifier::on_frame(const CanFrame& frame, Timestamp now) {
 
 void ChassisIdentifier::observe_passive(const CanFrame& frame) {
   const std::uint32_t id = frame.id;
-  // IDs only the vendor's revision sends.
-  if (id == protocol::kLightStateId || id == protocol::kRemoteControlStateId ||
-      id == protocol::kOdometerId ||
-      (id == protocol::kVersionId && !protocol::is_version_request(frame))) {
+  // Frames only the vendor's revision defines, sent by the chassis (the frame table).
+  const protocol::FrameInfo* info = protocol::find_frame(id);
+  const bool chassis_frame = protocol::is_chassis_frame(frame);
+  if (chassis_frame && (info->revisions & protocol::kInManual) == 0) {
     const std::string what = hex_id(id) + " (" + std::string(protocol::frame_name(id)) + ")";
     if (std::find(agx_signatures_.begin(), agx_signatures_.end(), what) == agx_signatures_.end()) {
       agx_signatures_.push_back(what);
     }
   }
   // Padding: a chassis frame longer than its layout (the host's own commands do not count).
-  const bool host_frame = id == protocol::kMotionCommandId || id == protocol::kLightCommandId ||
-                          id == protocol::kMotionModeCommandId ||
-                          id == protocol::kControlModeCommandId ||
-                          id == protocol::kErrorClearCommandId ||
-                          id == protocol::kUltrasonicSettingId || id == protocol::kVersionId;
-  if (!host_frame && protocol::extra_bytes(frame) > 0 &&
+  if (chassis_frame && protocol::extra_bytes(frame) > 0 &&
       std::find(padded_ids_.begin(), padded_ids_.end(), id) == padded_ids_.end()) {
     padded_ids_.push_back(id);
   }

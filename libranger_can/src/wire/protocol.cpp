@@ -12,72 +12,46 @@ namespace ranger::protocol {
 
 namespace {
 
-constexpr bool is_motor_id(std::uint32_t id, std::uint32_t base) {
-  return id > base && id <= base + static_cast<std::uint32_t>(kMotorCount);
-}
-constexpr bool is_bms_id(std::uint32_t id) {
-  return id >= kBmsBaseId && id < kBmsBaseId + 10;
-}
-
-}  // namespace
-
-std::vector<std::uint32_t> manual_ids() {
-  std::vector<std::uint32_t> ids = {kMotionCommandId, kMotionModeCommandId, kSystemStatusId,
-                                    kMotionFeedbackId};
-  for (std::uint32_t m = 1; m <= kMotorCount; ++m)
-    ids.push_back(kMotorHighSpeedBaseId + m);
-  for (std::uint32_t m = 1; m <= kMotorCount; ++m)
-    ids.push_back(kMotorLowSpeedBaseId + m);
-  ids.insert(ids.end(), {kSteeringAnglesId, kWheelSpeedsId, kMotionModeFeedbackId,
-                         kUltrasonic1to4Id, kUltrasonic5to8Id});
-  for (std::uint32_t k = 0; k < 10; ++k)
-    ids.push_back(kBmsBaseId + k);
-  ids.insert(ids.end(), {kControlModeCommandId, kErrorClearCommandId, kUltrasonicSettingId,
-                         kUltrasonicSettingFeedbackId});
-  return ids;  // ascending: 0x111 ... 0x36A, 0x421, 0x441, 0x451, 0x45A
-}
-
-std::vector<std::uint32_t> all_ids() {
-  std::vector<std::uint32_t> ids = manual_ids();
-  ids.insert(ids.end(),
-             {kLightCommandId, kLightStateId, kRemoteControlStateId, kOdometerId, kVersionId});
+std::vector<std::uint32_t> ids_of(std::uint8_t revisions) {
+  std::vector<std::uint32_t> ids;
+  for (const FrameInfo& f : kFrameTable) {
+    if ((f.revisions & revisions) == 0) continue;
+    for (int i = 0; i < f.count; ++i)
+      ids.push_back(f.id + static_cast<std::uint32_t>(i * f.stride));
+  }
   std::sort(ids.begin(), ids.end());
   return ids;
 }
 
+}  // namespace
+
+std::string_view to_string(Direction d) {
+  switch (d) {
+    case Direction::kToChassis:
+      return "to_chassis";
+    case Direction::kFromChassis:
+      return "from_chassis";
+    case Direction::kBoth:
+      return "both";
+  }
+  return "unknown";
+}
+
+std::vector<std::uint32_t> manual_ids() {
+  return ids_of(kInManual);
+}
+
+std::vector<std::uint32_t> all_ids() {
+  return ids_of(kInManual | kInAgxV2);
+}
+
 bool is_known_id(std::uint32_t id) {
-  return layout_dlc(id) >= 0;
+  return find_frame(id) != nullptr;
 }
 
 int layout_dlc(std::uint32_t id) {
-  switch (id) {
-    case kMotionCommandId:
-    case kLightCommandId:
-    case kSystemStatusId:
-    case kMotionFeedbackId:
-    case kLightStateId:
-    case kRemoteControlStateId:
-    case kSteeringAnglesId:
-    case kWheelSpeedsId:
-    case kOdometerId:
-    case kUltrasonic1to4Id:
-    case kUltrasonic5to8Id:
-      return 8;
-    case kMotionModeCommandId:
-    case kControlModeCommandId:
-    case kErrorClearCommandId:
-    case kUltrasonicSettingId:
-    case kUltrasonicSettingFeedbackId:
-    case kVersionId:
-      return 1;
-    case kMotionModeFeedbackId:
-      return 2;
-    default:
-      break;
-  }
-  if (is_motor_id(id, kMotorHighSpeedBaseId) || is_motor_id(id, kMotorLowSpeedBaseId)) return 8;
-  if (is_bms_id(id)) return ((id - kBmsBaseId) % 2 == 0) ? 8 : 4;
-  return -1;
+  const FrameInfo* f = find_frame(id);
+  return f != nullptr ? f->length : -1;
 }
 
 bool is_version_request(const CanFrame& f) {
@@ -87,6 +61,13 @@ bool is_version_request(const CanFrame& f) {
     if (f.data[i] != 0) return false;
   }
   return true;
+}
+
+bool is_chassis_frame(const CanFrame& frame) {
+  const FrameInfo* f = find_frame(frame.id);
+  if (f == nullptr || frame.is_error) return false;
+  return f->direction == Direction::kFromChassis ||
+         (f->direction == Direction::kBoth && !is_version_request(frame));
 }
 
 int extra_bytes(const CanFrame& frame) {
@@ -99,49 +80,8 @@ int extra_bytes(const CanFrame& frame) {
 }
 
 std::string_view frame_name(std::uint32_t id) {
-  switch (id) {
-    case kMotionCommandId:
-      return "motion_command";
-    case kLightCommandId:
-      return "light_command";
-    case kMotionModeCommandId:
-      return "motion_mode_command";
-    case kControlModeCommandId:
-      return "control_mode_command";
-    case kErrorClearCommandId:
-      return "error_clear_command";
-    case kUltrasonicSettingId:
-      return "ultrasonic_setting";
-    case kVersionId:
-      return "version";
-    case kSystemStatusId:
-      return "system_status";
-    case kMotionFeedbackId:
-      return "motion_feedback";
-    case kLightStateId:
-      return "light_state";
-    case kRemoteControlStateId:
-      return "remote_control";
-    case kSteeringAnglesId:
-      return "steering_angles";
-    case kWheelSpeedsId:
-      return "wheel_speeds";
-    case kMotionModeFeedbackId:
-      return "motion_mode";
-    case kOdometerId:
-      return "odometer";
-    case kUltrasonic1to4Id:
-    case kUltrasonic5to8Id:
-      return "ultrasonic";
-    case kUltrasonicSettingFeedbackId:
-      return "ultrasonic_setting_feedback";
-    default:
-      break;
-  }
-  if (is_motor_id(id, kMotorHighSpeedBaseId)) return "motor_high_speed";
-  if (is_motor_id(id, kMotorLowSpeedBaseId)) return "motor_low_speed";
-  if (is_bms_id(id)) return ((id - kBmsBaseId) % 2 == 0) ? "bms" : "bms_alarm";
-  return "unknown";
+  const FrameInfo* f = find_frame(id);
+  return f != nullptr ? f->name : "unknown";
 }
 
 // ---- Motion modes -------------------------------------------------------------------------------

@@ -62,24 +62,14 @@ std::string hex_id(std::uint32_t id) {
   return buf;
 }
 
-// Nominal frames per second of a feedback ID (0 for commands and on-change frames).
+// Nominal frames per second of a feedback ID (0 for commands and on-change frames): the frame
+// table's period.
 double nominal_rate(std::uint32_t id) {
-  if (id == protocol::kSystemStatusId || id == protocol::kMotionFeedbackId ||
-      id == protocol::kSteeringAnglesId || id == protocol::kWheelSpeedsId ||
-      id == protocol::kMotionModeFeedbackId ||
-      (id > protocol::kMotorHighSpeedBaseId && id <= protocol::kMotorHighSpeedBaseId + 8)) {
-    return 1000.0 / protocol::kFastPeriodMs;
+  const protocol::FrameInfo* f = protocol::find_frame(id);
+  if (f == nullptr || f->direction != protocol::Direction::kFromChassis || f->period_ms == 0) {
+    return 0.0;
   }
-  if (id == protocol::kUltrasonic1to4Id || id == protocol::kUltrasonic5to8Id) {
-    return 1000.0 / protocol::kUltrasonicPeriodMs;
-  }
-  if (id > protocol::kMotorLowSpeedBaseId && id <= protocol::kMotorLowSpeedBaseId + 8) {
-    return 1000.0 / protocol::kSlowPeriodMs;
-  }
-  if (id >= protocol::kBmsBaseId && id < protocol::kBmsBaseId + 10) {
-    return 1000.0 / protocol::kBmsPeriodMs;
-  }
-  return 0.0;
+  return 1000.0 / f->period_ms;
 }
 
 std::string ultrasonic_text(std::int16_t raw) {

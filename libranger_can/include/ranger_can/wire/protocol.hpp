@@ -50,8 +50,86 @@ inline constexpr int kMotorCount = 8;
 inline constexpr int kUltrasonicCount = 8;
 inline constexpr int kBatteryCount = 4;  // slots 1..4; index 0 is the whole pack
 
-// Every identifier of either revision, in ascending order (receive filters, the DBC cross-check,
-// frame-rate statistics). The decoder knows all of them whatever the profile.
+// ---- The frame table ----------------------------------------------------------------------------
+// Every frame of either revision, once: its identifier(s), name, direction, the length of its
+// layout, its nominal period and the revisions that define it. The ID lists, DLC checks, names,
+// the identification's vendor-only set, the monitor's expected rates, the virtual chassis's send
+// schedule and the DBC cross-check (tests/dbc/check_dbc.py parses this table) all read it.
+enum class Direction : std::uint8_t {
+  kToChassis,    // the host's commands
+  kFromChassis,  // the chassis's feedback
+  kBoth,         // 0x4A1: the host's request and the chassis's answers
+};
+std::string_view to_string(Direction d);  // "to_chassis", "from_chassis", "both"
+inline constexpr Direction kAllDirections[] = {Direction::kToChassis, Direction::kFromChassis,
+                                               Direction::kBoth};
+
+// The revisions that define a frame (a bit set).
+inline constexpr std::uint8_t kInManual = 1u << 0;  // the manual, section 3.2 (PROTOCOL.md)
+inline constexpr std::uint8_t kInAgxV2 = 1u << 1;   // the vendor's revision (PROTOCOL_AGX_V2.md)
+
+struct FrameInfo {
+  std::uint32_t id;  // the first identifier of the row
+  int count;         // identifiers in the row: id, id + stride, ... (motors, batteries)
+  int stride;
+  std::string_view name;  // snake_case, stable
+  Direction direction;
+  int length;     // the layout's length in bytes, the same in every revision that defines the frame
+                  // (a received frame may be longer, never shorter); 0x4A1: the request's
+  int period_ms;  // nominal period; 0: sent on request or on change
+  std::uint8_t revisions;
+
+  constexpr bool holds(std::uint32_t x) const {
+    if (x < id) return false;
+    const std::uint32_t offset = x - id;
+    return offset % static_cast<std::uint32_t>(stride) == 0 &&
+           offset / static_cast<std::uint32_t>(stride) < static_cast<std::uint32_t>(count);
+  }
+};
+
+// clang-format off
+inline constexpr FrameInfo kFrameTable[] = {
+  // id                          count stride name                     direction               length period  revisions
+  {kMotionCommandId,               1, 1, "motion_command",              Direction::kToChassis,   8,  20, kInManual | kInAgxV2},
+  {kLightCommandId,                1, 1, "light_command",               Direction::kToChassis,   8,   0, kInAgxV2},
+  {kMotionModeCommandId,           1, 1, "motion_mode_command",         Direction::kToChassis,   1,   0, kInManual | kInAgxV2},
+  {kSystemStatusId,                1, 1, "system_status",               Direction::kFromChassis, 8,  20, kInManual | kInAgxV2},
+  {kMotionFeedbackId,              1, 1, "motion_feedback",             Direction::kFromChassis, 8,  20, kInManual | kInAgxV2},
+  // 0x231 and 0x241: the period the vendor's manuals of the same family give (assumed here)
+  {kLightStateId,                  1, 1, "light_state",                 Direction::kFromChassis, 8,  20, kInAgxV2},
+  {kRemoteControlStateId,          1, 1, "remote_control",              Direction::kFromChassis, 8,  20, kInAgxV2},
+  {kMotorHighSpeedBaseId + 1, kMotorCount, 1, "motor_high_speed",       Direction::kFromChassis, 8,  20, kInManual | kInAgxV2},
+  {kMotorLowSpeedBaseId + 1,  kMotorCount, 1, "motor_low_speed",        Direction::kFromChassis, 8, 100, kInManual | kInAgxV2},
+  {kSteeringAnglesId,              1, 1, "steering_angles",             Direction::kFromChassis, 8,  20, kInManual | kInAgxV2},
+  {kWheelSpeedsId,                 1, 1, "wheel_speeds",                Direction::kFromChassis, 8,  20, kInManual | kInAgxV2},
+  {kMotionModeFeedbackId,          1, 1, "motion_mode",                 Direction::kFromChassis, 2,  20, kInManual | kInAgxV2},
+  {kOdometerId,                    1, 1, "odometer",                    Direction::kFromChassis, 8,   0, kInAgxV2},
+  {kUltrasonic1to4Id,              2, 1, "ultrasonic",                  Direction::kFromChassis, 8,  50, kInManual | kInAgxV2},
+  {kBmsBaseId,         kBatteryCount + 1, 2, "bms",                     Direction::kFromChassis, 8, 500, kInManual | kInAgxV2},
+  {kBmsBaseId + 1,     kBatteryCount + 1, 2, "bms_alarm",               Direction::kFromChassis, 4, 500, kInManual | kInAgxV2},
+  {kControlModeCommandId,          1, 1, "control_mode_command",        Direction::kToChassis,   1,   0, kInManual | kInAgxV2},
+  {kErrorClearCommandId,           1, 1, "error_clear_command",         Direction::kToChassis,   1,   0, kInManual | kInAgxV2},
+  {kUltrasonicSettingId,           1, 1, "ultrasonic_setting",          Direction::kToChassis,   1,   0, kInManual | kInAgxV2},
+  {kUltrasonicSettingFeedbackId,   1, 1, "ultrasonic_setting_feedback", Direction::kFromChassis, 1,   0, kInManual | kInAgxV2},
+  {kVersionId,                     1, 1, "version",                     Direction::kBoth,        1,   0, kInAgxV2},
+};
+// clang-format on
+
+// The row of `id`; nullptr for an identifier of neither revision.
+constexpr const FrameInfo* find_frame(std::uint32_t id) {
+  for (const FrameInfo& f : kFrameTable) {
+    if (f.holds(id)) return &f;
+  }
+  return nullptr;
+}
+// The nominal period of `id`'s frame in milliseconds (0: on request or on change, or unknown).
+constexpr int frame_period_ms(std::uint32_t id) {
+  const FrameInfo* f = find_frame(id);
+  return f != nullptr ? f->period_ms : 0;
+}
+
+// Every identifier of either revision, in ascending order (receive filters, frame-rate
+// statistics). The decoder knows all of them whatever the profile.
 std::vector<std::uint32_t> all_ids();
 // The identifiers of the manual (section 3.2), in ascending order.
 std::vector<std::uint32_t> manual_ids();
@@ -66,17 +144,14 @@ int extra_bytes(const CanFrame& frame);
 // A 0x4A1 frame is the host's version request when byte 0 is 0x01 and every further byte is zero
 // (a request padded to 8 bytes); anything else on 0x4A1 is an answer (text).
 bool is_version_request(const CanFrame& frame);
+// True when the chassis sent `frame` (feedback, or a 0x4A1 answer), false for the host's.
+bool is_chassis_frame(const CanFrame& frame);
 // A short snake_case name for `id` ("motion_command", "bms", ...), "unknown" otherwise.
 std::string_view frame_name(std::uint32_t id);
 
-// Nominal feedback periods from the manual, for rate checks and the simulator.
-inline constexpr int kFastPeriodMs = 20;        // 0x211 0x221 0x251-8 0x271 0x281 0x291
-inline constexpr int kUltrasonicPeriodMs = 50;  // 0x342 0x343
-inline constexpr int kSlowPeriodMs = 100;       // 0x261-8
-inline constexpr int kBmsPeriodMs = 500;        // 0x361-0x36A
-// The chassis stops if no 0x111 arrives for this long; the host keeps it alive at 20 ms.
+// The chassis stops if no 0x111 arrives for this long; the host keeps it alive at 0x111's period.
 inline constexpr int kChassisCommandTimeoutMs = 500;
-inline constexpr int kKeepAlivePeriodMs = 20;
+inline constexpr int kKeepAlivePeriodMs = frame_period_ms(kMotionCommandId);
 
 // ---- Enumerations ------------------------------------------------------------------------------
 // Motion modes. The values are agx_v2's wire numbering; the wire value of a mode depends on the
