@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Builds everything: libranger_can with its tool, unit tests and system suites (plain CMake, in
 # build/lib), then the ROS packages with colcon (build/ws, install/).
-# Usage: scripts/build.sh [lib|ros|all]    (default all; `ros` skips the library's own tests)
+# Usage: scripts/build.sh [lib|ros|all]    (default all; in the ROS workspace the library's own
+# tests are off: they are built in build/lib)
 # Environment: RANGER_BUILD_TYPE (default RelWithDebInfo), RANGER_JOBS (default nproc).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -11,7 +12,9 @@ jobs=${RANGER_JOBS:-$(nproc)}
 generator=()
 command -v ninja >/dev/null && generator=(-G Ninja)
 
-mkdir -p build && touch build/COLCON_IGNORE   # keep colcon from descending into build trees
+# Keep colcon and the catkin tools (catkin_make, catkin build) from finding the packages a second
+# time in the build trees.
+mkdir -p build && touch build/COLCON_IGNORE build/CATKIN_IGNORE
 case "$what" in lib | ros | all) ;; *) echo "build.sh: unknown target '$what'" >&2; exit 2 ;; esac
 
 if [ "$what" != ros ]; then
@@ -29,5 +32,4 @@ if [ -f /opt/ros/noetic/setup.bash ]; then set +u; source /opt/ros/noetic/setup.
 colcon --log-base build/log build --base-paths . --build-base build/ws --install-base install \
   --event-handlers console_cohesion- summary+ \
   --parallel-workers "$jobs" \
-  --cmake-args -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE="$build_type" \
-  -DRANGER_BUILD_TESTS=OFF -DRANGER_BUILD_BENCHMARKS=OFF
+  --cmake-args -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE="$build_type"

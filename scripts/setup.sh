@@ -4,7 +4,8 @@
 #   lib   compiler, CMake, GoogleTest, Google Benchmark: enough for libranger_can and its tool
 #   ros   lib + ROS 1 (distribution packages on Debian 12 / Ubuntu 22.04+, Noetic on Ubuntu 20.04)
 #   test  ros + what the full test suite needs: can-utils, qemu + a kernel with vcan (for hosts
-#         without CAN support), Xvfb for the rviz test, clang for fuzzing, valgrind
+#         without CAN support), Xvfb for the rviz test, clang for fuzzing, valgrind, the other
+#         ROS 1 build tools (catkin_tools, catkin_lint) for the workspace builds
 set -euo pipefail
 profile=${1:-test}
 
@@ -30,6 +31,13 @@ noetic_pkgs=(ros-noetic-ros-base ros-noetic-rostest ros-noetic-tf2-ros ros-noeti
   liburdfdom-tools libeigen3-dev python3-colcon-common-extensions python3-matplotlib)
 test_pkgs=(can-utils iproute2 kmod qemu-system-x86 linux-image-amd64 busybox-static cpio gzip
   xvfb xauth imagemagick clang libclang-rt-14-dev valgrind clang-format)
+# The workspace builds (scripts/test_workspaces.sh): catkin build and catkin_lint (catkin_make
+# and catkin_make_isolated come with catkin; CMake 3.16 from PyPI into a venv).
+if [ -d /opt/ros/noetic ]; then
+  test_pkgs+=(python3-catkin-tools python3-catkin-lint)
+else
+  test_pkgs+=(catkin-tools catkin-lint)
+fi
 
 pkgs=("${lib_pkgs[@]}")
 case "$profile" in

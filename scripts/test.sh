@@ -9,6 +9,9 @@
 #   ros       the ROS packages' tests (rostest + gtest, launch-file checks) via colcon test
 #   ros_vcan  the node against `ranger_can sim vcan0` over real SocketCAN (native or in the VM):
 #             stop on SIGINT / rosnode kill, the chassis's own stop after SIGKILL
+#   workspaces  the repository in the src/ of fresh ROS 1 workspaces (scripts/test_workspaces.sh):
+#             catkin_make (and the driver run from its devel space), catkin_make_isolated,
+#             catkin build, colcon; the plain build with CMake 3.16; catkin_lint -W1
 #   sanitize  ASan+UBSan and TSan builds of the library and its tests, ASan build of the ROS node
 #   fuzz      every libFuzzer target for a bounded time (RANGER_FUZZ_SECONDS, default 60)
 #
@@ -17,7 +20,7 @@ set -uo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
 results=$root/build/test-results
-stages=${RANGER_STAGES:-unit vcan ros ros_vcan sanitize fuzz}
+stages=${RANGER_STAGES:-unit vcan ros ros_vcan workspaces sanitize fuzz}
 failed=()
 passed=()
 
@@ -61,6 +64,7 @@ stage_ros() {
     exit $rc
   )
 }
+stage_workspaces() { scripts/test_workspaces.sh; }
 stage_sanitize() { scripts/test_sanitizers.sh; }
 stage_fuzz() { scripts/fuzz.sh "${RANGER_FUZZ_SECONDS:-60}"; }
 

@@ -250,10 +250,11 @@ TEST(ChassisVariants, ErrorBitsFollowTheLayout) {
 TEST(ChassisVariants, ModeNumberingOfTheProfile) {
   Host h(variant("mini_v1"));
   h.handshake();
-  h.send(MotionModeCommand{MotionMode::kSideSlip});  // wire 3 on a MINI V1: not simulated
+  h.send(MotionModeCommand{MotionMode::kSideSlip});  // wire 3 on a MINI V1
   EXPECT_EQ(h.frames(protocol::kMotionModeFeedbackId).back().data[0], 0);
   h.advance(1500ms);
-  EXPECT_EQ(h.chassis.snapshot().motion_mode, MotionMode::kAckermann);
+  EXPECT_EQ(h.chassis.snapshot().motion_mode, MotionMode::kSideSlip);
+  EXPECT_EQ(h.frames(protocol::kMotionModeFeedbackId).back().data[0], 3);
   h.switch_mode(MotionMode::kSpin);
   h.advance(40ms);
   EXPECT_EQ(h.frames(protocol::kMotionModeFeedbackId).back().data[0], 2);

@@ -55,8 +55,8 @@ TEST(CliMain, HelpListsEveryCommandWithItsSummary) {
   for (const CommandSpec* c : all_commands())
     EXPECT_NE(r.out.find("  " + c->name + " "), std::string::npos) << c->name;
   EXPECT_TRUE(std::regex_search(
-      r.out,
-      std::regex("\n  send +send one command: mode, control, clear-errors, ultrasonic, motion\n")))
+      r.out, std::regex("\n  send +send one command: mode, park, lights, version, control, "
+                        "clear-errors, ultrasonic, motion\n")))
       << r.out;
   EXPECT_EQ(run({"-h"}).out, r.out);
   EXPECT_EQ(run({"help"}).out, r.out);

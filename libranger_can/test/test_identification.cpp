@@ -17,6 +17,7 @@
 #include "ranger_can/control/commissioning.hpp"
 #include "ranger_can/control/driver.hpp"
 #include "ranger_can/control/identification.hpp"
+#include "ranger_can/control/plausibility.hpp"
 #include "ranger_can/sim/sim_bus_source.hpp"
 #include "ranger_can/wire/candump_log.hpp"
 #include "ranger_can/wire/codec.hpp"
@@ -144,6 +145,49 @@ TEST(Identifier, ConfigIsValidated) {
   EXPECT_FALSE(c.validate().ok()) << "5.7 times 10 deg is beyond the Ackermann range";
   c = IdentificationConfig{};
   c.listen_time = c.timeout;
+  EXPECT_FALSE(c.validate().ok());
+}
+
+// ---- the plausibility monitors' decisions, as values -------------------------------------------
+
+TEST(PlausibilityJudgement, SteeringNamesTheSettingTheWitnessesPointAt) {
+  const double r = PlausibilityConfig{}.unit_ratio;
+  EXPECT_EQ(judge_steering(1.0, 1.0, r).mismatch, SteeringMismatch::kNone);
+  EXPECT_EQ(judge_steering(1.0, std::nullopt, r).mismatch, SteeringMismatch::kNone);
+  EXPECT_EQ(judge_steering(-1.0, -1.0, r).mismatch, SteeringMismatch::kSign111);
+  EXPECT_EQ(judge_steering(-1.0, 1.0, r).mismatch, SteeringMismatch::kSign271);
+  EXPECT_EQ(judge_steering(-1.0, std::nullopt, r).mismatch, SteeringMismatch::kSign111Or271);
+  const SteeringJudgement more = judge_steering(5.7, 5.7, r);
+  EXPECT_EQ(more.mismatch, SteeringMismatch::kUnit111);
+  EXPECT_TRUE(more.more);
+  const SteeringJudgement less = judge_steering(1 / 5.7, 1.0, r);
+  EXPECT_EQ(less.mismatch, SteeringMismatch::kUnit271);
+  EXPECT_FALSE(less.more);
+  EXPECT_EQ(judge_steering(5.7, std::nullopt, r).mismatch, SteeringMismatch::kUnit111Or271);
+  EXPECT_EQ(judge_steering(1.0, -1.0, r).mismatch, SteeringMismatch::kSign221);
+  EXPECT_EQ(judge_steering(1.0, 5.7, r).mismatch, SteeringMismatch::kUnit221);
+}
+
+TEST(PlausibilityJudgement, ReferenceAndSpeedNameTheOtherReadingOnlyWhenItFitsClearly) {
+  const double d = M_PI / 180.0;
+  const std::array<double, kWheelCount> ours{10 * d, 8 * d, 8 * d, 10 * d};
+  const std::array<double, kWheelCount> other{10.6 * d, 8.5 * d, 8.5 * d, 10.6 * d};
+  EXPECT_FALSE(judge_reference(ours, ours, other).other_fits);
+  const ReferenceJudgement j = judge_reference(other, ours, other);
+  EXPECT_TRUE(j.other_fits);
+  EXPECT_NEAR(j.error, 0.6 * d, 1e-9);
+  EXPECT_NEAR(j.error_other, 0.0, 1e-12);
+  // 0x221 reporting the body centre's 0.50 m/s where the wheels' mean is 0.52 m/s.
+  EXPECT_TRUE(judge_feedback_speed(0.50, 0.52, 0.50, FeedbackSpeed::kMeanWheel).other_fits);
+  EXPECT_FALSE(judge_feedback_speed(0.50, 0.52, 0.50, FeedbackSpeed::kBodyCentre).other_fits);
+  EXPECT_FALSE(judge_feedback_speed(0.52, 0.52, 0.50, FeedbackSpeed::kMeanWheel).other_fits);
+}
+
+TEST(PlausibilityJudgement, FreshnessIsOneValidatedSetting) {
+  PlausibilityConfig c;
+  EXPECT_EQ(c.feedback_freshness, std::chrono::milliseconds(100));
+  EXPECT_TRUE(c.validate().ok());
+  c.feedback_freshness = std::chrono::nanoseconds(0);
   EXPECT_FALSE(c.validate().ok());
 }
 

@@ -326,7 +326,7 @@ TEST(ScenarioOutput, FixedFormattingWithoutNegativeZero) {
             "\"vy\":0.000000,\"wz\":0.000000},\"control_mode\":\"can\",\"motion_mode\":null,"
             "\"refusal\":\"rearm_required\",\"faults\":[\"emergency_stop\",\"over_current\"],"
             "\"rearm_required\":true,\"latched\":[\"emergency_stop\"],"
-            "\"steer_first_factor\":0.250000}");
+            "\"steer_first_factor\":0.250000,\"identification\":\"none\"}");
   // Checks compare the value as printed.
   EXPECT_EQ(*sample_number(s, "truth.x"), 0.333333);
   EXPECT_EQ(*sample_number(s, "truth.y"), 0.0);
@@ -522,6 +522,44 @@ TEST(CliScenario, TheHelpDocumentsTheLanguage) {
                            "--chassis-variant VARIANT", "--param NAME=VALUE", "Exit status"}) {
     EXPECT_TRUE(contains(r.out, word)) << word;
   }
+}
+
+}  // namespace
+}  // namespace ranger::sim
+
+namespace ranger::sim {
+namespace {
+
+// --remote boots the chassis under its remote control: the identification (protocol auto) learns
+// the wheels' reading from the remote's driving and waits for CAN command mode, saying so; the
+// identification's phase is a check of its own.
+TEST(ScenarioRun, TheChassisBootsUnderItsRemoteAndIdentificationIsChecked) {
+  ScenarioOptions o;
+  o.driver.protocol = ProtocolChoice::kAuto;
+  o.chassis.boot_in_remote_mode = true;
+  const RunOutcome r =
+      run("expect identification listening\n"
+          "remote sticks 0.2 -0.3\n"
+          "wait 3\n"
+          "expect control_mode remote\n"
+          "expect identification awaiting_control\n"
+          "expect odom.wz > 0.1\n"
+          "remote sticks 0 0\n"
+          "remote can\n"
+          "wait 1\n"
+          "expect identification awaiting_control\n"
+          "expect refusal rearm_required\n"
+          "resume\n"
+          "wait 3\n"
+          "expect identification decided\n",
+          o);
+  EXPECT_TRUE(r.result.passed()) << ::testing::PrintToString(r.failures);
+  EXPECT_EQ(r.result.expectations, 7u);
+  EXPECT_EQ(r.samples.front().identification, "listening");
+  ScenarioOptions fixed;
+  fixed.driver.protocol = ProtocolChoice::kForced;
+  EXPECT_EQ(run("wait 0.1\n", fixed).samples.back().identification, "none");
+  EXPECT_TRUE(contains(parse_error("expect identification maybe\n"), "decided"));
 }
 
 }  // namespace

@@ -355,6 +355,10 @@ std::string describe_refusal(const ranger::ControllerState& c) {
       // The identification's own words: its phase, or (failed) what to set.
       return c.identifying.empty() ? std::string("identifying the chassis's protocol settings")
                                    : c.identifying;
+    case R::kParked:
+      return c.parked() ? "parked: call park with data = false to drive again"
+                        : "parking (bringing the chassis to rest, then to park mode): call park "
+                          "with data = false to drive again";
   }
   return std::string(ranger::to_string(c.refusal));
 }
@@ -399,7 +403,63 @@ ranger_msgs::SystemState to_system_state(const ranger::DriverSnapshot& snapshot,
   out.active_causes = cause_names(state.active_causes);
   out.reclaim_blocked = state.reclaim_blocked;
   out.steer_first_factor = static_cast<float>(state.steer_first_factor);
+  out.park_requested = state.park_requested;
+  out.parked = state.parked();
+  out.firmware_version = snapshot.firmware.text;
+  out.firmware_version_state = std::string(ranger::to_string(snapshot.firmware.state));
   return out;
+}
+
+ranger_msgs::RemoteState to_remote_state(const ranger::RemoteState& remote,
+                                         const ros::Time& stamp) {
+  ranger_msgs::RemoteState out;
+  out.header.stamp = stamp;
+  out.swa = std::string(protocol::to_string(remote.swa));
+  out.swb = std::string(protocol::to_string(remote.swb));
+  out.swc = std::string(protocol::to_string(remote.swc));
+  out.swd = std::string(protocol::to_string(remote.swd));
+  out.left_vertical = static_cast<float>(remote.left_vertical);
+  out.left_horizontal = static_cast<float>(remote.left_horizontal);
+  out.right_vertical = static_cast<float>(remote.right_vertical);
+  out.right_horizontal = static_cast<float>(remote.right_horizontal);
+  out.knob = static_cast<float>(remote.knob);
+  return out;
+}
+
+ranger::Result<ranger::LightsRequest> to_lights_request(const ranger_msgs::SetLights::Request& r) {
+  ranger::LightsRequest out;
+  const struct {
+    const char* name;
+    std::uint8_t mode, brightness;
+    protocol::LightMode* out_mode;
+    std::uint8_t* out_brightness;
+  } lights[] = {{"front", r.front_mode, r.front_brightness, &out.front, &out.front_brightness},
+                {"rear", r.rear_mode, r.rear_brightness, &out.rear, &out.rear_brightness}};
+  for (const auto& l : lights) {
+    if (l.mode > ranger_msgs::SetLights::Request::CUSTOM) {
+      return ranger::Error{ranger::Errc::kInvalidArgument,
+                           std::string(l.name) + "_mode " + std::to_string(l.mode) +
+                               " is not a light mode (OFF 0, ON 1, BREATHING 2, CUSTOM 3)"};
+    }
+    if (l.brightness > 100) {
+      return ranger::Error{
+          ranger::Errc::kInvalidArgument,
+          std::string(l.name) + "_brightness " + std::to_string(l.brightness) + " is above 100"};
+    }
+    *l.out_mode = static_cast<protocol::LightMode>(l.mode);
+    *l.out_brightness = l.mode == ranger_msgs::SetLights::Request::CUSTOM ? l.brightness : 0;
+  }
+  return out;
+}
+
+void fill_lights_response(const std::optional<ranger::LightsState>& lights,
+                          ranger_msgs::SetLights::Response& out) {
+  if (!lights) return;
+  out.can_control = lights->can_control;
+  out.front_mode = static_cast<std::uint8_t>(lights->front);
+  out.front_brightness = lights->front_brightness;
+  out.rear_mode = static_cast<std::uint8_t>(lights->rear);
+  out.rear_brightness = lights->rear_brightness;
 }
 
 ranger_msgs::ActuatorStateArray to_actuator_state(const ranger::ChassisFeedback& feedback,

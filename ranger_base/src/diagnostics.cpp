@@ -50,6 +50,11 @@ void diagnose_link(const DriverSnapshot& s, DiagnosticStatusWrapper& out) {
   const auto& c = s.controller;
   out.add("Chassis link", std::string(ranger::to_string(c.link)));
   out.add("Chassis link losses", c.counters.link_losses);
+  out.add("Firmware version",
+          s.firmware.state == ranger::FirmwareVersion::State::kAnswered
+              ? s.firmware.text
+              : "unknown (" + std::string(ranger::to_string(s.firmware.state)) + ")");
+  out.add("Vendor frames (0x231, 0x241)", std::string(ranger::to_string(s.vendor_frames)));
   out.add("Odometry published", s.motion_known ? "yes" : "no (chassis not heard)");
   out.add("Undecodable frames", c.counters.decode_errors);
   out.add("Send failures", c.counters.send_failures);
@@ -104,6 +109,12 @@ void diagnose_control(const DriverSnapshot& s, DiagnosticStatusWrapper& out) {
   out.add("Motion mode pinned",
           c.mode_override ? std::string(protocol::to_string(*c.mode_override)) : "automatic");
   out.add("Mode switch", std::string(ranger::to_string(c.mode_switch.phase)));
+  out.add("Park", c.park_requested ? (c.parked() ? "parked" : "parking") : "released");
+  if (s.lights) {
+    out.add("Lights", ranger::describe(s.lights->front, s.lights->front_brightness, s.lights->rear,
+                                       s.lights->rear_brightness) +
+                          (s.lights->can_control ? " (CAN)" : " (the chassis's own)"));
+  }
   out.add("Motion refused because", std::string(ranger::to_string(c.refusal)));
   out.add("Re-arm required", c.rearm_required() ? "yes" : "no");
   out.add("Latched stop causes", join(cause_names(c.latched_causes)));

@@ -529,6 +529,7 @@ NodeParameters read_all(Reader& r) {
   s.mode_switch_duration =
       r.seconds("sim/mode_switch_duration", s.mode_switch_duration, closed(0.0, 10.0));
   s.boot_in_remote_mode = r.flag("sim/boot_in_remote_mode", s.boot_in_remote_mode);
+  s.version = r.text("sim/firmware_version", s.version);
   const double ultrasonic_m =
       r.number("sim/ultrasonic_range", s.ultrasonic[0] / 1000.0, closed(0.0, 32.767), "m");
   s.ultrasonic.fill(static_cast<std::int16_t>(std::lround(ultrasonic_m * 1000.0)));

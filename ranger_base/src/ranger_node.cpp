@@ -114,6 +114,8 @@ RangerNode::RangerNode(const ros::NodeHandle& nh, const ros::NodeHandle& private
   bms_state_pub_ = nh_.advertise<ranger_msgs::BmsStateArray>("bms_state", 10);
   battery_state_pub_ = nh_.advertise<sensor_msgs::BatteryState>("battery_state", 10);
   ultrasonic_state_pub_ = nh_.advertise<ranger_msgs::UltrasonicState>("ultrasonic_state", 10);
+  // Published only on a chassis that sends 0x241 (the vendor's revision).
+  remote_state_pub_ = nh_.advertise<ranger_msgs::RemoteState>("remote_state", 10);
   for (std::size_t i = 0; i < range_pubs_.size(); ++i) {
     range_pubs_[i] =
         nh_.advertise<sensor_msgs::Range>("ultrasonic/range_" + std::to_string(i + 1), 10);
@@ -155,6 +157,8 @@ void RangerNode::start() {
       service_nh_.advertiseService("set_ultrasonic", &RangerNode::on_set_ultrasonic, this);
   set_motion_mode_srv_ =
       service_nh_.advertiseService("set_motion_mode", &RangerNode::on_set_motion_mode, this);
+  set_lights_srv_ = service_nh_.advertiseService("set_lights", &RangerNode::on_set_lights, this);
+  park_srv_ = service_nh_.advertiseService("park", &RangerNode::on_park, this);
 
   cmd_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &cmd_queue_);
   service_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &service_queue_);
@@ -377,13 +381,28 @@ bool RangerNode::on_set_motion_mode(ranger_msgs::SetMotionMode::Request& req,
     case Req::SPIN:
       mode = protocol::MotionMode::kSpin;
       break;
+    case Req::SIDE_SLIP:
+      mode = protocol::MotionMode::kSideSlip;
+      break;
     case Req::AUTOMATIC:
       break;
     default:
       res.success = false;
       res.message = "mode " + std::to_string(req.mode) +
-                    " unknown: use 0 (Ackermann), 1 (oblique), 2 (spin) or 255 (automatic)";
+                    " unknown: use 0 (Ackermann), 1 (oblique), 2 (spin), 4 (side slip) or 255 "
+                    "(automatic)";
       return true;
+  }
+  if (mode) {
+    const auto s = driver_->snapshot();
+    if (!protocol::motion_mode_to_wire(*mode, s->profile.mode_numbering)) {
+      res.success = false;
+      res.message = std::string(protocol::to_string(*mode)) + ": unsupported by protocol " +
+                    s->profile.revision + " (its motion-mode numbering has no " +
+                    std::string(protocol::to_string(*mode)) + " mode; side slip is the MINI V1's)";
+      ROS_WARN("set_motion_mode: %s", res.message.c_str());
+      return true;
+    }
   }
   driver_->set_motion_mode(mode);
   res.success = true;
@@ -391,6 +410,56 @@ bool RangerNode::on_set_motion_mode(ranger_msgs::SetMotionMode::Request& req,
                            " (the switch happens at standstill)"
                      : "automatic motion-mode selection";
   ROS_INFO("set_motion_mode: %s", res.message.c_str());
+  return true;
+}
+
+bool RangerNode::on_set_lights(ranger_msgs::SetLights::Request& req,
+                               ranger_msgs::SetLights::Response& res) {
+  res.success = false;
+  const auto wanted = to_lights_request(req);
+  if (!wanted) {
+    res.message = wanted.error().message + ": nothing sent";
+    fill_lights_response(driver_->snapshot()->lights, res);
+    return true;
+  }
+  const auto posted = driver_->set_lights(*wanted);
+  if (!posted) {
+    res.message = posted.error().message;
+    return true;
+  }
+  // The vendor frames may still be being listened for: their wait, then the answer's.
+  const auto budget =
+      params_.driver.vendor_frames_wait + params_.driver.request_answer_timeout + kAnswerMargin;
+  const auto outcome = wait_for(*posted, budget);
+  res.success = outcome.state == State::kAnswered;
+  res.message = outcome.message.empty() ? "the chassis did not report its lights in time (" +
+                                              std::string(ranger::to_string(outcome.state)) + ")"
+                                        : outcome.message;
+  fill_lights_response(driver_->snapshot()->lights, res);
+  if (res.success) {
+    ROS_INFO("set_lights: %s", res.message.c_str());
+  } else {
+    ROS_WARN("set_lights: %s", res.message.c_str());
+  }
+  return true;
+}
+
+bool RangerNode::on_park(std_srvs::SetBool::Request& req, std_srvs::SetBool::Response& res) {
+  const auto& c = params_.driver.controller;
+  // Bringing the chassis to rest, then the switch with its retries.
+  const auto budget = c.mode_switch_timeout * (c.mode_switch_max_attempts + 1) +
+                      params_.driver.request_answer_timeout + std::chrono::seconds(3);
+  const auto outcome = wait_for(driver_->set_park(req.data), budget);
+  res.success = outcome.state == State::kAnswered;
+  res.message = outcome.message.empty()
+                    ? std::string(req.data ? "park" : "release") + " not confirmed in time (" +
+                          std::string(ranger::to_string(outcome.state)) + ")"
+                    : outcome.message;
+  if (res.success) {
+    ROS_INFO("park: %s", res.message.c_str());
+  } else {
+    ROS_WARN("park: %s", res.message.c_str());
+  }
   return true;
 }
 
@@ -454,6 +523,12 @@ void RangerNode::publish_states() {
   publish_if_heard(battery_state_pub_,
                    [&] { return to_battery_state(s->feedback, s->now, stamp); });
   publish_if_heard(ultrasonic_state_pub_, [&] { return to_ultrasonic_state(*s, stamp); });
+  if (s->remote && s->remote->received > last_remote_received_) {
+    last_remote_received_ = s->remote->received;
+    publish_if_heard(remote_state_pub_, [&] {
+      return to_remote_state(*s->remote, to_ros_time(s->feedback.remote_control_state->stamp));
+    });
+  }
   if (s->motion_known) {
     for (std::size_t g = 0; g < s->feedback.ultrasonic.size(); ++g) {
       const auto& group = s->feedback.ultrasonic[g];
@@ -538,6 +613,7 @@ void RangerNode::log_state_changes(const ranger::DriverSnapshot& s) {
       case R::kCmdTimeout:
       case R::kModeUnknown:
       case R::kSwitching:
+      case R::kParked:  // the commander's own wish
         ROS_INFO("%s", detail.c_str());
         break;
       case R::kIdentifying:  // the identification's own log says how it ends

@@ -278,11 +278,71 @@ TEST(SystemState, EveryRefusalIsDescribed) {
   ranger::ControllerState c;
   c.link = ranger::LinkState::kConnected;
   for (int r = static_cast<int>(ranger::MotionRefusal::kLinkLost);
-       r <= static_cast<int>(ranger::MotionRefusal::kIdentifying); ++r) {
+       r <= static_cast<int>(ranger::MotionRefusal::kParked); ++r) {
     c.refusal = static_cast<ranger::MotionRefusal>(r);
     EXPECT_FALSE(describe_refusal(c).empty()) << ranger::to_string(c.refusal);
     EXPECT_EQ(refusal_name(c), std::string(ranger::to_string(c.refusal)));
   }
+}
+
+TEST(SystemState, ParkAndTheFirmwareVersion) {
+  ranger::DriverSnapshot s;
+  s.controller.park_requested = true;
+  s.controller.chassis_mode = ranger::protocol::MotionMode::kPark;
+  s.controller.refusal = ranger::MotionRefusal::kParked;
+  s.firmware = {ranger::FirmwareVersion::State::kAnswered, "fw 5.7.3"};
+  const auto m = to_system_state(s, ros::Time(1.0));
+  EXPECT_TRUE(m.park_requested);
+  EXPECT_TRUE(m.parked);
+  EXPECT_EQ(m.motion_inhibited_reason, "parked");
+  EXPECT_NE(m.motion_inhibited_detail.find("call park with data = false"), std::string::npos);
+  EXPECT_EQ(m.firmware_version, "fw 5.7.3");
+  EXPECT_EQ(m.firmware_version_state, "answered");
+}
+
+// ---- the vendor's additions
+// ----------------------------------------------------------------------
+
+TEST(Vendor, RemoteStateNamesTheSwitchesAndKeepsTheSticks) {
+  ranger::RemoteState r;
+  r.swa = ranger::protocol::RemoteSwitch::kDown;
+  r.swb = ranger::protocol::RemoteSwitch::kMiddle;
+  r.left_vertical = 0.5;
+  r.knob = -1.0;
+  const auto m = to_remote_state(r, ros::Time(2.0));
+  EXPECT_EQ(m.swa, "down");
+  EXPECT_EQ(m.swb, "middle");
+  EXPECT_EQ(m.swc, "undefined");
+  EXPECT_FLOAT_EQ(m.left_vertical, 0.5f);
+  EXPECT_FLOAT_EQ(m.knob, -1.0f);
+  EXPECT_EQ(m.header.stamp, ros::Time(2.0));
+}
+
+TEST(Vendor, LightsRequestsAreCheckedField) {
+  ranger_msgs::SetLights::Request req;
+  req.front_mode = ranger_msgs::SetLights::Request::CUSTOM;
+  req.front_brightness = 30;
+  req.rear_mode = ranger_msgs::SetLights::Request::ON;
+  req.rear_brightness = 99;  // not custom: ignored
+  const auto ok = to_lights_request(req);
+  ASSERT_TRUE(ok.ok());
+  EXPECT_EQ(ok->front, ranger::protocol::LightMode::kCustom);
+  EXPECT_EQ(ok->front_brightness, 30);
+  EXPECT_EQ(ok->rear_brightness, 0);
+  req.rear_mode = 4;
+  const auto bad = to_lights_request(req);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().message.find("rear_mode 4"), std::string::npos);
+  req.rear_mode = 0;
+  req.front_brightness = 101;
+  EXPECT_FALSE(to_lights_request(req).ok());
+  ranger_msgs::SetLights::Response res;
+  fill_lights_response(ranger::LightsState{true, ranger::protocol::LightMode::kBreathing, 0,
+                                           ranger::protocol::LightMode::kCustom, 40},
+                       res);
+  EXPECT_TRUE(res.can_control);
+  EXPECT_EQ(res.front_mode, ranger_msgs::SetLights::Request::BREATHING);
+  EXPECT_EQ(res.rear_brightness, 40);
 }
 
 // ---- cmd_vel_out -------------------------------------------------------------------------------

@@ -4,7 +4,9 @@
 // /rosout, /diagnostics, services out. Launched by node_sim.test (NodeSim, Safety), and filtered
 // to one suite by node_sim_faults.test (Faults), node_sim_identify*.test (Identification:
 // protocol auto, the default, on sim, sim:agx_v2 and sim:undecidable) and
-// node_sim_implausible*.test (Implausible: a wrong forced setting on a sim variant).
+// node_sim_implausible*.test (Implausible: a wrong forced setting on a sim variant),
+// node_sim_vendor.test (Vendor: remote_state, set_lights, park, the firmware version on
+// sim:agx_v2) and node_sim_mini_v1.test (MiniV1: side slip, park refused).
 //
 // With protocol auto (the default) the node drives nothing until the identification has decided
 // (about 3.6 s after the chassis is first heard): SetUp waits for that, a condition like every
@@ -19,6 +21,8 @@
 #include <gtest/gtest.h>
 #include <nav_msgs/Odometry.h>
 #include <ranger_msgs/ClearErrors.h>
+#include <ranger_msgs/RemoteState.h>
+#include <ranger_msgs/SetLights.h>
 #include <ranger_msgs/SetMotionMode.h>
 #include <ranger_msgs/SetUltrasonic.h>
 #include <ranger_msgs/SystemState.h>
@@ -28,6 +32,7 @@
 #include <sensor_msgs/JointState.h>
 #include <sensor_msgs/Range.h>
 #include <std_msgs/String.h>
+#include <std_srvs/SetBool.h>
 #include <std_srvs/Trigger.h>
 #include <tf2/utils.h>
 
@@ -111,6 +116,11 @@ class NodeSim : public ::testing::Test {
     subs_.push_back(subscribe<ranger_msgs::UltrasonicState>(
         nh, "ultrasonic_state", 10,
         [](const ranger_msgs::UltrasonicState::ConstPtr& m) { ultrasonic_.set(*m); }));
+    subs_.push_back(subscribe<ranger_msgs::RemoteState>(
+        nh, "remote_state", 10, [](const ranger_msgs::RemoteState::ConstPtr& m) {
+          remote_.set(*m);
+          ++remote_count_;
+        }));
     subs_.push_back(subscribe<geometry_msgs::TwistStamped>(
         nh, "cmd_vel_out", 1000, [](const geometry_msgs::TwistStamped::ConstPtr& m) {
           std::lock_guard<std::mutex> lock(commands_mutex_);
@@ -340,7 +350,8 @@ class NodeSim : public ::testing::Test {
   static Latest<nav_msgs::Odometry> odom_, truth_;
   static Latest<ranger_msgs::UltrasonicState> ultrasonic_;
   static Latest<sensor_msgs::Range> range_;
-  static std::atomic<int> odom_count_, joints_count_, odom_stamp_regressions_;
+  static Latest<ranger_msgs::RemoteState> remote_;
+  static std::atomic<int> odom_count_, joints_count_, odom_stamp_regressions_, remote_count_;
   static std::mutex commands_mutex_;
   static std::deque<geometry_msgs::TwistStamped> commands_;
   static std::deque<SystemState> states_;
@@ -356,8 +367,9 @@ Latest<SystemState> NodeSim::state_;
 Latest<nav_msgs::Odometry> NodeSim::odom_, NodeSim::truth_;
 Latest<ranger_msgs::UltrasonicState> NodeSim::ultrasonic_;
 Latest<sensor_msgs::Range> NodeSim::range_;
+Latest<ranger_msgs::RemoteState> NodeSim::remote_;
 std::atomic<int> NodeSim::odom_count_{0}, NodeSim::joints_count_{0},
-    NodeSim::odom_stamp_regressions_{0};
+    NodeSim::odom_stamp_regressions_{0}, NodeSim::remote_count_{0};
 std::mutex NodeSim::commands_mutex_;
 std::deque<geometry_msgs::TwistStamped> NodeSim::commands_;
 std::deque<SystemState> NodeSim::states_;
@@ -621,6 +633,160 @@ TEST_F(NodeSim, MotionModeCanBePinnedAndReleased) {
   ASSERT_TRUE(client.call(srv));
   EXPECT_FALSE(srv.response.success);
   stop_and_settle();
+}
+
+TEST_F(NodeSim, LightsAndParkAreRefusedByNameOnTheManualsChassis) {
+  ros::ServiceClient lights = nh_->serviceClient<ranger_msgs::SetLights>("set_lights");
+  ros::ServiceClient park = nh_->serviceClient<std_srvs::SetBool>("park");
+  ASSERT_TRUE(lights.waitForExistence(ros::Duration(10.0)));
+  ASSERT_TRUE(park.waitForExistence(ros::Duration(10.0)));
+  ranger_msgs::SetLights l;
+  l.request.front_mode = ranger_msgs::SetLights::Request::BREATHING;
+  ASSERT_TRUE(lights.call(l));
+  EXPECT_FALSE(l.response.success);
+  EXPECT_NE(l.response.message.find("lights: unsupported by protocol manual"), std::string::npos)
+      << l.response.message;
+  std_srvs::SetBool p;
+  p.request.data = true;
+  ASSERT_TRUE(park.call(p));
+  EXPECT_FALSE(p.response.success);
+  EXPECT_NE(p.response.message.find("park: unsupported by protocol manual"), std::string::npos)
+      << p.response.message;
+  EXPECT_FALSE(state_.get()->park_requested);
+  // Side slip is not in the manual's numbering either.
+  ros::ServiceClient modes = nh_->serviceClient<ranger_msgs::SetMotionMode>("set_motion_mode");
+  ranger_msgs::SetMotionMode m;
+  m.request.mode = ranger_msgs::SetMotionMode::Request::SIDE_SLIP;
+  ASSERT_TRUE(modes.call(m));
+  EXPECT_FALSE(m.response.success);
+  EXPECT_NE(m.response.message.find("side_slip: unsupported by protocol manual"), std::string::npos)
+      << m.response.message;
+  // No remote state from a chassis that sends no 0x241; the version is known unsupported.
+  EXPECT_EQ(remote_count_.load(), 0);
+  EXPECT_EQ(state_.get()->firmware_version_state, "unsupported");
+  // And cmd_vel still drives.
+  ASSERT_TRUE(
+      drive_until(twist(0.3, 0, 0), [] { return truth_.get()->twist.twist.linear.x > 0.2; }));
+  stop_and_settle();
+}
+
+// ---- the vendor's additions on sim:agx_v2 (node_sim_vendor.test) ------------------------------
+
+class Vendor : public NodeSim {};
+
+TEST_F(Vendor, RemoteStateIsPublishedWithSwitchesByName) {
+  ASSERT_TRUE(wait_for([] { return remote_count_ > 5; }));
+  const auto r = remote_.get();
+  EXPECT_EQ(r->swb, "up") << "SWB up: CAN command mode";
+  EXPECT_EQ(r->swa, "up");
+  EXPECT_GE(r->left_vertical, -1.0f);
+  EXPECT_LE(r->left_vertical, 1.0f);
+  EXPECT_GT(r->header.stamp.toSec(), 0.0);
+}
+
+TEST_F(Vendor, SetLightsIsAnsweredWithTheStateTheChassisReports) {
+  ros::ServiceClient client = nh_->serviceClient<ranger_msgs::SetLights>("set_lights");
+  ASSERT_TRUE(client.waitForExistence(ros::Duration(10.0)));
+  using Req = ranger_msgs::SetLights::Request;
+  ranger_msgs::SetLights srv;
+  srv.request.front_mode = Req::BREATHING;
+  srv.request.rear_mode = Req::CUSTOM;
+  srv.request.rear_brightness = 40;
+  ASSERT_TRUE(client.call(srv));
+  EXPECT_TRUE(srv.response.success) << srv.response.message;
+  EXPECT_EQ(srv.response.message, "the chassis reports front breathing, rear custom 40");
+  EXPECT_TRUE(srv.response.can_control);
+  EXPECT_EQ(srv.response.front_mode, Req::BREATHING);
+  EXPECT_EQ(srv.response.rear_mode, Req::CUSTOM);
+  EXPECT_EQ(srv.response.rear_brightness, 40);
+  // A brightness above 100 is refused before anything is sent.
+  srv.request.rear_brightness = 101;
+  ASSERT_TRUE(client.call(srv));
+  EXPECT_FALSE(srv.response.success);
+  EXPECT_NE(srv.response.message.find("rear_brightness 101"), std::string::npos)
+      << srv.response.message;
+  EXPECT_EQ(srv.response.rear_brightness, 40) << "the state the chassis still reports";
+  // Off again.
+  srv.request.front_mode = srv.request.rear_mode = Req::OFF;
+  srv.request.rear_brightness = 0;
+  ASSERT_TRUE(client.call(srv));
+  EXPECT_TRUE(srv.response.success) << srv.response.message;
+  EXPECT_EQ(srv.response.front_mode, Req::OFF);
+}
+
+TEST_F(Vendor, ParkRefusesMotionByNameUntilReleased) {
+  ros::ServiceClient park = nh_->serviceClient<std_srvs::SetBool>("park");
+  ASSERT_TRUE(park.waitForExistence(ros::Duration(10.0)));
+  std_srvs::SetBool srv;
+  srv.request.data = true;
+  ASSERT_TRUE(park.call(srv));
+  ASSERT_TRUE(srv.response.success) << srv.response.message;
+  ASSERT_TRUE(wait_for([] {
+    const auto s = state_.get();
+    return s->parked && s->park_requested && s->motion_mode_name == "park";
+  }));
+  // Every twist is refused by name; the chassis does not move.
+  const double x0 = truth_.get()->pose.pose.position.x;
+  ASSERT_TRUE(drive_for_states(twist(0.4, 0, 0), 10));
+  EXPECT_EQ(state_.get()->motion_inhibited_reason, "parked");
+  EXPECT_NE(state_.get()->motion_inhibited_detail.find("call park with data = false"),
+            std::string::npos);
+  EXPECT_NEAR(truth_.get()->pose.pose.position.x, x0, 1e-6);
+  // Released: the twist drives again.
+  srv.request.data = false;
+  ASSERT_TRUE(park.call(srv));
+  ASSERT_TRUE(srv.response.success) << srv.response.message;
+  ASSERT_TRUE(
+      drive_until(twist(0.4, 0, 0), [] { return truth_.get()->twist.twist.linear.x > 0.2; }));
+  EXPECT_FALSE(state_.get()->park_requested);
+  EXPECT_EQ(state_.get()->motion_inhibited_reason, "");
+  stop_and_settle();
+}
+
+TEST_F(Vendor, TheFirmwareVersionIsInSystemStateAndDiagnostics) {
+  std::string want;
+  ASSERT_TRUE(ros::param::get("~expected_firmware", want));
+  ASSERT_TRUE(wait_for([&] { return state_.get()->firmware_version == want; }))
+      << state_.get()->firmware_version;
+  EXPECT_EQ(state_.get()->firmware_version_state, "answered");
+  ASSERT_TRUE(wait_for([&] {
+    const auto d = diagnostic("CAN link");
+    return d && value_of(*d, "Firmware version") == want;
+  }));
+}
+
+// ---- the RANGER MINI V1 (node_sim_mini_v1.test) -----------------------------------------------
+
+class MiniV1 : public NodeSim {};
+
+TEST_F(MiniV1, SideSlipThroughSetMotionModeMovesSidewaysWithOdometry) {
+  ros::ServiceClient modes = nh_->serviceClient<ranger_msgs::SetMotionMode>("set_motion_mode");
+  ASSERT_TRUE(modes.waitForExistence(ros::Duration(10.0)));
+  ranger_msgs::SetMotionMode srv;
+  srv.request.mode = ranger_msgs::SetMotionMode::Request::SIDE_SLIP;
+  ASSERT_TRUE(modes.call(srv));
+  ASSERT_TRUE(srv.response.success) << srv.response.message;
+  const auto y0 = truth_.get()->pose.pose.position.y;
+  const auto oy0 = odom_.get()->pose.pose.position.y;
+  ASSERT_TRUE(drive_until(twist(0, 0.3, 0), [&] {
+    return state_.get()->motion_mode_name == "side_slip" &&
+           truth_.get()->pose.pose.position.y > y0 + 0.5;
+  }));
+  EXPECT_EQ(state_.get()->motion_mode, 3) << "the MINI V1's side slip is its mode 3";
+  EXPECT_NEAR(truth_.get()->twist.twist.linear.y, 0.3, 0.02);
+  EXPECT_NEAR(odom_.get()->pose.pose.position.y - oy0, truth_.get()->pose.pose.position.y - y0,
+              0.05);
+  stop_and_settle();
+  srv.request.mode = ranger_msgs::SetMotionMode::Request::AUTOMATIC;
+  ASSERT_TRUE(modes.call(srv));
+  // Park is not the MINI V1's.
+  ros::ServiceClient park = nh_->serviceClient<std_srvs::SetBool>("park");
+  std_srvs::SetBool p;
+  p.request.data = true;
+  ASSERT_TRUE(park.call(p));
+  EXPECT_FALSE(p.response.success);
+  EXPECT_NE(p.response.message.find("park: unsupported by protocol"), std::string::npos)
+      << p.response.message;
 }
 
 // ---- safety through ROS (issue 13): the re-arm latch, resume, sim/inject ------------------------

@@ -471,7 +471,13 @@ def drive_one_robot(session, cmd, match):
 INJECTED_STATE = {
     "estop on": [("vehicle_status", 1), ("motion_inhibited_reason", "estop")],
     "estop off": [("vehicle_status", 0), ("rearm_required", True)],
+    "remote on": [("control_mode", 3), ("motion_inhibited_reason", "remote")],
+    "remote sticks 0.2 -0.3": [("control_mode", 3), ("motion_mode", 0)],
+    "remote swd bottom": [("control_mode", 3), ("motion_mode", 1)],
+    "remote can": [("control_mode", 1), ("rearm_required", True)],
 }
+# ... and the sim/inject lines after which the robot moves (its ground truth).
+INJECTED_MOVES = {"remote sticks 0.2 -0.3"}
 
 
 def inject_fault(session, cmd, match):
@@ -484,9 +490,12 @@ def inject_fault(session, cmd, match):
         f"`{cmd.text}`: say in INJECTED_STATE what '{line}' shows in system_state")
     run_ok(session, cmd, match)
     topic = f"/{ns}/system_state" if ns else "/system_state"
-    session.probe(session.running[-1], [
-        {"topic": topic, "type": "ranger_msgs/SystemState", "field": f, "equals": v}
-        for f, v in INJECTED_STATE[line]])
+    conditions = [{"topic": topic, "type": "ranger_msgs/SystemState", "field": f, "equals": v}
+                  for f, v in INJECTED_STATE[line]]
+    if line in INJECTED_MOVES:
+        conditions.append({"topic": f"/{ns}/sim/ground_truth" if ns else "/sim/ground_truth",
+                           "type": "nav_msgs/Odometry", "moved_more_than": 0.05})
+    session.probe(session.running[-1], conditions)
 
 
 def call_resume(session, cmd, match):
@@ -594,6 +603,32 @@ def build_sh_runs_first(session, cmd, match):
     assert re.search(r"lib \| ros \| all\)", read("scripts/build.sh"))
 
 
+WORKSPACE_STEPS = {  # tool -> (scripts/test_workspaces.sh's step, the space it makes)
+    "catkin_make": ("catkin_make", "devel"),
+    "catkin_make_isolated": ("catkin_make_isolated", "devel_isolated"),
+    "catkin build": ("catkin_build", "devel"),
+    "colcon build": ("colcon", "install"),
+}
+
+
+def workspace_build_in_ci(session, cmd, match):
+    """A build in a ROS 1 workspace (~/catkin_ws, the repository in its src/): verified, not run
+    (a fresh workspace build takes minutes): scripts/test_workspaces.sh has a step that runs the
+    same tool in a fresh workspace, the setup file is the one that tool makes, and test.sh's
+    `workspaces` stage runs the script."""
+    tool, space = match.group("tool"), match.group("space")
+    step, made = WORKSPACE_STEPS[tool]
+    assert space == made, f"{tool} makes {made}/setup.bash, not {space}/setup.bash"
+    body = re.search(rf"^step_{step}\(\) {{\n(.*?)^}}", read("scripts/test_workspaces.sh"),
+                     re.M | re.S)
+    assert body, f"scripts/test_workspaces.sh has no step_{step}"
+    assert re.search(rf"(^|\s){tool}(\s|$)", body.group(1), re.M), \
+        f"step_{step} does not run {tool}:\n{body.group(1)}"
+    stage = r"^stage_workspaces\(\) \{ scripts/test_workspaces\.sh"
+    assert re.search(stage, read("scripts/test.sh"), re.M), \
+        "test.sh has no workspaces stage running scripts/test_workspaces.sh"
+
+
 @dataclass
 class Rule:
     pattern: str  # matched against the whole command
@@ -632,6 +667,10 @@ RULES = [
     Rule(r"cmake -S \. -B build/lib && cmake --build build/lib && ctest --test-dir build/lib "
          r"-LE vcan", library_build, "runs (incremental: test.sh built build/lib); exit status 0"),
     Rule(r"colcon list", colcon_list, "runs; lists the five packages"),
+    Rule(r"cd ~/catkin_ws && (?P<tool>catkin_make|catkin_make_isolated|catkin build|colcon build)"
+         r" && source (?P<space>devel|devel_isolated|install)/setup\.bash", workspace_build_in_ci,
+         "verified: scripts/test_workspaces.sh (test.sh's workspaces stage) runs that tool in a "
+         "fresh workspace"),
     Rule(r"(RANGER_STAGES=(?P<stages>\S+|\"[^\"]*\") )?\./scripts/test\.sh", test_sh_is_what_ci_runs,
          "verified: it runs this check; .ci/run runs it; the stages named exist"),
     Rule(r"\./scripts/demo\.sh|scripts/demo\.sh --no-setup --no-build --headless",

@@ -56,3 +56,6 @@ def test_demo_drives_all_modes_and_plots_odometry_against_ground_truth():
     assert driven > 8.0, "the route is about 10 m long"
     assert abs(odom_driven - driven) < 0.02 * driven
     assert error_m < 0.10 and error_deg < 2.0, summary
+    # The spin turns what its label says (the virtual chassis's ground truth, braking included).
+    spin = re.search(r"spin left half a turn\s+spin\s+[\d.]+ m\s+(\d+) deg", summary)
+    assert spin and abs(int(spin.group(1)) - 180) <= 5, summary

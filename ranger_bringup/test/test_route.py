@@ -16,7 +16,67 @@ def test_default_route_uses_every_mode_with_switches():
     assert R.mode_switches(R.DEFAULT_ROUTE) >= 3
     assert any(s.mode == R.ACKERMANN and s.wz != 0 for s in R.DEFAULT_ROUTE)  # an arc
     # Well under a minute of driving, leaving time for start-up and mode switches.
-    assert sum(s.duration for s in R.DEFAULT_ROUTE) <= 30
+    assert sum(R.driving_time(s) for s in R.DEFAULT_ROUTE) <= 30
+
+
+def test_each_spin_turns_what_its_label_says():
+    """A spin's label names its angle, and the segment turns that angle (Segment.turn) instead of
+    driving for a time."""
+    words = {"a quarter turn": math.pi / 2, "half a turn": math.pi, "a full turn": 2 * math.pi}
+    spins = [s for s in R.DEFAULT_ROUTE if s.mode == R.SPIN]
+    assert spins
+    for s in spins:
+        named = [angle for text, angle in words.items() if text in s.label]
+        assert named == [pytest.approx(s.turn)], s
+        assert ("left" in s.label) == (s.wz > 0) and ("right" in s.label) == (s.wz < 0), s
+
+
+def chassis_turn(segment, speed_up, slow_down, delay, dt=0.02):
+    """The yaw (rad) a chassis turns under R.spin_rate: its yaw rate follows the command `delay` s
+    late, at most speed_up / slow_down rad/s^2; braking to standstill after the last command is
+    counted."""
+    rate, yaw, queue = 0.0, 0.0, [0.0] * round(delay / dt)
+    commanding = True
+    for _ in range(round(60 / dt)):
+        turned = yaw * math.copysign(1.0, segment.wz)
+        command = R.spin_rate(segment, turned) if commanding else 0.0
+        commanding = commanding and command != 0.0
+        queue.append(command)
+        target = queue.pop(0)
+        limit = (speed_up if abs(target) > abs(rate) and target * rate >= 0 else slow_down) * dt
+        rate += max(-limit, min(limit, target - rate))
+        yaw += rate * dt
+        if not commanding and rate == 0.0 and not any(queue):
+            return yaw
+    raise AssertionError("the chassis never stopped")
+
+
+@pytest.mark.parametrize("speed_up,slow_down,delay", [
+    (2.9, 5.7, 0.1),  # the virtual RANGER: 1 and 2 m/s^2 at the wheels, 0.35 m from the centre
+    (1.0, 2.0, 0.2),  # a sluggish chassis
+    (6.0, 6.0, 0.05),  # a brisk one
+])
+def test_a_spin_by_angle_ends_on_its_turn(speed_up, slow_down, delay):
+    segment = next(s for s in R.DEFAULT_ROUTE if s.turn)
+    turned = chassis_turn(segment, speed_up, slow_down, delay)
+    assert math.degrees(turned) == pytest.approx(math.degrees(segment.turn), abs=2.5)
+    mirrored = R.Segment("spin right", R.SPIN, wz=-segment.wz, turn=segment.turn)
+    assert chassis_turn(mirrored, speed_up, slow_down, delay) == pytest.approx(-turned)
+
+
+def test_spin_rate_slows_down_near_the_end_and_stops_there():
+    segment = R.Segment("spin right half a turn", R.SPIN, wz=-0.9, turn=math.pi)
+    assert R.spin_rate(segment, 0.0) == -0.9
+    assert -0.9 < R.spin_rate(segment, math.pi - 0.5) < -R.MIN_SPIN_RATE
+    assert R.spin_rate(segment, math.pi - 0.05) == -R.MIN_SPIN_RATE
+    assert R.spin_rate(segment, math.pi) == 0.0
+    assert R.spin_rate(segment, math.pi + 0.3) == 0.0
+
+
+def test_yaw_change_is_signed_across_the_wrap():
+    samples = [(0.0, 0, 0, 3.0), (1.0, 0, 0, -3.0), (2.0, 0, 0, -2.0)]
+    assert R.yaw_change(samples) == pytest.approx(2 * math.pi - 6.0 + 1.0)
+    assert R.yaw_change(list(reversed(samples))) == pytest.approx(-(2 * math.pi - 5.0))
 
 
 @pytest.mark.parametrize("segment,message", [
@@ -25,6 +85,8 @@ def test_default_route_uses_every_mode_with_switches():
     (R.Segment("x", R.ACKERMANN, vy=0.1, vx=1.0), "Ackermann needs"),
     (R.Segment("x", R.ACKERMANN, vx=float("nan")), "finite"),
     (R.Segment("x", R.ACKERMANN, vx=1.0, duration=0), "duration"),
+    (R.Segment("x", R.ACKERMANN, vx=1.0, turn=1.0), "a turn is a spin's"),
+    (R.Segment("x", R.SPIN, wz=1.0, turn=-1.0), "a turn is a spin's"),
 ])
 def test_inconsistent_segments_are_refused(segment, message):
     with pytest.raises(ValueError, match=message):

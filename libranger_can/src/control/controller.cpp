@@ -23,8 +23,11 @@ bool known_control_mode(std::uint8_t raw) {
          raw == static_cast<std::uint8_t>(ControlMode::kRemote);
 }
 
+// The modes a twist can be driven in; side slip only where the profile's numbering has it, and
+// only when forced (the automatic selection never picks it).
 bool drivable_mode(MotionMode m) {
-  return m == MotionMode::kAckermann || m == MotionMode::kOblique || m == MotionMode::kSpin;
+  return m == MotionMode::kAckermann || m == MotionMode::kOblique || m == MotionMode::kSpin ||
+         m == MotionMode::kSideSlip;
 }
 
 bool is_zero(const BodyTwist& t) {
@@ -72,6 +75,8 @@ std::string_view to_string(MotionRefusal r) {
       return "below_minimum";
     case MotionRefusal::kIdentifying:
       return "identifying";
+    case MotionRefusal::kParked:
+      return "parked";
   }
   return "unknown";
 }
@@ -246,6 +251,15 @@ void ChassisController::on_system_status(const SystemStatus& m, Timestamp now) {
 }
 
 void ChassisController::on_motion_mode(const MotionModeFeedback& m) {
+  state_.chassis_mode = m.mode_known ? std::optional<MotionMode>(m.mode) : std::nullopt;
+  if (state_.chassis_mode != MotionMode::kPark) leave_park_ = false;
+  if (m.mode == MotionMode::kPark && m.mode_known) {
+    // Park: nothing to command in, but the switch into it (request_park) completes here.
+    state_.motion_mode.reset();
+    state_.chassis_switching = m.switching;
+    if (mode_switch_.on_feedback(m.mode, m.switching)) command_changed_ = true;
+    return;
+  }
   if (!m.mode_known || !drivable_mode(m.mode)) {
     // A mode this driver cannot command in (unknown value, park, side slip): the meaning of
     // 0x111 is unknown, so nothing moves (kModeUnknown). The switching bit still counts.
@@ -281,10 +295,11 @@ Status ChassisController::set_command(const MotionRequest& request, Timestamp no
                                          (std::isnan(c.value) ? "NaN" : "infinite") + "; stopping"};
     }
   }
-  if (request.mode && !drivable_mode(*request.mode)) {
-    return Error{Errc::kInvalidArgument, "controller: motion mode " +
-                                             std::to_string(static_cast<int>(*request.mode)) +
-                                             " cannot be driven (ackermann, oblique or spin)"};
+  if (request.mode && !can_drive_in(*request.mode)) {
+    return Error{Errc::kInvalidArgument,
+                 "controller: motion mode " + std::string(protocol::to_string(*request.mode)) +
+                     " cannot be driven under protocol " + config_.profile.revision +
+                     " (ackermann, oblique, spin; side_slip where the mode numbering has it)"};
   }
   if (is_zero(request.twist)) {
     // A zero twist abandons a switch that never completed, and re-arms once every cause of an
@@ -302,9 +317,14 @@ Status ChassisController::set_command(const MotionRequest& request, Timestamp no
   return ok_status();
 }
 
+bool ChassisController::can_drive_in(MotionMode mode) const {
+  return drivable_mode(mode) &&
+         protocol::motion_mode_to_wire(mode, config_.profile.mode_numbering).has_value();
+}
+
 void ChassisController::request_motion_mode(std::optional<MotionMode> mode, Timestamp now) {
   state_.now = now;
-  if (mode && !drivable_mode(*mode)) return;
+  if (mode && !can_drive_in(*mode)) return;
   state_.mode_override = mode;
   command_changed_ = true;
 }
@@ -342,6 +362,38 @@ Status ChassisController::set_ultrasonic(bool enable, Timestamp now) {
   ++state_.counters.ultrasonic_requests;
   update_faults();
   if (!send(UltrasonicSettingCommand{enable}, now)) return Error{Errc::kIoError, state_.last_error};
+  return ok_status();
+}
+
+Status ChassisController::request_park(bool on, Timestamp now) {
+  state_.now = now;
+  if (on && !protocol::motion_mode_to_wire(MotionMode::kPark, config_.profile.mode_numbering)) {
+    return Error{Errc::kInvalidArgument, "park: unsupported by protocol " +
+                                             config_.profile.revision +
+                                             " (its motion-mode numbering has no park mode)"};
+  }
+  if (on == state_.park_requested) return ok_status();
+  state_.park_requested = on;
+  leave_park_ = !on;
+  mode_switch_.cancel();  // towards park, or out of it: a switch under way is abandoned
+  command_changed_ = true;
+  return ok_status();
+}
+
+Status ChassisController::set_lights(const LightCommand& lights, Timestamp now) {
+  state_.now = now;
+  LightCommand c = lights;
+  c.counter = light_counter_++;
+  ++state_.counters.light_commands;
+  if (!send(c, now)) return Error{Errc::kIoError, state_.last_error};
+  return ok_status();
+}
+
+Status ChassisController::request_version(Timestamp now) {
+  state_.now = now;
+  feedback_.version.clear();
+  ++state_.counters.version_requests;
+  if (!send(VersionRequest{}, now)) return Error{Errc::kIoError, state_.last_error};
   return ok_status();
 }
 
@@ -544,7 +596,9 @@ MotionRefusal ChassisController::evaluate_refusal() const {
   if (has(active, StopCause::kImplausible)) return MotionRefusal::kImplausible;
   if (state_.latched_causes != 0) return MotionRefusal::kRearmRequired;
   if (state_.control_mode != ControlMode::kCan) return MotionRefusal::kStandby;
-  if (!state_.motion_mode) return MotionRefusal::kModeUnknown;
+  if (state_.park_requested) return MotionRefusal::kParked;
+  // A released park is left by a switch (run_motion); park itself commands nothing.
+  if (!state_.motion_mode && !(leave_park_ && state_.parked())) return MotionRefusal::kModeUnknown;
   if (!state_.identifying.empty()) return MotionRefusal::kIdentifying;
   if (state_.cmd_timed_out) return MotionRefusal::kCmdTimeout;
   if (selector_.below_minimum(state_.requested.twist)) return MotionRefusal::kBelowMinimum;
@@ -594,19 +648,27 @@ void ChassisController::run_motion(Timestamp now) {
   // A switch that failed goes on retrying at its bounded rate (it stops nothing else).
   // The identification's probe: zero speed, a steering angle, possibly in another mode.
   const bool probing = refusal == MotionRefusal::kIdentifying && state_.probe.has_value();
+  // Park wanted: to rest, then 0x141 park. Park released: out of it without waiting for a twist.
+  const bool parking = refusal == MotionRefusal::kParked && state_.chassis_mode.has_value();
+  const bool leaving_park =
+      leave_park_ && state_.parked() &&
+      (refusal == MotionRefusal::kNone || refusal == MotionRefusal::kCmdTimeout ||
+       refusal == MotionRefusal::kBelowMinimum || refusal == MotionRefusal::kModeSwitchFailed);
   const bool may_drive =
       ((refusal == MotionRefusal::kNone || refusal == MotionRefusal::kModeSwitchFailed) &&
        state_.has_command) ||
-      (probing && probe_mode_.has_value());
+      (probing && probe_mode_.has_value()) || parking || leaving_park;
 
   // 3. Motion-mode switching: decide the wanted mode, then stop -> 0x141 -> confirmation.
   std::optional<MotionMode> mode_to_send;
   if (!may_drive) {
     mode_switch_.cancel();  // nothing to drive (or not allowed to): no reason to switch
   } else {
-    const MotionMode current = *state_.motion_mode;
+    const MotionMode current = state_.motion_mode ? *state_.motion_mode : *state_.chassis_mode;
     MotionMode wanted = current;
-    if (probing) {
+    if (parking) {
+      wanted = MotionMode::kPark;
+    } else if (probing) {
       wanted = *probe_mode_;
     } else if (state_.requested.mode) {
       wanted = *state_.requested.mode;
@@ -614,6 +676,11 @@ void ChassisController::run_motion(Timestamp now) {
       wanted = *state_.mode_override;
     } else {
       wanted = selector_.select(state_.requested.twist, current, now);
+    }
+    // Out of park into the mode the commander forced, else Ackermann (the selector keeps the
+    // current mode for a twist it cannot classify).
+    if (!parking && wanted == MotionMode::kPark) {
+      wanted = state_.mode_override.value_or(MotionMode::kAckermann);
     }
     const bool was_active = mode_switch_.active();
     const int attempts = mode_switch_.status().attempts;
@@ -639,7 +706,7 @@ void ChassisController::run_motion(Timestamp now) {
   MotionCommand command{};
   const KinematicsSolution* solution = nullptr;
   state_.steer_first_factor = 1.0;
-  if (refusal == MotionRefusal::kNone && state_.has_command) {
+  if (refusal == MotionRefusal::kNone && state_.has_command && state_.motion_mode) {
     const double dt = limiter_started_ ? seconds(now - last_limit_time_) : 0.0;
     const BodyTwist& target = state_.requested.twist;
     const BodyTwist previous = state_.limited;

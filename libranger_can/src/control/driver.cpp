@@ -56,7 +56,74 @@ std::string hex2(std::uint8_t v) {
   return std::string("0x") + digits[v >> 4] + digits[v & 0xF];
 }
 
+double axis(std::int8_t raw) {
+  return std::clamp(raw / protocol::kRemoteAxisFullScale, -1.0, 1.0);
+}
+
+std::string light_text(protocol::LightMode mode, std::uint8_t brightness) {
+  std::string out(protocol::to_string(mode));
+  if (mode == protocol::LightMode::kCustom) out += " " + std::to_string(brightness);
+  return out;
+}
+
+bool lights_match(const LightsState& s, const LightsRequest& r) {
+  auto same = [](protocol::LightMode m1, std::uint8_t b1, protocol::LightMode m2, std::uint8_t b2) {
+    return m1 == m2 && (m1 != protocol::LightMode::kCustom || b1 == b2);
+  };
+  return same(s.front, s.front_brightness, r.front, r.front_brightness) &&
+         same(s.rear, s.rear_brightness, r.rear, r.rear_brightness);
+}
+
 }  // namespace
+
+std::string_view to_string(VendorFrames v) {
+  switch (v) {
+    case VendorFrames::kUnknown:
+      return "unknown";
+    case VendorFrames::kPresent:
+      return "present";
+    case VendorFrames::kAbsent:
+      return "absent";
+  }
+  return "unknown";
+}
+
+std::string_view to_string(FirmwareVersion::State s) {
+  switch (s) {
+    case FirmwareVersion::State::kNotAsked:
+      return "not_asked";
+    case FirmwareVersion::State::kAsked:
+      return "asked";
+    case FirmwareVersion::State::kAnswered:
+      return "answered";
+    case FirmwareVersion::State::kUnanswered:
+      return "unanswered";
+    case FirmwareVersion::State::kUnsupported:
+      return "unsupported";
+  }
+  return "unknown";
+}
+
+RemoteState remote_state_from(const RemoteControlState& rc, Timestamp received) {
+  RemoteState r;
+  r.swa = rc.swa;
+  r.swb = rc.swb;
+  r.swc = rc.swc;
+  r.swd = rc.swd;
+  r.left_vertical = axis(rc.stick_left_v);
+  r.left_horizontal = axis(rc.stick_left_h);
+  r.right_vertical = axis(rc.stick_right_v);
+  r.right_horizontal = axis(rc.stick_right_h);
+  r.knob = axis(rc.var_a);
+  r.received = received;
+  return r;
+}
+
+std::string describe(protocol::LightMode front, std::uint8_t front_brightness,
+                     protocol::LightMode rear, std::uint8_t rear_brightness) {
+  return "front " + light_text(front, front_brightness) + ", rear " +
+         light_text(rear, rear_brightness);
+}
 
 std::string_view to_string(RequestOutcome::State s) {
   switch (s) {
@@ -86,9 +153,11 @@ Status DriverConfig::validate() const {
       if (auto p = protocol_preset(*identify_revision); !p) return p.error();
     }
   }
-  if (reconnect_interval.count() <= 0 || request_answer_timeout.count() <= 0) {
+  if (reconnect_interval.count() <= 0 || request_answer_timeout.count() <= 0 ||
+      vendor_frames_wait.count() <= 0) {
     return Error{Errc::kOutOfRange,
-                 "driver: reconnect_interval and request_answer_timeout must be > 0"};
+                 "driver: reconnect_interval, request_answer_timeout and vendor_frames_wait must "
+                 "be > 0"};
   }
   return ok_status();
 }
@@ -107,12 +176,13 @@ struct Driver::Mail {
   std::optional<std::optional<protocol::MotionMode>> mode;
   std::optional<std::optional<StandstillProbe>> probe;
   struct Action {
-    enum Kind { kClearErrors, kUltrasonic, kResume } kind;
+    enum Kind { kClearErrors, kUltrasonic, kResume, kPark } kind;
     std::uint64_t id;
     std::uint8_t code;
     bool enable;
   };
   std::vector<Action> actions;
+  std::vector<DriverVendorAction> vendor;  // lights, version
 };
 
 Driver::Driver(DriverConfig config, std::shared_ptr<BusSource> source, const Clock& clock)
@@ -246,6 +316,44 @@ std::uint64_t Driver::resume() {
   return id;
 }
 
+Result<std::uint64_t> Driver::set_lights(const LightsRequest& lights) {
+  if (lights.front_brightness > 100 || lights.rear_brightness > 100) {
+    return Error{Errc::kInvalidArgument, "lights: brightness is 0..100"};
+  }
+  std::uint64_t id = 0;
+  {
+    std::lock_guard<std::mutex> lock(mail_mutex_);
+    id = add_request("lights " + describe(lights.front, lights.front_brightness, lights.rear,
+                                          lights.rear_brightness))
+             .id;
+    mail_->vendor.push_back({DriverVendorAction::Kind::kLights, id, lights});
+  }
+  wake();
+  return id;
+}
+
+std::uint64_t Driver::set_park(bool on) {
+  std::uint64_t id = 0;
+  {
+    std::lock_guard<std::mutex> lock(mail_mutex_);
+    id = add_request(std::string("park ") + (on ? "on" : "off")).id;
+    mail_->actions.push_back({Mail::Action::kPark, id, 0, on});
+  }
+  wake();
+  return id;
+}
+
+std::uint64_t Driver::request_firmware_version() {
+  std::uint64_t id = 0;
+  {
+    std::lock_guard<std::mutex> lock(mail_mutex_);
+    id = add_request("firmware_version").id;
+    mail_->vendor.push_back({DriverVendorAction::Kind::kVersion, id, {}});
+  }
+  wake();
+  return id;
+}
+
 RequestOutcome Driver::wait_for(std::uint64_t id, std::chrono::nanoseconds timeout) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   std::unique_lock<std::mutex> lock(snapshot_mutex_);
@@ -329,10 +437,28 @@ void Driver::handle_frame(const CanFrame& frame, Timestamp now) {
     controller_->on_frame(frame, now);  // counts and records the decode error
     return;
   }
-  if (std::holds_alternative<SystemStatus>(*message)) ++status_frames_;
+  if (std::holds_alternative<SystemStatus>(*message)) {
+    ++status_frames_;
+    if (!first_status_) first_status_ = now;
+  }
+  if (std::holds_alternative<VersionResponse>(*message)) last_version_frame_ = now;
   controller_->on_message(*message, frame.stamp, now);
-  odometry_.on_message(*message, frame.stamp);
-  joints_.on_message(*message, frame.stamp);
+  if (odometry_readable()) {
+    odometry_.on_message(*message, frame.stamp);
+    odometry_fed_ = true;
+  }
+  if (joints_readable()) joints_.on_message(*message, frame.stamp);
+}
+
+bool Driver::joints_readable() const {
+  return !identifier_ || identifier_->wheel_angles_known();
+}
+
+bool Driver::odometry_readable() const {
+  if (!identifier_ || identifier_->status().decided_ok()) return true;
+  // The wheels' odometry reads 0x271 and 0x281 (whose unit no revision changes); 0x221's needs
+  // the whole decision.
+  return config_.odometry.source == OdometrySource::kWheels && identifier_->wheel_angles_known();
 }
 
 void Driver::apply_mail(Timestamp now) {
@@ -357,6 +483,9 @@ void Driver::apply_mail(Timestamp now) {
         break;
       case Mail::Action::kUltrasonic:
         st = controller_->set_ultrasonic(a.enable, now);
+        break;
+      case Mail::Action::kPark:
+        st = controller_->request_park(a.enable, now);
         break;
       case Mail::Action::kResume:
         // The operator takes a plausibility stop on: the monitors start over (and trip again
@@ -384,6 +513,99 @@ void Driver::apply_mail(Timestamp now) {
       }
     }
   }
+  for (const DriverVendorAction& a : mail.vendor)
+    deferred_.push_back(a);
+}
+
+bool Driver::apply_vendor_action(const DriverVendorAction& a, Timestamp now) {
+  if (vendor_frames_ == VendorFrames::kUnknown) return false;
+  Status st = ok_status();
+  if (vendor_frames_ == VendorFrames::kAbsent) {
+    st = Error{
+        Errc::kInvalidArgument,
+        std::string(a.kind == DriverVendorAction::Kind::kLights ? "lights" : "firmware version") +
+            ": unsupported by protocol " + profile_.revision +
+            ": the chassis sends none of the vendor's frames (0x231 light state, 0x241 "
+            "remote state)"};
+  } else if (a.kind == DriverVendorAction::Kind::kLights) {
+    LightCommand c;
+    c.enable = true;
+    c.front_mode = a.lights.front;
+    c.front_custom = a.lights.front_brightness;
+    c.rear_mode = a.lights.rear;
+    c.rear_custom = a.lights.rear_brightness;
+    st = controller_->set_lights(c, now);
+    if (st) sent_lights_.emplace_back(a.id, a.lights);
+  } else {
+    st = controller_->request_version(now);
+    if (st) {
+      firmware_ = FirmwareVersion{FirmwareVersion::State::kAsked, ""};
+      version_asked_ = now;
+    }
+  }
+  std::lock_guard<std::mutex> lock(mail_mutex_);
+  for (RequestOutcome& r : requests_) {
+    if (r.id != a.id) continue;
+    r.sent = now;
+    if (!st) {
+      r.state = RequestOutcome::State::kFailed;
+      r.message = st.error().message;
+    } else {
+      r.state = RequestOutcome::State::kSent;
+    }
+  }
+  return true;
+}
+
+void Driver::update_vendor(Timestamp now) {
+  const ChassisFeedback& fb = controller_->feedback();
+  if (fb.remote_control_state) {
+    remote_ = remote_state_from(fb.remote_control_state->value, fb.remote_control_state->received);
+  }
+  if (fb.light_state) {
+    const LightState& l = fb.light_state->value;
+    lights_ = LightsState{l.enable,    l.front_mode,  l.front_custom,
+                          l.rear_mode, l.rear_custom, fb.light_state->received};
+  }
+  if (fb.light_state || fb.remote_control_state) {
+    vendor_frames_ = VendorFrames::kPresent;
+  } else if (first_status_ && now - *first_status_ >= config_.vendor_frames_wait) {
+    vendor_frames_ = VendorFrames::kAbsent;
+  }
+  // The version: asked once the chassis is heard speaking the vendor's revision, and we speak.
+  const ControllerState& c = controller_->state();
+  using VS = FirmwareVersion::State;
+  if (firmware_.state == VS::kNotAsked) {
+    if (vendor_frames_ == VendorFrames::kAbsent) {
+      firmware_.state = VS::kUnsupported;
+    } else if (vendor_frames_ == VendorFrames::kPresent && c.link == LinkState::kConnected &&
+               !c.quiet && !config_.controller.listen_only && !(source_ && source_->read_only())) {
+      if (controller_->request_version(now)) {
+        firmware_.state = VS::kAsked;
+        version_asked_ = now;
+      }
+    }
+  }
+  if (firmware_.state == VS::kAsked) {
+    firmware_.text = fb.version;
+    if (!fb.version.empty() && now - last_version_frame_ >= kAnswerDelay) {
+      firmware_.state = VS::kAnswered;
+    } else if (fb.version.empty() && now - version_asked_ > config_.request_answer_timeout) {
+      firmware_.state = VS::kUnanswered;
+    }
+  }
+  // A replayed log answers nothing, but may hold the answers of the session it recorded.
+  if (firmware_.state != VS::kAsked && !fb.version.empty()) {
+    firmware_.text = fb.version;
+    if (firmware_.state != VS::kAnswered && now - last_version_frame_ >= kAnswerDelay) {
+      firmware_.state = VS::kAnswered;
+    }
+  }
+  std::vector<DriverVendorAction> waiting;
+  for (const DriverVendorAction& a : deferred_) {
+    if (!apply_vendor_action(a, now)) waiting.push_back(a);
+  }
+  deferred_.swap(waiting);
 }
 
 void Driver::update_requests(Timestamp now) {
@@ -402,6 +624,69 @@ void Driver::update_requests(Timestamp now) {
       } else if (now - r.sent > config_.request_answer_timeout) {
         r.state = RequestOutcome::State::kFailed;
         r.message = "the chassis did not answer (no 0x211) within " +
+                    std::to_string(seconds(config_.request_answer_timeout)) + " s";
+      }
+    } else if (r.what.rfind("lights", 0) == 0) {
+      auto it = std::find_if(sent_lights_.begin(), sent_lights_.end(),
+                             [&](const auto& p) { return p.first == r.id; });
+      if (it == sent_lights_.end()) continue;
+      const bool fresh = lights_ && lights_->received >= r.sent + kAnswerDelay;
+      if (fresh && lights_match(*lights_, it->second)) {
+        r.state = RequestOutcome::State::kAnswered;
+        r.message = "the chassis reports " + describe(lights_->front, lights_->front_brightness,
+                                                      lights_->rear, lights_->rear_brightness);
+      } else if (now - r.sent > config_.request_answer_timeout) {
+        r.state = RequestOutcome::State::kFailed;
+        r.message = fresh ? "the chassis reports " +
+                                describe(lights_->front, lights_->front_brightness, lights_->rear,
+                                         lights_->rear_brightness) +
+                                (c.control_mode == protocol::ControlMode::kRemote
+                                     ? " (the remote control has the chassis)"
+                                     : "")
+                          : "the chassis did not report its lights (no 0x231) within " +
+                                std::to_string(seconds(config_.request_answer_timeout)) + " s";
+      }
+      if (r.state != RequestOutcome::State::kSent) sent_lights_.erase(it);
+    } else if (r.what == "park on") {
+      const auto limit =
+          config_.controller.mode_switch_timeout * config_.controller.mode_switch_max_attempts +
+          config_.request_answer_timeout;
+      if (c.parked()) {
+        r.state = RequestOutcome::State::kAnswered;
+        r.message = "parked (0x291 reports park): motion is refused until park is released";
+      } else if (!c.park_requested) {
+        r.state = RequestOutcome::State::kFailed;
+        r.message = "park was released before the chassis reported it";
+      } else if (now - r.sent > limit) {
+        r.state = RequestOutcome::State::kFailed;
+        r.message = "the chassis did not report park (0x291) within " +
+                    std::to_string(seconds(limit)) + " s" +
+                    (c.refusal != MotionRefusal::kParked
+                         ? std::string(" (") + std::string(to_string(c.refusal)) + ")"
+                         : std::string());
+      }
+    } else if (r.what == "park off") {
+      if (c.park_requested) {
+        r.state = RequestOutcome::State::kFailed;
+        r.message = "park was requested again";
+      } else if (c.chassis_mode != protocol::MotionMode::kPark) {
+        r.state = RequestOutcome::State::kAnswered;
+        r.message = "park released: motion allowed";
+      } else if (now - r.sent > config_.controller.mode_switch_timeout *
+                                        config_.controller.mode_switch_max_attempts +
+                                    config_.request_answer_timeout) {
+        r.state = RequestOutcome::State::kAnswered;
+        r.message =
+            "park released: motion allowed (the chassis still reports park; the next "
+            "motion switches it out)";
+      }
+    } else if (r.what == "firmware_version") {
+      if (firmware_.state == FirmwareVersion::State::kAnswered) {
+        r.state = RequestOutcome::State::kAnswered;
+        r.message = firmware_.text;
+      } else if (firmware_.state == FirmwareVersion::State::kUnanswered) {
+        r.state = RequestOutcome::State::kFailed;
+        r.message = "the chassis did not answer the version request (0x4A1) within " +
                     std::to_string(seconds(config_.request_answer_timeout)) + " s";
       }
     } else if (r.what.rfind("ultrasonic", 0) == 0) {
@@ -439,6 +724,10 @@ void Driver::publish(Timestamp now) {
   if (identifier_) s->identification = identifier_->status();
   s->plausibility = monitor_.status();
   s->loop_iterations = loop_iterations_;
+  s->vendor_frames = vendor_frames_;
+  s->remote = remote_;
+  s->lights = lights_;
+  s->firmware = firmware_;
   {
     std::lock_guard<std::mutex> lock(mail_mutex_);
     s->requests.assign(requests_.begin(), requests_.end());
@@ -472,6 +761,7 @@ void Driver::step(Timestamp now) {
     apply_mail(now);
     run_identification(now);
     run_standstill_probe();
+    update_vendor(now);
     controller_->tick(now);
     run_plausibility(now);
     update_requests(now);
@@ -500,12 +790,48 @@ void Driver::use_profile(const ProtocolProfile& profile, bool reset_odometry) {
   monitor_.set_profile(profile);
 }
 
+ProtocolProfile Driver::with_configured_settings(const IdentificationStatus& st) const {
+  // What the identification kept from its revision's preset, the configured profile (a model's
+  // own readings: the MINI V1's mode numbering, spin field and sign) has a better value for,
+  // when it is of the same revision.
+  ProtocolProfile p = st.profile;
+  const ProtocolProfile& configured = config_.controller.profile;
+  if (configured.revision != p.revision) return p;
+  for (const ProfileSetting& setting : profile_settings()) {
+    const bool decided =
+        std::any_of(st.decided.begin(), st.decided.end(),
+                    [&](const IdentifiedSetting& d) { return d.name == setting.name; });
+    if (decided) continue;
+    if (auto v = get_setting(configured, setting.name)) set_setting(p, setting.name, *v);
+  }
+  return p;
+}
+
 void Driver::run_identification(Timestamp now) {
   if (!identifier_ || identifier_->status().done()) return;
+  // The probe is motion the controller would refuse for a cause of the commander's (a re-arm
+  // after the remote control or a stop, an e-stop): it waits for that, not for the chassis.
+  const MotionRefusal refusal = controller_->state().refusal;
+  switch (refusal) {
+    case MotionRefusal::kRearmRequired:
+      identifier_->hold_probe("motion needs the re-arm (call resume, or send a zero twist)");
+      break;
+    case MotionRefusal::kRemote:  // (as of the last tick: the hand-back is being heard now)
+    case MotionRefusal::kEstop:
+    case MotionRefusal::kCriticalError:
+    case MotionRefusal::kLowBattery:
+    case MotionRefusal::kImplausible:
+      identifier_->hold_probe("motion is refused (" + std::string(to_string(refusal)) + ")");
+      break;
+    default:
+      identifier_->hold_probe("");
+      break;
+  }
   identifier_->tick(now);
   const IdentificationStatus& st = identifier_->status();
   if (st.decided_ok()) {
-    use_profile(st.profile);
+    // A chassis driven (by its remote) before the decision keeps the pose it reached.
+    use_profile(with_configured_settings(st), /*reset_odometry=*/!odometry_fed_);
     controller_->set_probe(std::nullopt, std::nullopt);
     controller_->set_quiet(false);
     controller_->set_identifying("");
@@ -518,7 +844,7 @@ void Driver::run_identification(Timestamp now) {
     return;
   }
   const IdentificationRequest r = identifier_->request();
-  if (r.profile) use_profile(*r.profile);
+  if (r.profile) use_profile(*r.profile, /*reset_odometry=*/!odometry_fed_);
   controller_->set_quiet(r.quiet);
   controller_->set_probe(r.mode, r.probe);
   controller_->set_identifying(st.message);
@@ -553,7 +879,7 @@ void Driver::run_plausibility(Timestamp now) {
   // Auto: a setting the identification could not decide at rest is learned here. The stop stays
   // latched (a zero twist or resume re-arms); the cause itself is gone with the setting.
   if (identifier_ && identifier_->adopt(stop->setting, stop->try_value, stop->detail)) {
-    use_profile(identifier_->status().profile, /*reset_odometry=*/false);
+    use_profile(with_configured_settings(identifier_->status()), /*reset_odometry=*/false);
     controller_->set_implausible("");
     applied_stop_.clear();
   }

@@ -86,6 +86,192 @@ std::string values_text(const std::array<double, 4>& a) {
   return out + " deg";
 }
 
+// A reading of an angle field: its unit and sign.
+struct Reading271 {
+  AngleUnit unit;
+  SteeringSign sign;
+};
+
+// The four wheel angles (REP-103, rad) of a 0x271 frame read in `unit` and `sign` under `profile`;
+// nullopt when that reading puts them beyond any model's reach.
+std::optional<std::array<double, 4>> read_271(const CanFrame& frame, ProtocolProfile profile,
+                                              AngleUnit unit, SteeringSign sign) {
+  profile.steering_unit_271 = unit;
+  profile.steering_sign_271 = sign;
+  Result<Message> m = decode(frame, profile);
+  if (!m) return std::nullopt;
+  const auto* a = std::get_if<SteeringAnglesFeedback>(&*m);
+  if (a == nullptr) return std::nullopt;
+  std::array<double, 4> out{};
+  for (std::size_t i = 0; i < out.size(); ++i)
+    out[i] = interpretation::rep103_from_manual_wheel_angle(a->angles[i]);
+  return out;
+}
+
+// One explanation of the steering probe's answer: a reading of 0x111 (unit, sign, reference) and
+// of 0x271, with how well the predicted wheel angles fit the measured ones.
+struct SteerCombo {
+  AngleUnit u111;
+  SteeringSign s111;
+  SteeringReference ref;
+  AngleUnit u271;
+  SteeringSign s271;
+  double commanded;  // REP-103 angle the chassis reads
+  double residual;   // rad: the worst wheel's error
+};
+
+// Every combination of the 0x111 reading and the 0x271 readings `h271`: the wheel angles the
+// probe (sent as `probe_wire_angle` under `proposal`) predicts against those `angles` shows.
+std::vector<SteerCombo> rank_steer_combos(const CanFrame& angles, const ProtocolProfile& proposal,
+                                          const VehicleGeometry& geometry, double probe_wire_angle,
+                                          const std::vector<Reading271>& h271) {
+  std::vector<SteerCombo> combos;
+  // The wire value the probe went out as, read under each 0x111 hypothesis.
+  MotionCommand sent;
+  sent.steering_angle = probe_wire_angle;
+  const Result<CanFrame> wire = encode(sent, proposal);
+  for (AngleUnit u111 : kUnits) {
+    for (SteeringSign s111 : kSigns) {
+      ProtocolProfile p = proposal;
+      p.steering_unit_111 = u111;
+      p.steering_sign_111 = s111;
+      Result<Message> read = wire ? decode(*wire, p) : Result<Message>(wire.error());
+      if (!read) continue;
+      const MotionCommand as_read = std::get<MotionCommand>(*read);
+      for (SteeringReference ref : kReferences) {
+        p.steering_reference = ref;
+        const auto predicted =
+            wheel_angles_for_command(as_read, MotionMode::kAckermann, geometry, p);
+        for (const Reading271& h : h271) {
+          const auto measured = read_271(angles, proposal, h.unit, h.sign);
+          if (!measured) continue;
+          double r = 0.0;
+          for (std::size_t i = 0; i < 4; ++i)
+            r = std::max(r, std::fabs((*measured)[i] - predicted[i]));
+          combos.push_back(
+              {u111, s111, ref, h.unit, h.sign,
+               interpretation::rep103_from_manual_command_steering(as_read.steering_angle), r});
+        }
+      }
+    }
+  }
+  return combos;
+}
+
+enum class SteerOutcome {
+  kReprobeTooSmall,   // too small to tell the readings apart; the best fit names another 0x111
+                      // unit: probe again in it
+  kReprobeCorrected,  // a clear fit, but far smaller than asked: probe again in the corrected
+                      // 0x111 unit and sign, so that the reference is judged at a useful angle
+  kNoFit,             // no combination explains the answer clearly
+  kDecided,
+};
+
+struct SteerDecision {
+  SteerOutcome outcome = SteerOutcome::kNoFit;
+  std::optional<SteerCombo> best;  // the best fit of units and signs (nullopt: nothing fits)
+  double confidence = 1.0;         // of the units and signs
+  // kDecided: the residuals of the winning units and signs under each reference (mean, inner),
+  // and the reference where they tell it apart.
+  std::array<double, 2> reference_residual{std::numeric_limits<double>::infinity(),
+                                           std::numeric_limits<double>::infinity()};
+  std::optional<SteeringReference> reference;
+  double reference_confidence = 1.0;
+};
+
+// What the steering probe's answer decides, given the proposal it was sent under and the number
+// of probes made so far.
+SteerDecision decide_steer(const std::vector<SteerCombo>& combos, const ProtocolProfile& proposal,
+                           const IdentificationConfig& config, int probes) {
+  // Units and signs first (the reference set aside: it is a 6 % effect).
+  Ranking gross;
+  for (std::size_t c = 0; c < combos.size(); ++c) {
+    bool dominated = false;  // keep one entry per (u111, s111, u271, s271): its best reference
+    for (std::size_t d = 0; d < combos.size(); ++d) {
+      if (d != c && combos[d].u111 == combos[c].u111 && combos[d].s111 == combos[c].s111 &&
+          combos[d].u271 == combos[c].u271 && combos[d].s271 == combos[c].s271 &&
+          (combos[d].residual < combos[c].residual ||
+           (combos[d].residual == combos[c].residual && d < c))) {
+        dominated = true;
+      }
+    }
+    if (!dominated) gross.add(static_cast<int>(c), combos[c].residual);
+  }
+  SteerDecision out;
+  if (gross.best >= 0) out.best = combos[static_cast<std::size_t>(gross.best)];
+  const double probe_tol = config.angle_tolerance + 0.1 * 6.0 * config.probe_angle;
+  const bool clear = gross.clear(probe_tol, config.margin, 0.1 * kDeg);
+  const bool may_reprobe = probes < kMaxSteerProbes;
+  if (!clear) {
+    if (out.best && gross.best_residual <= probe_tol && may_reprobe &&
+        std::fabs(out.best->commanded) < kMinReferenceAngle &&
+        out.best->u111 != proposal.steering_unit_111) {
+      out.outcome = SteerOutcome::kReprobeTooSmall;
+    } else {
+      out.outcome = SteerOutcome::kNoFit;
+    }
+    return out;
+  }
+  const SteerCombo& g = *out.best;
+  const double actual = std::fabs(g.commanded);
+  if (actual < kMinReferenceAngle && may_reprobe && g.u111 != proposal.steering_unit_111) {
+    out.outcome = SteerOutcome::kReprobeCorrected;
+    return out;
+  }
+  out.outcome = SteerOutcome::kDecided;
+  out.confidence = gross.confidence();
+  // The reference: the two entries of the winning units and signs.
+  for (const SteerCombo& k : combos) {
+    if (k.u111 == g.u111 && k.s111 == g.s111 && k.u271 == g.u271 && k.s271 == g.s271) {
+      out.reference_residual[k.ref == SteeringReference::kInnerFront ? 1 : 0] = k.residual;
+    }
+  }
+  const int best_ref = out.reference_residual[1] < out.reference_residual[0] ? 1 : 0;
+  const double lo = out.reference_residual[static_cast<std::size_t>(best_ref)];
+  const double hi = out.reference_residual[static_cast<std::size_t>(1 - best_ref)];
+  if (actual >= kMinReferenceAngle && hi >= config.margin * std::max(lo, 0.05 * kDeg)) {
+    out.reference = kReferences[static_cast<std::size_t>(best_ref)];
+    out.reference_confidence = hi > 0 ? 1.0 - lo / hi : 1.0;
+  }
+  return out;
+}
+
+// 0x221's steering angle read under each unit and sign, against what it should report for the
+// wheels as they stand (`measured`, REP-103 rad) under the proposal's reference.
+struct Angle221Decision {
+  double expected = 0.0;              // rad, REP-103
+  std::optional<Reading271> reading;  // the unit and sign, when one reading fits clearly
+  double confidence = 1.0;
+};
+
+Angle221Decision decide_221(const CanFrame& motion, const std::array<double, 4>& m,
+                            const ProtocolProfile& proposal, const IdentificationConfig& config) {
+  Angle221Decision out;
+  const double mean_front = (m[kRightFront] + m[kLeftFront]) / 2.0;
+  const double inner_front =
+      std::fabs(m[kRightFront]) > std::fabs(m[kLeftFront]) ? m[kRightFront] : m[kLeftFront];
+  out.expected =
+      proposal.steering_reference == SteeringReference::kInnerFront ? inner_front : mean_front;
+  Ranking r221;
+  for (int h = 0; h < 4; ++h) {
+    ProtocolProfile p = proposal;
+    p.steering_unit_221 = kUnits[h / 2];
+    p.steering_sign_221 = kSigns[h % 2];
+    Result<Message> fb = decode(motion, p);
+    if (!fb) continue;
+    const double a =
+        interpretation::rep103_from_manual_steering(std::get<MotionFeedback>(*fb).steering_angle);
+    r221.add(h, std::fabs(a - out.expected));
+  }
+  if (std::fabs(out.expected) >= 1.0 * kDeg &&
+      r221.clear(config.angle_tolerance + 0.1 * std::fabs(out.expected), config.margin,
+                 0.1 * kDeg)) {
+    out.reading = Reading271{kUnits[r221.best / 2], kSigns[r221.best % 2]};
+    out.confidence = r221.confidence();
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string_view to_string(IdentificationPhase p) {
@@ -155,6 +341,7 @@ void ChassisIdentifier::start(Timestamp now) {
   if (started_) return;
   started_ = true;
   status_.started = now;
+  timeout_from_ = now;
   status_.finished = now;
 }
 
@@ -182,17 +369,7 @@ void ChassisIdentifier::set(std::string_view name, std::string_view value, std::
 std::optional<std::array<double, 4>> ChassisIdentifier::wheel_angles(const CanFrame& frame,
                                                                      AngleUnit unit,
                                                                      SteeringSign sign) const {
-  ProtocolProfile p = status_.profile;
-  p.steering_unit_271 = unit;
-  p.steering_sign_271 = sign;
-  Result<Message> m = decode(frame, p);
-  if (!m) return std::nullopt;  // e.g. beyond any model's reach under this reading
-  const auto* a = std::get_if<SteeringAnglesFeedback>(&*m);
-  if (a == nullptr) return std::nullopt;
-  std::array<double, 4> out{};
-  for (std::size_t i = 0; i < out.size(); ++i)
-    out[i] = interpretation::rep103_from_manual_wheel_angle(a->angles[i]);
-  return out;
+  return read_271(frame, status_.profile, unit, sign);
 }
 
 // ---- frames
@@ -351,7 +528,13 @@ void ChassisIdentifier::tick(Timestamp now) {
   start(now);
   if (status_.done()) return;
   status_.finished = now;
-  if (now - status_.started >= config_.timeout) {
+  // Under the remote control the operator drives: waiting for CAN command mode is no failure,
+  // and the time for the probe counts from when the remote hands back.
+  if (status_.phase == IdentificationPhase::kAwaitingControl &&
+      (under_remote() || !probe_hold_.empty())) {
+    timeout_from_ = now;
+  }
+  if (now - timeout_from_ >= config_.timeout) {
     std::string why;
     switch (status_.phase) {
       case IdentificationPhase::kListening:
@@ -391,10 +574,17 @@ void ChassisIdentifier::tick(Timestamp now) {
       break;
     case IdentificationPhase::kAwaitingControl:
       if (control_mode_raw_ == static_cast<std::uint8_t>(protocol::ControlMode::kCan) && mode_ &&
-          !switching_) {
+          !switching_ && !probe_hold_.empty()) {
+        status_.message = "identifying the chassis: the steering probe waits: " + probe_hold_;
+      } else if (control_mode_raw_ == static_cast<std::uint8_t>(protocol::ControlMode::kCan) &&
+                 mode_ && !switching_) {
         begin_step(config_.spin_check && !verdict_271_ ? IdentificationPhase::kSpinCheck
                                                        : IdentificationPhase::kSteerProbe,
                    now);
+      } else if (under_remote()) {
+        observe_remote_driving(now);
+      } else {
+        status_.message = "identifying the chassis: waiting for CAN command mode";
       }
       break;
     case IdentificationPhase::kSpinCheck:
@@ -464,6 +654,11 @@ bool ChassisIdentifier::settled(Timestamp now) const {
 }
 
 void ChassisIdentifier::evaluate_spin(Timestamp now) {
+  judge_spin_position("spin position at standstill", /*quiet_if_unclear=*/false);
+  begin_step(IdentificationPhase::kSteerProbe, now);
+}
+
+bool ChassisIdentifier::judge_spin_position(const std::string& context, bool quiet_if_unclear) {
   const auto expected =
       wheel_angles_for_command(MotionCommand{}, MotionMode::kSpin, geometry_, status_.profile);
   Ranking rank;
@@ -482,7 +677,7 @@ void ChassisIdentifier::evaluate_spin(Timestamp now) {
     const Hypothesis271 v{kUnits[rank.best / 2], kSigns[rank.best % 2]};
     verdict_271_ = v;
     min_margin_ = std::min(min_margin_, rank.confidence());
-    const std::string read = std::string("spin position at standstill: 0x271 read ") +
+    const std::string read = context + ": 0x271 read " +
                              (plain ? values_text(*plain) + " in 0.01 deg" : "beyond 100 deg") +
                              ", expected +-" + deg(std::fabs(expected[0])) +
                              " (atan(wheelbase/track), RF +, RR -, LR +, LF - in REP-103)";
@@ -490,116 +685,87 @@ void ChassisIdentifier::evaluate_spin(Timestamp now) {
         read + ": the unit is " + std::string(to_string(v.unit)));
     set("steering_sign_271", to_string(v.sign),
         "spin position sign pattern: " + std::string(to_string(v.sign)));
-  } else {
+    return true;
+  }
+  if (!quiet_if_unclear) {
     note("spin check inconclusive: 0x271 " + (plain ? values_text(*plain) : std::string("?")) +
          " fits no reading of the spin position " + deg(std::fabs(expected[0])) +
          " (best residual " + deg(rank.best_residual) + ")");
   }
-  begin_step(IdentificationPhase::kSteerProbe, now);
+  return false;
+}
+
+bool ChassisIdentifier::under_remote() const {
+  return control_mode_raw_ == static_cast<std::uint8_t>(protocol::ControlMode::kRemote);
+}
+
+void ChassisIdentifier::observe_remote_driving(Timestamp now) {
+  // The remote's own driving tells the 0x271 reading: steered wheels rolling (the rigid-body
+  // fit), or the wheels held at the spin position while the remote spins.
+  if (!verdict_271_) judge_rigid_body(/*quiet_if_unclear=*/true);
+  if (!verdict_271_ && mode_ == MotionMode::kSpin && !switching_ && angles_ &&
+      now - angles_changed_ >= config_.settle_time) {
+    judge_spin_position("spin position while the remote control spins", true);
+  }
+  std::string text = "identifying the chassis under the remote control: ";
+  if (verdict_271_) {
+    text += "the wheels' reading is decided (steering_unit_271 " +
+            std::string(to_string(verdict_271_->unit)) + ", steering_sign_271 " +
+            std::string(to_string(verdict_271_->sign)) + ": odometry and joint states follow)";
+  } else {
+    text +=
+        "the wheels' reading (steering_unit_271, steering_sign_271) is not known yet: odometry "
+        "and joint states wait for the remote to drive with the wheels steered, or to spin";
+  }
+  text +=
+      "; still lacking for commands: steering_unit_111, steering_sign_111, steering_reference, "
+      "steering_unit_221, steering_sign_221 (probed at standstill once CAN command mode is "
+      "granted)";
+  status_.message = text;
 }
 
 void ChassisIdentifier::evaluate_steer(Timestamp now) {
-  // Every combination of the 0x111 reading (unit, sign, reference) and the 0x271 reading (the
-  // spin check's verdict, or all four): the predicted wheel angles against the measured ones.
-  struct Combo {
-    AngleUnit u111;
-    SteeringSign s111;
-    SteeringReference ref;
-    AngleUnit u271;
-    SteeringSign s271;
-    double commanded;  // REP-103 angle the chassis reads
-  };
-  std::vector<Combo> combos;
-  std::vector<double> residuals;
-  const std::vector<Hypothesis271> h271 = verdict_271_
-                                              ? std::vector<Hypothesis271>{*verdict_271_}
-                                              : std::vector<Hypothesis271>{{kUnits[0], kSigns[0]},
-                                                                           {kUnits[0], kSigns[1]},
-                                                                           {kUnits[1], kSigns[0]},
-                                                                           {kUnits[1], kSigns[1]}};
-  // The wire value the probe went out as, read under each 0x111 hypothesis.
-  MotionCommand sent;
-  sent.steering_angle = probe_wire_angle_;
-  const Result<CanFrame> wire = encode(sent, status_.profile);
-  for (AngleUnit u111 : kUnits) {
-    for (SteeringSign s111 : kSigns) {
-      ProtocolProfile p = status_.profile;
-      p.steering_unit_111 = u111;
-      p.steering_sign_111 = s111;
-      Result<Message> read = wire ? decode(*wire, p) : Result<Message>(wire.error());
-      if (!read) continue;
-      const MotionCommand as_read = std::get<MotionCommand>(*read);
-      for (SteeringReference ref : kReferences) {
-        p.steering_reference = ref;
-        const auto predicted =
-            wheel_angles_for_command(as_read, MotionMode::kAckermann, geometry_, p);
-        for (const Hypothesis271& h : h271) {
-          const auto measured = wheel_angles(*angles_, h.unit, h.sign);
-          if (!measured) continue;
-          double r = 0.0;
-          for (std::size_t i = 0; i < 4; ++i)
-            r = std::max(r, std::fabs((*measured)[i] - predicted[i]));
-          combos.push_back(
-              {u111, s111, ref, h.unit, h.sign,
-               interpretation::rep103_from_manual_command_steering(as_read.steering_angle)});
-          residuals.push_back(r);
-        }
-      }
-    }
+  std::vector<Reading271> h271;
+  if (verdict_271_) {
+    h271.push_back({verdict_271_->unit, verdict_271_->sign});
+  } else {
+    for (int h = 0; h < 4; ++h)
+      h271.push_back({kUnits[h / 2], kSigns[h % 2]});
   }
+  const std::vector<SteerCombo> combos =
+      rank_steer_combos(*angles_, status_.profile, geometry_, probe_wire_angle_, h271);
+  const SteerDecision d = decide_steer(combos, status_.profile, config_, steer_probes_);
   const auto plain = wheel_angles(*angles_, AngleUnit::kCentidegree, SteeringSign::kRightPositive);
   const std::string seen = plain ? values_text(*plain) + " (read in 0.01 deg)" : "beyond 100 deg";
-  // Units and signs first (the reference set aside: it is a 6 % effect).
-  Ranking gross;
-  for (std::size_t c = 0; c < combos.size(); ++c) {
-    bool dominated = false;  // keep one entry per (u111, s111, u271, s271): its best reference
-    for (std::size_t d = 0; d < combos.size(); ++d) {
-      if (d != c && combos[d].u111 == combos[c].u111 && combos[d].s111 == combos[c].s111 &&
-          combos[d].u271 == combos[c].u271 && combos[d].s271 == combos[c].s271 &&
-          (residuals[d] < residuals[c] || (residuals[d] == residuals[c] && d < c))) {
-        dominated = true;
-      }
-    }
-    if (!dominated) gross.add(static_cast<int>(c), residuals[c]);
-  }
-  const double probe_tol = config_.angle_tolerance + 0.1 * 6.0 * config_.probe_angle;
-  // An answer too small to tell the readings apart: probe again in the unit the best fit names.
-  if (!gross.clear(probe_tol, config_.margin, 0.1 * kDeg) && gross.best >= 0 &&
-      gross.best_residual <= probe_tol && steer_probes_ < kMaxSteerProbes) {
-    const Combo& b = combos[static_cast<std::size_t>(gross.best)];
-    if (std::fabs(b.commanded) < kMinReferenceAngle &&
-        b.u111 != status_.profile.steering_unit_111) {
+  switch (d.outcome) {
+    case SteerOutcome::kReprobeTooSmall:
       note("steering probe 1: 0x271 came back " + (plain ? values_text(*plain) : std::string("?")) +
-           ", too small to judge: probing again in " + std::string(to_string(b.u111)));
-      status_.profile.steering_unit_111 = b.u111;
+           ", too small to judge: probing again in " + std::string(to_string(d.best->u111)));
+      status_.profile.steering_unit_111 = d.best->u111;
       begin_step(IdentificationPhase::kSteerProbe, now);
       return;
-    }
+    case SteerOutcome::kReprobeCorrected:
+      note("steering probe 1: 0x271 came back " + seen + ", " + deg(std::fabs(d.best->commanded)) +
+           " where " + deg(config_.probe_angle) + " was asked: 0x111 reads " +
+           std::string(to_string(d.best->u111)) + "; probing again in that unit");
+      status_.profile.steering_unit_111 = d.best->u111;
+      status_.profile.steering_sign_111 = d.best->s111;
+      begin_step(IdentificationPhase::kSteerProbe, now);
+      return;
+    case SteerOutcome::kNoFit:
+      fail("the steering probe's answer fits no reading of the protocol: 0x111 steering " +
+               deg(config_.probe_angle) + " to the left (as " +
+               std::string(to_string(status_.profile.steering_unit_111)) + ", " +
+               std::string(to_string(status_.profile.steering_sign_111)) + "), 0x271 came back " +
+               seen + (d.best ? ", best fit off by " + deg(d.best->residual) : ""),
+           now);
+      return;
+    case SteerOutcome::kDecided:
+      break;
   }
-  if (!gross.clear(probe_tol, config_.margin, 0.1 * kDeg)) {
-    fail("the steering probe's answer fits no reading of the protocol: 0x111 steering " +
-             deg(config_.probe_angle) + " to the left (as " +
-             std::string(to_string(status_.profile.steering_unit_111)) + ", " +
-             std::string(to_string(status_.profile.steering_sign_111)) + "), 0x271 came back " +
-             seen + (gross.best >= 0 ? ", best fit off by " + deg(gross.best_residual) : ""),
-         now);
-    return;
-  }
-  const Combo g = combos[static_cast<std::size_t>(gross.best)];
+  const SteerCombo g = *d.best;
   const double actual = std::fabs(g.commanded);
-  // 5.7 times smaller than asked: probe again in the corrected unit, so that the reference is
-  // judged at a useful angle.
-  if (actual < kMinReferenceAngle && steer_probes_ < kMaxSteerProbes &&
-      g.u111 != status_.profile.steering_unit_111) {
-    note("steering probe 1: 0x271 came back " + seen + ", " + deg(actual) + " where " +
-         deg(config_.probe_angle) + " was asked: 0x111 reads " + std::string(to_string(g.u111)) +
-         "; probing again in that unit");
-    status_.profile.steering_unit_111 = g.u111;
-    status_.profile.steering_sign_111 = g.s111;
-    begin_step(IdentificationPhase::kSteerProbe, now);
-    return;
-  }
-  min_margin_ = std::min(min_margin_, gross.confidence());
+  min_margin_ = std::min(min_margin_, d.confidence);
   if (!verdict_271_) {
     set("steering_unit_271", to_string(g.u271),
         "steering probe: 0x271 came back " + seen + ": the four wheels fit 0x271 in " +
@@ -615,59 +781,32 @@ void ChassisIdentifier::evaluate_steer(Timestamp now) {
   set("steering_sign_111", to_string(g.s111),
       std::string("steering probe: the wheels turned ") + (g.commanded > 0 ? "left" : "right") +
           ": 0x111 is " + std::string(to_string(g.s111)));
-  // The reference: the two entries of the winning units and signs.
-  double r_ref[2] = {std::numeric_limits<double>::infinity(),
-                     std::numeric_limits<double>::infinity()};
-  for (std::size_t c = 0; c < combos.size(); ++c) {
-    const Combo& k = combos[c];
-    if (k.u111 == g.u111 && k.s111 == g.s111 && k.u271 == g.u271 && k.s271 == g.s271) {
-      r_ref[k.ref == SteeringReference::kInnerFront ? 1 : 0] = residuals[c];
-    }
-  }
-  const int best_ref = r_ref[1] < r_ref[0] ? 1 : 0;
-  const double lo = r_ref[best_ref], hi = r_ref[1 - best_ref];
-  if (actual >= kMinReferenceAngle && hi >= config_.margin * std::max(lo, 0.05 * kDeg)) {
-    min_margin_ = std::min(min_margin_, hi > 0 ? 1.0 - lo / hi : 1.0);
-    set("steering_reference", to_string(kReferences[static_cast<std::size_t>(best_ref)]),
+  const double r_mean = d.reference_residual[0], r_inner = d.reference_residual[1];
+  if (d.reference) {
+    const bool inner = *d.reference == SteeringReference::kInnerFront;
+    min_margin_ = std::min(min_margin_, d.reference_confidence);
+    set("steering_reference", to_string(*d.reference),
         std::string("steering probe: ") +
-            (best_ref == 1 ? "the inner front wheel" : "the front wheels' mean") +
-            " stands at the commanded " + deg(actual) + " (off by " + deg(lo) + "; the " +
-            (best_ref == 1 ? "mean" : "inner wheel") + " is off by " + deg(hi) + ")");
+            (inner ? "the inner front wheel" : "the front wheels' mean") +
+            " stands at the commanded " + deg(actual) + " (off by " +
+            deg(inner ? r_inner : r_mean) + "; the " + (inner ? "mean" : "inner wheel") +
+            " is off by " + deg(inner ? r_mean : r_inner) + ")");
   } else {
     note("steering probe: the reference (inner or mean front wheel) is not decidable at " +
-         deg(actual) + " (residuals " + deg(r_ref[0]) + " mean, " + deg(r_ref[1]) +
-         " inner): kept " + std::string(to_string(status_.profile.steering_reference)));
+         deg(actual) + " (residuals " + deg(r_mean) + " mean, " + deg(r_inner) + " inner): kept " +
+         std::string(to_string(status_.profile.steering_reference)));
   }
   // 0x221: its angle against what the chassis should report for the wheels as they stand.
   if (motion_) {
     const auto measured = wheel_angles(*angles_, g.u271, g.s271);
-    const auto& m = *measured;
-    const double mean_front = (m[kRightFront] + m[kLeftFront]) / 2.0;
-    const double inner_front =
-        std::fabs(m[kRightFront]) > std::fabs(m[kLeftFront]) ? m[kRightFront] : m[kLeftFront];
-    const double expected = status_.profile.steering_reference == SteeringReference::kInnerFront
-                                ? inner_front
-                                : mean_front;
-    Ranking r221;
-    for (int h = 0; h < 4; ++h) {
-      ProtocolProfile p = status_.profile;
-      p.steering_unit_221 = kUnits[h / 2];
-      p.steering_sign_221 = kSigns[h % 2];
-      Result<Message> fb = decode(*motion_, p);
-      if (!fb) continue;
-      const double a =
-          interpretation::rep103_from_manual_steering(std::get<MotionFeedback>(*fb).steering_angle);
-      r221.add(h, std::fabs(a - expected));
-    }
-    if (std::fabs(expected) >= 1.0 * kDeg &&
-        r221.clear(config_.angle_tolerance + 0.1 * std::fabs(expected), config_.margin,
-                   0.1 * kDeg)) {
-      min_margin_ = std::min(min_margin_, r221.confidence());
-      set("steering_unit_221", to_string(kUnits[r221.best / 2]),
-          "steering probe: 0x221 reports " + deg(expected) + " in " +
-              std::string(to_string(kUnits[r221.best / 2])));
-      set("steering_sign_221", to_string(kSigns[r221.best % 2]),
-          "steering probe: 0x221's angle is " + std::string(to_string(kSigns[r221.best % 2])));
+    const Angle221Decision a = decide_221(*motion_, *measured, status_.profile, config_);
+    if (a.reading) {
+      min_margin_ = std::min(min_margin_, a.confidence);
+      set("steering_unit_221", to_string(a.reading->unit),
+          "steering probe: 0x221 reports " + deg(a.expected) + " in " +
+              std::string(to_string(a.reading->unit)));
+      set("steering_sign_221", to_string(a.reading->sign),
+          "steering probe: 0x221's angle is " + std::string(to_string(a.reading->sign)));
     } else {
       note("steering probe: 0x221's angle fits no reading clearly: kept its preset");
     }
@@ -740,6 +879,10 @@ void ChassisIdentifier::decide_passive(Timestamp now) {
   } else if (bms_frames_ == 0) {
     note("no BMS frame (0x361) with a battery voltage to compare: bms_voltage_scale kept");
   }
+  judge_rigid_body(/*quiet_if_unclear=*/false);
+}
+
+bool ChassisIdentifier::judge_rigid_body(bool quiet_if_unclear) {
   // Rigid-body fits while the wheels rolled.
   if (rigid_samples_ >= kMinRigidSamples) {
     Ranking rank;
@@ -758,11 +901,14 @@ void ChassisIdentifier::decide_passive(Timestamp now) {
                               fmt("%.3f", rank.second_residual) + ")";
       set("steering_unit_271", to_string(verdict_271_->unit), why);
       set("steering_sign_271", to_string(verdict_271_->sign), why);
-    } else {
+      return true;
+    }
+    if (!quiet_if_unclear) {
       note("rolling wheels seen (" + std::to_string(rigid_samples_) +
            " samples) but no 0x271 reading fits them clearly");
     }
   }
+  return false;
 }
 
 void ChassisIdentifier::fail(std::string why, Timestamp now) {

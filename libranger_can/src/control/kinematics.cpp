@@ -145,6 +145,23 @@ void solve_spin(const BodyTwist& t, const VehicleGeometry& g, const KinematicsLi
   s.achieved = BodyTwist{0.0, 0.0, wz};
 }
 
+// Side slip (MINI V1 mode 3, agx_v2 mode 4): every wheel at 90 deg, the body moves sideways.
+// Only vy is driven; it goes out in 0x111 bytes 4-5 (the spin wheel-speed field, whose range it
+// shares) with the profile's spin sign, left positive.
+void solve_side_slip(const BodyTwist& t, const KinematicsLimits& limits,
+                     const ProtocolProfile& profile, KinematicsSolution& s) {
+  if (std::fabs(t.vx) > kEps) s.flags |= kTranslationDropped;
+  if (std::fabs(t.wz) > kEps) s.flags |= kRotationDropped;
+  const double max = std::min(limits.max_linear_speed, kMaxSpinSpeedMps);
+  double vy = t.vy;
+  if (std::fabs(vy) > max) {
+    vy = sign(vy) * max;
+    s.flags |= kSpeedSaturated;
+  }
+  s.command.spin_speed = interp::spin_wire_from_ccw(vy, profile);
+  s.achieved = BodyTwist{0.0, vy, 0.0};
+}
+
 }  // namespace
 
 Status KinematicsLimits::validate() const {
@@ -222,6 +239,9 @@ Result<KinematicsSolution> solve_kinematics(const BodyTwist& twist, MotionMode m
     case MotionMode::kSpin:
       solve_spin(twist, geometry, limits, profile, s);
       break;
+    case MotionMode::kSideSlip:
+      solve_side_slip(twist, limits, profile, s);
+      break;
     default:
       return Error{Errc::kInvalidArgument,
                    "kinematics: unknown motion mode " + std::to_string(static_cast<int>(mode))};
@@ -257,8 +277,9 @@ BodyTwist twist_from_command(const MotionCommand& command, MotionMode mode,
                                   geometry.wheelbase, geometry.track);
       return BodyTwist{0.0, 0.0, wz};
     }
-    case MotionMode::kPark:  // no motion: the zero twist below
     case MotionMode::kSideSlip:
+      return BodyTwist{0.0, interp::spin_ccw_from_wire(command.spin_speed, profile), 0.0};
+    case MotionMode::kPark:  // no motion: the zero twist below
       break;
   }
   return BodyTwist{};
@@ -285,6 +306,9 @@ std::array<double, kWheelCount> wheel_angles_for_command(const MotionCommand& co
       }
       case MotionMode::kOblique:
         angle = steering;
+        break;
+      case MotionMode::kSideSlip:
+        angle = M_PI / 2.0;
         break;
       default:
         angle = std::atan2(p.x, -p.y);

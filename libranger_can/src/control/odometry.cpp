@@ -87,8 +87,11 @@ BodyTwist twist_from_motion_feedback(const MotionFeedback& feedback, MotionMode 
     }
     case MotionMode::kSpin:
       return BodyTwist{0.0, 0.0, spin_rate()};
-    case MotionMode::kPark:  // no motion: the zero twist below
     case MotionMode::kSideSlip:
+      // Reading: 0x221's speed is the lateral speed, left positive (the vendor's odometry
+      // integrates it at +90 deg).
+      return BodyTwist{0.0, feedback.speed, 0.0};
+    case MotionMode::kPark:  // no motion: the zero twist below
       break;
   }
   return BodyTwist{};

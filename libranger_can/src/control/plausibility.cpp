@@ -48,11 +48,71 @@ std::string PlausibilityFinding::text() const {
   return setting + ": try " + try_value + " (" + detail + ")";
 }
 
+SteeringJudgement judge_steering(double s271, std::optional<double> s221, double unit_ratio) {
+  const double r = unit_ratio;
+  auto close = [](double a, double b) {
+    return std::fabs(a - b) <= 0.3 * std::max(1.0, std::fabs(b));
+  };
+  auto off_unit = [r](double s) { return std::fabs(s) > r || std::fabs(s) < 1.0 / r; };
+  SteeringJudgement j;
+  if (s271 < -0.3) {
+    if (s221 && *s221 < -0.3) {
+      j.mismatch = SteeringMismatch::kSign111;
+    } else if (s221 && *s221 > 0.3) {
+      j.mismatch = SteeringMismatch::kSign271;
+    } else {
+      j.mismatch = SteeringMismatch::kSign111Or271;
+    }
+  } else if (off_unit(s271)) {
+    j.more = std::fabs(s271) > r;
+    if (s221 && close(*s221, s271)) {
+      j.mismatch = SteeringMismatch::kUnit111;
+    } else if (s221 && close(*s221, 1.0)) {
+      j.mismatch = SteeringMismatch::kUnit271;
+    } else {
+      j.mismatch = SteeringMismatch::kUnit111Or271;
+    }
+  } else if (s221 && *s221 < -0.3) {
+    j.mismatch = SteeringMismatch::kSign221;
+  } else if (s221 && off_unit(*s221)) {
+    j.mismatch = SteeringMismatch::kUnit221;
+  }
+  return j;
+}
+
+ReferenceJudgement judge_reference(const std::array<double, kWheelCount>& measured,
+                                   const std::array<double, kWheelCount>& ours,
+                                   const std::array<double, kWheelCount>& other) {
+  ReferenceJudgement j;
+  for (int i = 0; i < kWheelCount; ++i) {
+    j.error = std::max(j.error, std::fabs(measured[i] - ours[i]));
+    j.error_other = std::max(j.error_other, std::fabs(measured[i] - other[i]));
+    j.gap = std::max(j.gap, std::fabs(ours[i] - other[i]));
+  }
+  j.other_fits = j.error >= 0.5 * j.gap && j.error_other <= 0.3 * j.gap && j.error >= 0.15 * kDeg;
+  return j;
+}
+
+FeedbackSpeedJudgement judge_feedback_speed(double reported, double mean_wheel, double body_centre,
+                                            FeedbackSpeed ours) {
+  FeedbackSpeedJudgement j;
+  j.mean_wheel = mean_wheel;
+  j.body_centre = body_centre;
+  const double gap = std::fabs(mean_wheel - body_centre);
+  const bool ours_mean = ours == FeedbackSpeed::kMeanWheel;
+  const double expected = ours_mean ? mean_wheel : body_centre;
+  const double other = ours_mean ? body_centre : mean_wheel;
+  j.other_fits =
+      std::fabs(reported - expected) >= 0.7 * gap && std::fabs(reported - other) <= 0.3 * gap;
+  return j;
+}
+
 Status PlausibilityConfig::validate() const {
-  if (stop_after.count() <= 0 || steering_settle.count() < 0 || warn_after.count() < 0 ||
-      subtle_stop_after.count() < 0 || yaw_settle.count() < 0) {
-    return Error{Errc::kOutOfRange,
-                 "plausibility: stop_after must be > 0 and the other durations >= 0"};
+  if (stop_after.count() <= 0 || feedback_freshness.count() <= 0 || steering_settle.count() < 0 ||
+      warn_after.count() < 0 || subtle_stop_after.count() < 0 || yaw_settle.count() < 0) {
+    return Error{
+        Errc::kOutOfRange,
+        "plausibility: stop_after and feedback_freshness must be > 0, the other durations >= 0"};
   }
   if (!(unit_ratio > 1.0) || !(min_steering > 0.0) || !(min_reference_angle > 0.0) ||
       !(min_yaw_rate > 0.0) || !(min_speed_difference > 0.0) || !(min_speed > 0.0) ||
@@ -227,7 +287,7 @@ void PlausibilityMonitor::check_steering(Timestamp now, const ControllerState& c
     steer_since_ = now;
   }
   if (now - steer_since_ < config_.steering_settle ||
-      !is_fresh(fb.steering_angles, now, std::chrono::milliseconds(100))) {
+      !is_fresh(fb.steering_angles, now, config_.feedback_freshness)) {
     return;
   }
   const auto wanted = wheel_angles_for_command(cmd, mode, geometry_, profile_);
@@ -253,95 +313,99 @@ void PlausibilityMonitor::check_steering(Timestamp now, const ControllerState& c
   const double s271 = num_ / den;
   // 0x221's witness: what it should report for the commanded angle, and the scale it shows.
   std::optional<double> s221;
-  if (is_fresh(fb.motion, now, std::chrono::milliseconds(100))) {
+  if (is_fresh(fb.motion, now, config_.feedback_freshness)) {
     const double reported =
         interpretation::rep103_from_manual_steering(fb.motion->value.steering_angle);
-    const double front = interpretation::rep103_from_manual_command_steering(cmd.steering_angle);
-    double expected = front;  // oblique: the direction; Ackermann: the commanded reference
+    // Oblique: the direction; Ackermann: the commanded reference.
+    const double expected = interpretation::rep103_from_manual_command_steering(cmd.steering_angle);
     if (std::fabs(expected) > 1e-6) s221 = reported / expected;
   }
-  // Built only for a finding: this check runs at every driver step.
-  auto seen = [&] {
-    return "commanded " + deg((wanted[kRightFront] + wanted[kLeftFront]) / 2) +
-           " at the front wheels, 0x271 shows " +
-           deg((measured[kRightFront] + measured[kLeftFront]) / 2) +
-           (s221 ? ", 0x221 scale " + num("%.2f", *s221) : std::string());
-  };
-  auto close = [](double a, double b) {
-    return std::fabs(a - b) <= 0.3 * std::max(1.0, std::fabs(b));
-  };
-  const double r = config_.unit_ratio;
-  std::optional<PlausibilityFinding> f;
-  auto finding = [&](const std::string& what, const std::string& setting) {
-    PlausibilityFinding x;
-    x.check = "steering";
-    x.setting = setting;
-    x.try_value = other_value(profile_, setting);
-    x.detail = what + ": " + seen();
-    return x;
-  };
-  const bool sign_off = s271 < -0.3;
-  const bool unit_off = !sign_off && (std::fabs(s271) > r || std::fabs(s271) < 1.0 / r);
-  if (sign_off) {
-    if (s221 && *s221 < -0.3) {
-      f = finding("the wheels turned the other way (0x221 agrees with them)", "steering_sign_111");
-    } else if (s221 && *s221 > 0.3) {
-      f = finding("0x271 shows the other way, 0x221 the commanded one", "steering_sign_271");
+  const SteeringJudgement j = judge_steering(s271, s221, config_.unit_ratio);
+  if (j.mismatch == SteeringMismatch::kNone) {
+    steering_.clear();
+    if (mode == MotionMode::kAckermann && widest >= config_.min_reference_angle) {
+      check_reference(now, cmd, wanted, measured);
     } else {
-      f = finding("the wheels turned the other way", "steering_sign_111");
-      f->setting = "steering_sign_111 or steering_sign_271";
-      f->try_value = other_value(profile_, "steering_sign_111");
+      reference_.clear();
     }
-  } else if (unit_off) {
-    const std::string how = std::fabs(s271) > r ? "several times more" : "several times less";
-    if (s221 && close(*s221, s271)) {
-      f = finding("the wheels steered " + how + " than asked (0x221 agrees with them)",
-                  "steering_unit_111");
-    } else if (s221 && close(*s221, 1.0)) {
-      f = finding("0x271 shows " + how + " than asked, 0x221 what was asked", "steering_unit_271");
-    } else {
-      f = finding("the wheels steered " + how + " than asked", "steering_unit_111");
-      f->setting = "steering_unit_111 or steering_unit_271";
-      f->try_value = other_value(profile_, "steering_unit_111");
-    }
-  } else if (s221 && *s221 < -0.3) {
-    f = finding("0x221 reports the other way", "steering_sign_221");
-  } else if (s221 && (std::fabs(*s221) > r || std::fabs(*s221) < 1.0 / r)) {
-    f = finding("0x221 reports several times more or less", "steering_unit_221");
-  }
-  if (f) {
-    hold(steering_, *f, now, {}, {});
-    reference_.clear();
     return;
   }
-  steering_.clear();
-  // The reference: the wheels fit the other reading clearly better.
-  if (mode != MotionMode::kAckermann || widest < config_.min_reference_angle) {
-    reference_.clear();
-    return;
+  reference_.clear();
+  // The finding's text (built only now: this check runs at every driver step).
+  const std::string how = j.more ? "several times more" : "several times less";
+  std::string what, setting;
+  switch (j.mismatch) {
+    case SteeringMismatch::kNone:
+      return;
+    case SteeringMismatch::kSign111:
+      what = "the wheels turned the other way (0x221 agrees with them)";
+      setting = "steering_sign_111";
+      break;
+    case SteeringMismatch::kSign271:
+      what = "0x271 shows the other way, 0x221 the commanded one";
+      setting = "steering_sign_271";
+      break;
+    case SteeringMismatch::kSign111Or271:
+      what = "the wheels turned the other way";
+      setting = "steering_sign_111";
+      break;
+    case SteeringMismatch::kUnit111:
+      what = "the wheels steered " + how + " than asked (0x221 agrees with them)";
+      setting = "steering_unit_111";
+      break;
+    case SteeringMismatch::kUnit271:
+      what = "0x271 shows " + how + " than asked, 0x221 what was asked";
+      setting = "steering_unit_271";
+      break;
+    case SteeringMismatch::kUnit111Or271:
+      what = "the wheels steered " + how + " than asked";
+      setting = "steering_unit_111";
+      break;
+    case SteeringMismatch::kSign221:
+      what = "0x221 reports the other way";
+      setting = "steering_sign_221";
+      break;
+    case SteeringMismatch::kUnit221:
+      what = "0x221 reports several times more or less";
+      setting = "steering_unit_221";
+      break;
   }
+  PlausibilityFinding x;
+  x.check = "steering";
+  x.setting = setting;
+  x.try_value = other_value(profile_, setting);
+  if (j.mismatch == SteeringMismatch::kSign111Or271) {
+    x.setting = "steering_sign_111 or steering_sign_271";
+  } else if (j.mismatch == SteeringMismatch::kUnit111Or271) {
+    x.setting = "steering_unit_111 or steering_unit_271";
+  }
+  x.detail = what + ": commanded " + deg((wanted[kRightFront] + wanted[kLeftFront]) / 2) +
+             " at the front wheels, 0x271 shows " +
+             deg((measured[kRightFront] + measured[kLeftFront]) / 2) +
+             (s221 ? ", 0x221 scale " + num("%.2f", *s221) : std::string());
+  hold(steering_, x, now, {}, {});
+}
+
+void PlausibilityMonitor::check_reference(Timestamp now, const MotionCommand& cmd,
+                                          const std::array<double, kWheelCount>& wanted,
+                                          const std::array<double, kWheelCount>& measured) {
   ProtocolProfile other = profile_;
   other.steering_reference = profile_.steering_reference == SteeringReference::kMeanFront
                                  ? SteeringReference::kInnerFront
                                  : SteeringReference::kMeanFront;
-  const auto wanted_other = wheel_angles_for_command(cmd, mode, geometry_, other);
-  double err = 0.0, err_other = 0.0, gap = 0.0;
-  for (int i = 0; i < kWheelCount; ++i) {
-    err = std::max(err, std::fabs(measured[i] - wanted[i]));
-    err_other = std::max(err_other, std::fabs(measured[i] - wanted_other[i]));
-    gap = std::max(gap, std::fabs(wanted[i] - wanted_other[i]));
-  }
-  if (err >= 0.5 * gap && err_other <= 0.3 * gap && err >= 0.15 * kDeg) {
-    PlausibilityFinding x;
-    x.check = "steering_reference";
-    x.setting = "steering_reference";
-    x.try_value = other_value(profile_, "steering_reference");
-    x.detail = "the wheels stand as the other reading commands (off by " + deg(err) + ", the " +
-               x.try_value + " reading by " + deg(err_other) + ")";
-    hold(reference_, x, now, {}, {});
-  } else {
+  const auto wanted_other = wheel_angles_for_command(cmd, MotionMode::kAckermann, geometry_, other);
+  const ReferenceJudgement j = judge_reference(measured, wanted, wanted_other);
+  if (!j.other_fits) {
     reference_.clear();
+    return;
   }
+  PlausibilityFinding x;
+  x.check = "steering_reference";
+  x.setting = "steering_reference";
+  x.try_value = other_value(profile_, "steering_reference");
+  x.detail = "the wheels stand as the other reading commands (off by " + deg(j.error) + ", the " +
+             x.try_value + " reading by " + deg(j.error_other) + ")";
+  hold(reference_, x, now, {}, {});
 }
 
 void PlausibilityMonitor::check_yaw(Timestamp now, const ControllerState& c,
@@ -381,10 +445,10 @@ void PlausibilityMonitor::check_yaw(Timestamp now, const ControllerState& c,
 
 void PlausibilityMonitor::check_speed(Timestamp now, const ControllerState& c,
                                       const ChassisFeedback& fb) {
+  const auto fresh = config_.feedback_freshness;
   if (*c.motion_mode != MotionMode::kAckermann || c.steer_first_factor < 1.0 ||
-      !is_fresh(fb.motion, now, std::chrono::milliseconds(100)) ||
-      !is_fresh(fb.wheel_speeds, now, std::chrono::milliseconds(100)) ||
-      !is_fresh(fb.steering_angles, now, std::chrono::milliseconds(100))) {
+      !is_fresh(fb.motion, now, fresh) || !is_fresh(fb.wheel_speeds, now, fresh) ||
+      !is_fresh(fb.steering_angles, now, fresh)) {
     speed_.clear();
     return;
   }
@@ -402,32 +466,30 @@ void PlausibilityMonitor::check_speed(Timestamp now, const ControllerState& c,
     return;
   }
   mean = std::copysign(mean, t.vx);
-  const double gap = std::fabs(mean - t.vx);
-  if (gap < config_.min_speed_difference) {
+  if (std::fabs(mean - t.vx) < config_.min_speed_difference) {
     speed_.clear();
     return;
   }
   ++status_.checks;
   const double reported = fb.motion->value.speed;
-  const bool ours_mean = profile_.feedback_speed == FeedbackSpeed::kMeanWheel;
-  const double expected = ours_mean ? mean : t.vx;
-  const double other = ours_mean ? t.vx : mean;
-  if (std::fabs(reported - expected) >= 0.7 * gap && std::fabs(reported - other) <= 0.3 * gap) {
-    PlausibilityFinding x;
-    x.check = "feedback_speed";
-    x.setting = "feedback_speed";
-    x.try_value = other_value(profile_, "feedback_speed");
-    x.detail = "0x221 reports " + num("%.3f", reported) + " m/s while turning: the wheels' mean " +
-               num("%.3f", mean) + " m/s, the body centre's " + num("%.3f", t.vx) + " m/s";
-    hold(speed_, x, now, {}, {});
-  } else {
+  const FeedbackSpeedJudgement j =
+      judge_feedback_speed(reported, mean, t.vx, profile_.feedback_speed);
+  if (!j.other_fits) {
     speed_.clear();
+    return;
   }
+  PlausibilityFinding x;
+  x.check = "feedback_speed";
+  x.setting = "feedback_speed";
+  x.try_value = other_value(profile_, "feedback_speed");
+  x.detail = "0x221 reports " + num("%.3f", reported) + " m/s while turning: the wheels' mean " +
+             num("%.3f", mean) + " m/s, the body centre's " + num("%.3f", t.vx) + " m/s";
+  hold(speed_, x, now, {}, {});
 }
 
 void PlausibilityMonitor::check_rigid(Timestamp now, const ChassisFeedback& fb) {
-  if (!is_fresh(fb.wheel_speeds, now, std::chrono::milliseconds(100)) ||
-      !is_fresh(fb.steering_angles, now, std::chrono::milliseconds(100))) {
+  if (!is_fresh(fb.wheel_speeds, now, config_.feedback_freshness) ||
+      !is_fresh(fb.steering_angles, now, config_.feedback_freshness)) {
     rigid_.clear();
     return;
   }

@@ -16,6 +16,15 @@ const char* const kChassisCommandHelp =
     "commands (one per line):\n"
     "  remote on|can|off|lost   the remote control takes over | hands back to CAN command mode |\n"
     "                           is switched off (standby) | loses its signal (standby + error)\n"
+    "  remote swd top|bottom    motion switch: top = dual Ackermann, and spin while only the\n"
+    "                           right stick is pushed; bottom = oblique (user manual 2.3)\n"
+    "  remote sticks LEFT RIGHT stick positions, each -1..1 (|v| < 0.05 reads as centred):\n"
+    "                           LEFT + forward = + max linear speed at 1; RIGHT + pushed right =\n"
+    "                           steer right by the max Ackermann (top) or oblique (bottom)\n"
+    "                           angle at 1, or with LEFT centred spin clockwise at the max spin\n"
+    "                           wheel speed; the chassis drives them while the remote has control\n"
+    "  remote swa top|bottom    lights under the remote: bottom = both off, top = both on\n"
+    "  remote swc top|middle|bottom  middle = ultrasonic obstacle avoidance on, else off\n"
     "  estop on|off             press / release the emergency stop\n"
     "  error BIT|NAME [on|off]  raise (default) or drop a 0x211 error bit: 0-31 or its name,\n"
     "                           e.g. 'error 9' = host_communication_lost, 'error 15 off'\n"
@@ -27,6 +36,7 @@ const char* const kChassisCommandHelp =
     "  ultrasonic N|all MM      distance of sensor N (1-8) or all sensors, mm (-1..-4: codes)\n"
     "  ultrasonic on|off        obstacle avoidance, as the remote's SWC switch sets it\n"
     "  pose X Y YAW             move the ground truth (m, m, rad)\n"
+    "  version TEXT             the firmware version the chassis answers 0x4A1 with (agx_v2)\n"
     "  status                   print the chassis state\n";
 
 namespace {
@@ -101,6 +111,15 @@ std::string describe_chassis(const sim::ChassisSnapshot& s, ErrorWordLayout layo
   const auto names = protocol::error_bit_names(s.error_bits, layout);
   out += names.empty() ? "none" : text::join(names, ",");
   out += s.motion_allowed ? ", motion allowed" : ", motion refused: " + s.motion_refused_reason;
+  auto position = [](protocol::RemoteSwitch p) {
+    return p == protocol::RemoteSwitch::kUp     ? "top"
+           : p == protocol::RemoteSwitch::kDown ? "bottom"
+                                                : "middle";
+  };
+  out += std::string(", remote SWA ") + position(s.remote.swa) + " SWC " + position(s.remote.swc) +
+         " SWD " + position(s.remote.swd) + " sticks (" + fixed(s.remote.left, 2) + ", " +
+         fixed(s.remote.right, 2) + ")";
+  out += ", lights " + describe_lights(s.lights);
   if (s.silent) out += ", SILENT";
   return out;
 }
@@ -123,12 +142,38 @@ Result<ChassisAction> parse_chassis_command(std::string_view line) {
   };
 
   if (cmd == "remote") {
-    if (auto s = need(2, "remote on|can|off|lost"); !s) return s.error();
+    if (w.size() >= 2 && w[1] == "sticks") {
+      if (auto s = need(4, "remote sticks LEFT RIGHT (each -1..1)"); !s) return s.error();
+      auto left = parse_double_in("remote sticks LEFT", w[2], -1.0, 1.0);
+      if (!left) return left.error();
+      auto right = parse_double_in("remote sticks RIGHT", w[3], -1.0, 1.0);
+      if (!right) return right.error();
+      return act([l = *left, r = *right](VirtualChassis& c) { c.set_remote_sticks(l, r); });
+    }
+    if (w.size() >= 2 && (w[1] == "swa" || w[1] == "swc" || w[1] == "swd")) {
+      const bool three = w[1] == "swc";
+      const std::string form = "remote " + w[1] + (three ? " top|middle|bottom" : " top|bottom");
+      if (auto s = need(3, form.c_str()); !s) return s.error();
+      protocol::RemoteSwitch position;
+      if (w[2] == "top") {
+        position = protocol::RemoteSwitch::kUp;
+      } else if (w[2] == "bottom") {
+        position = protocol::RemoteSwitch::kDown;
+      } else if (w[2] == "middle" && three) {
+        position = protocol::RemoteSwitch::kMiddle;
+      } else {
+        return usage(form + ": unknown position '" + w[2] + "'");
+      }
+      if (w[1] == "swa") return act([position](VirtualChassis& c) { c.set_remote_swa(position); });
+      if (w[1] == "swc") return act([position](VirtualChassis& c) { c.set_remote_swc(position); });
+      return act([position](VirtualChassis& c) { c.set_remote_swd(position); });
+    }
+    if (auto s = need(2, "remote on|can|off|lost|swa|swc|swd|sticks ..."); !s) return s.error();
     if (w[1] == "on") return act([](VirtualChassis& c) { c.remote_takeover(); });
     if (w[1] == "can") return act([](VirtualChassis& c) { c.remote_hand_back(false); });
     if (w[1] == "off") return act([](VirtualChassis& c) { c.remote_hand_back(true); });
     if (w[1] == "lost") return act([](VirtualChassis& c) { c.remote_signal_lost(); });
-    return usage("remote: expected on|can|off|lost, got '" + w[1] + "'");
+    return usage("remote: expected on|can|off|lost|swa|swc|swd|sticks, got '" + w[1] + "'");
   }
   if (cmd == "estop") {
     if (auto s = need(2, "estop on|off"); !s) return s.error();
@@ -210,6 +255,21 @@ Result<ChassisAction> parse_chassis_command(std::string_view line) {
     if (!n) return n.error();
     return act([n = static_cast<int>(*n), raw](VirtualChassis& c) { c.set_ultrasonic(n, raw); });
   }
+  if (cmd == "version") {
+    // The rest of the line, as typed (inner spaces kept).
+    const std::string_view rest = line.substr(line.find("version") + 7);
+    const auto first = rest.find_first_not_of(" \t");
+    const auto last = rest.find_last_not_of(" \t\r\n");
+    if (first == std::string_view::npos) return usage("usage: version TEXT");
+    std::string text(rest.substr(first, last - first + 1));
+    if (text.size() > 64) return usage("version: at most 64 characters");
+    for (char ch : text) {
+      if (static_cast<unsigned char>(ch) < 0x20 || static_cast<unsigned char>(ch) > 0x7E) {
+        return usage("version: printable ASCII only");
+      }
+    }
+    return act([text](VirtualChassis& c) { c.set_version(text); });
+  }
   if (cmd == "pose") {
     if (auto s = need(4, "pose X Y YAW"); !s) return s.error();
     auto x = parse_double("pose X", w[1]);
@@ -240,7 +300,7 @@ Result<std::string> apply_chassis_command(std::string_view line, VirtualChassis&
 const std::vector<std::string>& chassis_command_names() {
   static const std::vector<std::string> names = {"remote",     "estop",  "error",   "clear",
                                                  "battery",    "silent", "garbage", "stuck",
-                                                 "ultrasonic", "pose",   "status"};
+                                                 "ultrasonic", "pose",   "version", "status"};
   return names;
 }
 

@@ -47,6 +47,7 @@ double ChassisModel::clamp_steering(MotionMode mode, double steering) const {
 }
 
 double ChassisModel::clamp_speed(MotionMode mode, double speed) const {
+  if (mode == MotionMode::kPark) return 0.0;
   return clamp_abs(speed,
                    mode == MotionMode::kSpin ? limits_.max_spin_speed : limits_.max_linear_speed);
 }
@@ -92,6 +93,10 @@ BodyTwist ChassisModel::twist_for(MotionMode mode, double steering, double speed
     }
     case MotionMode::kOblique:
       return {speed * std::cos(steering), speed * std::sin(steering), 0.0};
+    case MotionMode::kSideSlip:
+      return {0.0, speed, 0.0};
+    case MotionMode::kPark:
+      return {};
     default:
       return {0.0, 0.0,
               interpretation::spin_yaw_rate_from_wheel_speed(speed, geometry_.wheelbase,
@@ -108,6 +113,8 @@ WheelStates ChassisModel::wheels_for(MotionMode mode, double steering, double sp
         return twist_for(mode, steering, 1.0);
       case MotionMode::kOblique:
         return BodyTwist{std::cos(steering), std::sin(steering), 0.0};
+      case MotionMode::kPark:  // the wheels stand as for spin: nothing can roll the body
+        return twist_for(MotionMode::kSpin, 0.0, 1.0);
       default:
         return twist_for(mode, 0.0, 1.0);
     }

@@ -25,8 +25,10 @@ const char* const kActionsHelp =
     "                           every 50 ms of simulated time, the first at once\n"
     "  cmd none                 stop publishing (the driver's cmd_timeout then stops the chassis)\n"
     "  resume                   the explicit re-arm (refused while a stop cause is active)\n"
-    "  mode auto|ackermann|oblique|spin\n"
-    "                           force the motion mode of later commands (auto: chosen per twist)\n"
+    "  mode auto|ackermann|oblique|spin|side_slip\n"
+    "                           force the motion mode of later commands (auto: chosen per twist;\n"
+    "                           side_slip where the mode numbering has it: mini_v1, agx_v2)\n"
+    "  park on|off              Driver::set_park(): park (motion refused, \"parked\") or release\n"
     "  clear-errors CODE        the driver sends 0x441 CODE (0-16, or 0x00-0x10)\n"
     "  wait SEC                 advance simulated time by SEC (whole milliseconds, >= 0)\n"
     "  expect ...               a check of the state now (below); a failed one is reported and\n"
@@ -40,10 +42,13 @@ const char* const kExpectHelp =
     "  expect refusal NAME      why motion is refused: none, link_lost, remote, estop,\n"
     "                           critical_error, low_battery, mode_switch_failed,\n"
     "                           implausible_feedback, rearm_required, standby, mode_unknown,\n"
-    "                           switching, cmd_timeout, below_minimum\n"
+    "                           switching, cmd_timeout, below_minimum, parked\n"
     "  expect control_mode standby|can|remote|null\n"
-    "  expect motion_mode ackermann|oblique|spin|null\n"
+    "  expect motion_mode ackermann|oblique|spin|park|side_slip|null   (the chassis's 0x291)\n"
     "  expect rearm_required true|false\n"
+    "  expect identification listening|awaiting_control|spin_check|steer_probe|returning|\n"
+    "                           decided|failed|none   the identification's phase (none: the\n"
+    "                           protocol was given)\n"
     "  expect moving | still    ground truth: the fastest point of the chassis (body centre or a\n"
     "                           wheel) is faster than 1 mm/s | not faster\n"
     "  expect fault NAME | no-fault NAME | no-faults\n"
@@ -144,6 +149,16 @@ const std::vector<std::string>& control_mode_names() {
   return names;
 }
 
+// The identification's phases (protocol auto), and "none" for a protocol that was given.
+const std::vector<std::string>& identification_names() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> out = text::names_of(kAllIdentificationPhases);
+    out.emplace_back("none");
+    return out;
+  }();
+  return names;
+}
+
 const std::vector<std::string>& motion_mode_names() {
   static const std::vector<std::string> names = names_or_null(protocol::kAllMotionModes);
   return names;
@@ -237,8 +252,8 @@ void append_optional(std::string& out, const std::optional<std::string>& v) {
 // ---- parsing ----
 
 const std::vector<std::string>& driver_action_names() {
-  static const std::vector<std::string> names = {"cmd",          "resume", "mode",
-                                                 "clear-errors", "wait",   "expect"};
+  static const std::vector<std::string> names = {"cmd",  "resume", "mode", "clear-errors",
+                                                 "wait", "expect", "park"};
   return names;
 }
 
@@ -270,7 +285,8 @@ Result<Expectation> parse_expect(const std::vector<std::string>& w) {
   // w[0] == "expect"
   const std::string usage =
       "expect: give one of: refusal NAME, control_mode NAME, motion_mode NAME, rearm_required "
-      "true|false, moving, still, fault NAME, no-fault NAME, no-faults, FIELD OP NUMBER";
+      "true|false, identification PHASE, moving, still, fault NAME, no-fault NAME, no-faults, "
+      "FIELD OP NUMBER";
   if (w.size() < 2) return problem(usage);
   const std::string& what = w[1];
   Expectation e;
@@ -304,7 +320,8 @@ Result<Expectation> parse_expect(const std::vector<std::string>& w) {
   } text_fields[] = {{"refusal", refusal_names()},
                      {"control_mode", control_mode_names()},
                      {"motion_mode", motion_mode_names()},
-                     {"rearm_required", bool_names()}};
+                     {"rearm_required", bool_names()},
+                     {"identification", identification_names()}};
   for (const auto& f : text_fields) {
     if (what != f.field) continue;
     if (auto st = need(3, what + " " + join(f.valid, "|")); !st) return st.error();
@@ -389,18 +406,26 @@ Result<std::optional<ScenarioAction>> parse_scenario_line(std::string_view raw, 
     a.kind = ScenarioAction::Kind::kResume;
     return std::optional<ScenarioAction>(std::move(a));
   }
+  if (verb == "park") {
+    if (w.size() != 2 || (w[1] != "on" && w[1] != "off")) return problem("usage: park on|off");
+    a.kind = ScenarioAction::Kind::kPark;
+    a.enable = w[1] == "on";
+    return std::optional<ScenarioAction>(std::move(a));
+  }
   if (verb == "mode") {
-    const std::string usage = "usage: mode auto|ackermann|oblique|spin";
+    const std::string usage = "usage: mode auto|ackermann|oblique|spin|side_slip";
     if (w.size() != 2) return problem(usage);
     a.kind = ScenarioAction::Kind::kMode;
     if (w[1] == "auto") return std::optional<ScenarioAction>(std::move(a));
-    for (MotionMode m : {MotionMode::kAckermann, MotionMode::kOblique, MotionMode::kSpin}) {
+    for (MotionMode m :
+         {MotionMode::kAckermann, MotionMode::kOblique, MotionMode::kSpin, MotionMode::kSideSlip}) {
       if (w[1] == protocol::to_string(m)) {
         a.mode = m;
         return std::optional<ScenarioAction>(std::move(a));
       }
     }
-    return problem("mode: unknown '" + w[1] + "' (valid: auto, ackermann, oblique, spin)");
+    return problem("mode: unknown '" + w[1] +
+                   "' (valid: auto, ackermann, oblique, spin, side_slip)");
   }
   if (verb == "clear-errors") {
     if (w.size() != 2) return problem("usage: clear-errors CODE (0-16 or 0x00-0x10)");
@@ -641,6 +666,8 @@ std::string to_json(const ScenarioSample& s) {
   append_list(out, s.latched);
   out += ',';
   num("steer_first_factor", s.steer_first_factor);
+  out += ",\"identification\":";
+  append_string(out, s.identification);
   out += '}';
   return out;
 }
@@ -715,7 +742,7 @@ struct ScenarioRunner::Impl {
     s.odom_twist = snap->odometry.twist;
     const ControllerState& c = snap->controller;
     if (c.control_mode) s.control_mode = std::string(protocol::to_string(*c.control_mode));
-    if (c.motion_mode) s.motion_mode = std::string(protocol::to_string(*c.motion_mode));
+    if (c.chassis_mode) s.motion_mode = std::string(protocol::to_string(*c.chassis_mode));
     s.refusal = std::string(to_string(c.refusal));
     s.faults = c.faults;
     s.rearm_required = c.rearm_required();
@@ -728,6 +755,8 @@ struct ScenarioRunner::Impl {
       start = end + 1;
     }
     s.steer_first_factor = c.steer_first_factor;
+    s.identification =
+        snap->identification ? std::string(to_string(snap->identification->phase)) : "none";
     return s;
   }
 
@@ -741,6 +770,7 @@ struct ScenarioRunner::Impl {
         if (e.field == "control_mode") got = s.control_mode.value_or("null");
         if (e.field == "motion_mode") got = s.motion_mode.value_or("null");
         if (e.field == "rearm_required") got = s.rearm_required ? "true" : "false";
+        if (e.field == "identification") got = s.identification;
         if (got == e.text) return std::nullopt;
         return got;
       }
@@ -873,6 +903,9 @@ ScenarioResult ScenarioRunner::run(const Scenario& scenario, const ScenarioOutpu
         break;
       case ScenarioAction::Kind::kMode:
         m.driver->set_motion_mode(a.mode);
+        break;
+      case ScenarioAction::Kind::kPark:
+        m.pending.push_back({m.driver->set_park(a.enable), a.line});
         break;
       case ScenarioAction::Kind::kClearErrors: {
         auto id = m.driver->clear_errors(a.code);

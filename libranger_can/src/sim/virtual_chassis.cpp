@@ -33,6 +33,8 @@ constexpr std::uint8_t kBmsUnderVoltage = protocol::bms_status::kUnderVoltage;
 
 constexpr double kLowBatteryCutoffSoc = 10.0;   // manual: under 10 % the drivers lose power
 constexpr double kLowBatteryWarningSoc = 15.0;  // manual: under 15 % the lights flash
+// Reading: a 0x141 park is obeyed when the body is slower than this (m/s).
+constexpr double kParkStandstillSpeed = 0.01;
 constexpr std::size_t kMaxEvents = 1000;
 
 std::string names_of(std::uint32_t bits, ErrorWordLayout layout) {
@@ -228,16 +230,23 @@ std::string VirtualChassis::refusal_reason() const {
   if (control_mode_ != ControlMode::kCan) {
     return std::string("control mode is ") + std::string(protocol::to_string(control_mode_));
   }
+  if (std::string r = drive_refusal(); !r.empty()) return r;
+  if (motion_.switching()) return "switching motion mode";
+  if (motion_.mode() == MotionMode::kPark) return "parked";
+  return {};
+}
+
+std::string VirtualChassis::drive_refusal() const {
   if (emergency_stop_) return "emergency stop";
   const std::uint32_t errors = error_word();
   const ErrorWordLayout layout = config_.profile.error_word;
   if (errors & bit(Fault::kBatteryUnderVoltage)) return "battery under-voltage: drive power cut";
   if (ultrasonic_triggered()) return "ultrasonic obstacle avoidance triggered";
-  if (host_link_lost_) return "host communication lost";
+  // The host link matters only to the host's commands.
+  if (host_link_lost_ && control_mode_ == ControlMode::kCan) return "host communication lost";
   if (protocol::is_critical_error(errors, layout)) {
     return "critical error: " + names_of(errors, layout);
   }
-  if (motion_.switching()) return "switching motion mode";
   return {};
 }
 
@@ -268,19 +277,109 @@ void VirtualChassis::update_conditions(Timestamp) {
 }
 
 void VirtualChassis::apply_motion_policy() {
-  const std::string reason = refusal_reason();
-  if (reason != last_refusal_) {
-    event(reason.empty() ? std::string("motion allowed") : "motion refused: " + reason);
-    last_refusal_ = reason;
+  const bool remote = control_mode_ == ControlMode::kRemote;
+  const std::string reason = remote ? drive_refusal() : refusal_reason();
+  const std::string shown = remote && reason.empty() ? std::string("(remote)") : reason;
+  if (shown != last_refusal_) {
+    event(!reason.empty() ? "motion refused: " + reason
+                          : (remote ? std::string("motion by the remote control")
+                                    : std::string("motion allowed")));
+    last_refusal_ = shown;
   }
   if (!reason.empty()) {
     commanded_.speed = 0.0;
     const bool power_cut =
         emergency_stop_ || (error_word() & bit(Fault::kBatteryUnderVoltage)) != 0;
     motion_.stop(power_cut);
+  } else if (remote) {
+    drive_by_remote();
   } else {
     motion_.set_target(commanded_);
   }
+}
+
+// ---- the remote control -----------------------------------------------------------------------
+
+namespace {
+
+double stick(double v) {
+  if (!std::isfinite(v) || std::abs(v) < kRemoteStickDeadband) return 0.0;
+  return std::clamp(v, -1.0, 1.0);
+}
+
+std::int8_t stick_wire(double v) {
+  return static_cast<std::int8_t>(std::lround(stick(v) * kRemoteStickFullScale));
+}
+
+}  // namespace
+
+MotionMode VirtualChassis::remote_mode() const {
+  if (remote_.swd == protocol::RemoteSwitch::kDown) return MotionMode::kOblique;
+  if (stick(remote_.left) != 0.0) return MotionMode::kAckermann;
+  if (stick(remote_.right) != 0.0) return MotionMode::kSpin;
+  // Both sticks centred: a spin stays a spin (at rest), anything else is Ackermann.
+  const MotionMode heading = motion_.switching() ? motion_.switch_target() : motion_.mode();
+  return heading == MotionMode::kSpin ? MotionMode::kSpin : MotionMode::kAckermann;
+}
+
+MotionTarget VirtualChassis::remote_target() const {
+  const MotionLimits& l = motion_.limits();
+  const double left = stick(remote_.left);
+  const double right = stick(remote_.right);
+  // Stick right steers right: a negative REP-103 angle, a clockwise spin.
+  switch (motion_.mode()) {
+    case MotionMode::kAckermann:
+      return {left * l.max_linear_speed, -right * l.max_ackermann_angle};
+    case MotionMode::kOblique:
+      return {left * l.max_linear_speed, -right * l.max_oblique_angle};
+    case MotionMode::kSpin:
+      return {-right * l.max_spin_speed, 0.0};
+    default:
+      return {};
+  }
+}
+
+void VirtualChassis::drive_by_remote() {
+  const MotionMode want = remote_mode();
+  const MotionMode heading = motion_.switching() ? motion_.switch_target() : motion_.mode();
+  if (want != heading && motion_.begin_mode_switch(want, seconds(config_.mode_switch_duration))) {
+    event("remote control: switching motion mode " +
+          std::string(protocol::to_string(motion_.mode())) + " -> " +
+          std::string(protocol::to_string(want)));
+  }
+  motion_.set_target(remote_target());  // ignored while switching
+}
+
+void VirtualChassis::set_remote_swa(protocol::RemoteSwitch position) {
+  if (position == remote_.swa) return;
+  remote_.swa = position;
+  event("remote SWA " + std::string(protocol::to_string(position)) +
+        (control_mode_ != ControlMode::kRemote ? " (no effect: SWB is not in remote position)"
+                                               : ""));
+  lights_.set_remote(control_mode_ == ControlMode::kRemote, remote_.swa);
+  if (lights_.take_changed()) event("lights: " + describe_lights(lights_.report()));
+}
+
+void VirtualChassis::set_remote_swc(protocol::RemoteSwitch position) {
+  if (position == remote_.swc) return;
+  remote_.swc = position;
+  event("remote SWC " + std::string(protocol::to_string(position)));
+  set_ultrasonic_enabled(position == protocol::RemoteSwitch::kMiddle);
+}
+
+void VirtualChassis::set_remote_swd(protocol::RemoteSwitch position) {
+  if (position == remote_.swd) return;
+  remote_.swd = position;
+  event("remote SWD " + std::string(protocol::to_string(position)));
+  update_conditions(now_);
+  apply_motion_policy();
+}
+
+void VirtualChassis::set_remote_sticks(double left, double right) {
+  remote_.left = std::isfinite(left) ? std::clamp(left, -1.0, 1.0) : 0.0;
+  remote_.right = std::isfinite(right) ? std::clamp(right, -1.0, 1.0) : 0.0;
+  update_conditions(now_);
+  apply_motion_policy();
 }
 
 void VirtualChassis::event(std::string text) {
@@ -342,7 +441,10 @@ void VirtualChassis::on_frame(const CanFrame& frame, Timestamp now) {
     if (!clear_errors(m->code)) ++counters_.frames_ignored;
   }
   if (auto* m = std::get_if<UltrasonicSettingCommand>(&msg)) handle_ultrasonic_setting(*m);
-  if (auto* m = std::get_if<LightCommand>(&msg)) lights_ = *m;
+  if (auto* m = std::get_if<LightCommand>(&msg)) {
+    lights_.command(*m);
+    if (lights_.take_changed()) event("lights: " + describe_lights(lights_.report()) + " (0x121)");
+  }
   update_conditions(now_);
   apply_motion_policy();
 }
@@ -361,7 +463,14 @@ void VirtualChassis::handle_motion_command(const MotionCommand& cmd) {
   const MotionMode mode = motion_.mode();
   const ProtocolProfile& p = config_.profile;
   const VehicleGeometry& g = motion_.geometry();
-  if (mode == MotionMode::kSpin) {
+  if (mode == MotionMode::kPark) {  // parked: 0x111 keeps the link, it moves nothing
+    ++counters_.frames_ignored;
+    return;
+  }
+  if (mode == MotionMode::kSideSlip) {
+    // Reading (MINI V1): the lateral speed is the spin field of bytes 4-5, with the spin sign.
+    commanded_ = {interpretation::spin_ccw_from_wire(cmd.spin_speed, p), 0.0};
+  } else if (mode == MotionMode::kSpin) {
     // Only the profile's spin field moves the chassis; the other one is ignored.
     const double wheel_speed =
         p.spin_field == SpinField::kYawRate
@@ -398,11 +507,12 @@ void VirtualChassis::handle_motion_mode(const MotionModeCommand& cmd) {
     event("0x141 with unknown motion mode " + std::to_string(cmd.mode_raw) + " ignored");
     return;
   }
-  if (cmd.mode != MotionMode::kAckermann && cmd.mode != MotionMode::kOblique &&
-      cmd.mode != MotionMode::kSpin) {
+  // Park only at standstill (reading: the wheels cannot lock a rolling chassis); a 0x141 park
+  // while moving is ignored.
+  if (cmd.mode == MotionMode::kPark && !motion_.switching() && motion_.mode() != cmd.mode &&
+      std::abs(motion_.speed()) > kParkStandstillSpeed) {
     ++counters_.frames_ignored;
-    event("0x141 motion mode " + std::string(protocol::to_string(cmd.mode)) +
-          " is not simulated: ignored");
+    event("0x141 park ignored: the chassis is moving");
     return;
   }
   if (motion_.begin_mode_switch(cmd.mode, seconds(config_.mode_switch_duration))) {
@@ -425,6 +535,8 @@ void VirtualChassis::set_control_mode(ControlMode mode, const std::string& why) 
   event("control mode " + std::string(protocol::to_string(control_mode_)) + " -> " +
         std::string(protocol::to_string(mode)) + " (" + why + ")");
   control_mode_ = mode;
+  lights_.set_remote(mode == ControlMode::kRemote, remote_.swa);
+  if (lights_.take_changed()) event("lights: " + describe_lights(lights_.report()));
   commanded_.speed = 0.0;
   watchdog_armed_ = false;  // arms with the first 0x111 in CAN mode
 }
@@ -650,9 +762,15 @@ Message VirtualChassis::motion_feedback() const {
       fb.steering_angle = interpretation::manual_from_rep103_steering(mean_angle);
       break;
     }
+    case MotionMode::kSideSlip:
+      // Reading (the vendor's odometry integrates it at +90 deg): the lateral speed in bytes 0-1,
+      // left positive, the wheels' 90 deg as the angle.
+      fb.steering_angle = interpretation::manual_from_rep103_steering(M_PI / 2.0);
+      fb.speed = twist.vy;
+      break;
     default: {
-      // Spin: the fixed angle (mean of |angles|) and (point 9) the signed tangential speed, in
-      // the profile's spin field.
+      // Spin (and park, where nothing moves): the fixed angle (mean of |angles|) and (point 9) the
+      // signed tangential speed, in the profile's spin field.
       if (config_.spin_angle_reported) {
         for (const auto& s : w)
           fb.steering_angle += std::abs(s.angle) / kWheelCount;
@@ -717,22 +835,19 @@ void VirtualChassis::send_due(ScheduleId which, Timestamp t) {
       send(mm, t);
       if (config_.vendor_frames) {
         // 0x231 and 0x241, each with its counter.
-        LightState light;
-        light.enable = lights_.enable;
-        light.front_mode = lights_.front_mode;
-        light.front_custom = lights_.front_custom;
-        light.rear_mode = lights_.rear_mode;
-        light.rear_custom = lights_.rear_custom;
+        LightState light = lights_.report();
         light.counter = vendor_counter_;
         send(light, t);
-        // The remote control on, SWB up (command mode) unless the remote is in charge.
+        // The remote control on, SWB up (command mode) unless the remote is in charge; the
+        // sticks as the operator holds them (centred within the dead band).
         RemoteControlState rc;
-        rc.swa = protocol::RemoteSwitch::kUp;
+        rc.swa = remote_.swa;
         rc.swb = control_mode_ == ControlMode::kRemote ? protocol::RemoteSwitch::kMiddle
                                                        : protocol::RemoteSwitch::kUp;
-        rc.swc = protocol::RemoteSwitch::kUp;
-        rc.swd = motion_.mode() == MotionMode::kOblique ? protocol::RemoteSwitch::kDown
-                                                        : protocol::RemoteSwitch::kUp;
+        rc.swc = remote_.swc;
+        rc.swd = remote_.swd;
+        rc.stick_left_v = stick_wire(remote_.left);
+        rc.stick_right_h = stick_wire(remote_.right);
         rc.counter = vendor_counter_;
         send(rc, t);
         ++vendor_counter_;
@@ -810,6 +925,7 @@ ChassisSnapshot VirtualChassis::snapshot() const {
   s.motion_allowed = s.motion_refused_reason.empty();
   s.silent = silent_;
   s.ultrasonic_enabled = ultrasonic_enabled_;
+  s.remote = remote_;
   s.target = motion_.target();
   s.speed = motion_.speed();
   s.steering = motion_.steering();
@@ -819,6 +935,7 @@ ChassisSnapshot VirtualChassis::snapshot() const {
   s.distance_travelled = motion_.distance_travelled();
   s.yaw_travelled = motion_.yaw_travelled();
   s.battery = drivetrain_.pack();
+  s.lights = lights_.report();
   return s;
 }
 

@@ -263,6 +263,26 @@ std::string ChassisMonitor::render_text(std::string_view iface, const BusStatus&
   }
   line(us);
 
+  // The vendor's additions (agx_v2): the remote control, the lights, the firmware version.
+  if (fb_.remote_control_state) {
+    const RemoteState r =
+        remote_state_from(fb_.remote_control_state->value, fb_.remote_control_state->received);
+    line("Remote   SWA " + std::string(protocol::to_string(r.swa)) + "  SWB " +
+         std::string(protocol::to_string(r.swb)) + "  SWC " +
+         std::string(protocol::to_string(r.swc)) + "  SWD " +
+         std::string(protocol::to_string(r.swd)) +
+         fmt("   left stick (%+.2f fwd,", r.left_vertical) +
+         fmt(" %+.2f right)", r.left_horizontal) +
+         fmt("  right stick (%+.2f fwd,", r.right_vertical) +
+         fmt(" %+.2f right)", r.right_horizontal) + fmt("  knob %+.2f", r.knob));
+  }
+  if (fb_.light_state) {
+    const LightState& l = fb_.light_state->value;
+    line("Lights   " + describe(l.front_mode, l.front_custom, l.rear_mode, l.rear_custom) +
+         (l.enable ? "  (under CAN control)" : "  (the chassis's own)"));
+  }
+  if (!fb_.version.empty()) line("Firmware " + fb_.version);
+
   // Frame rates: every ID seen, plus the periodic feedback IDs that are missing.
   line("Rates /s  (expected in brackets; " + st.red("red") + " = more than 20% off)");
   std::vector<std::uint32_t> ids;
@@ -351,6 +371,28 @@ std::string ChassisMonitor::render_json(std::string_view iface, const BusStatus&
   }
   if (fb_.ultrasonic_setting)
     w.key("ultrasonic_enabled").boolean(fb_.ultrasonic_setting->value.enabled);
+  if (fb_.remote_control_state) {
+    const RemoteState r =
+        remote_state_from(fb_.remote_control_state->value, fb_.remote_control_state->received);
+    w.key("remote").begin_object();
+    w.key("swa").string(protocol::to_string(r.swa)).key("swb").string(protocol::to_string(r.swb));
+    w.key("swc").string(protocol::to_string(r.swc)).key("swd").string(protocol::to_string(r.swd));
+    w.key("left_vertical").number(r.left_vertical).key("left_horizontal").number(r.left_horizontal);
+    w.key("right_vertical").number(r.right_vertical);
+    w.key("right_horizontal").number(r.right_horizontal).key("knob").number(r.knob);
+    w.end_object();
+  }
+  if (fb_.light_state) {
+    const LightState& l = fb_.light_state->value;
+    w.key("lights").begin_object();
+    w.key("can_control").boolean(l.enable);
+    w.key("front").string(protocol::to_string(l.front_mode));
+    w.key("front_brightness").unsigned_integer(l.front_custom);
+    w.key("rear").string(protocol::to_string(l.rear_mode));
+    w.key("rear_brightness").unsigned_integer(l.rear_custom);
+    w.end_object();
+  }
+  if (!fb_.version.empty()) w.key("firmware_version").string(fb_.version);
   if (motion_command_) {
     w.key("host_motion_command").begin_object();
     w.key("linear_speed").number(motion_command_->value.linear_speed);

@@ -13,6 +13,7 @@
 #include <string_view>
 #include <utility>
 
+#include "ranger_can/control/driver.hpp"  // RemoteState, describe(lights)
 #include "ranger_can/control/feedback.hpp"
 #include "ranger_can/control/frame_stats.hpp"
 #include "ranger_can/transport/bus.hpp"

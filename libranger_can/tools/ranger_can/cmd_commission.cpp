@@ -409,11 +409,12 @@ int commission_main(const ParsedArgs& args, Io io) {
         1, snap->identification ? snap->identification->message : "the identification did not end");
   }
   const IdentificationStatus id = *snap->identification;
-  c.profile = id.profile;
+  // The settings in use: the identification's, with what it only kept taken from --model's.
+  c.profile = snap->profile;
   if (Status st = apply_set_options(c.profile, args); !st) {
     return finish(2, st.error().message);
   }
-  if (c.profile != id.profile) c.restart_with(c.profile);
+  if (c.profile != snap->profile) c.restart_with(c.profile);
   io.out << "identified in " << f2(seconds(id.elapsed())) << " s"
          << (s.simulated() ? " (simulated)" : "") << ": " << describe(c.profile) << "\n";
   for (const IdentifiedSetting& d : id.decided) {

@@ -54,6 +54,20 @@ void print_identification(const IdentificationStatus& s, const ProtocolProfile& 
     out << "  - " << e << "\n";
 }
 
+std::string firmware_text(const FirmwareVersion& v) {
+  switch (v.state) {
+    case FirmwareVersion::State::kAnswered:
+      return v.text;
+      break;
+    case FirmwareVersion::State::kUnsupported:
+      return "unknown (the chassis sends none of the vendor's frames: no 0x4A1 version)";
+    case FirmwareVersion::State::kUnanswered:
+      return "unknown (no answer to the 0x4A1 version request)";
+    default:
+      return "unknown (" + std::string(to_string(v.state)) + ")";
+  }
+}
+
 int identify_main(const ParsedArgs& args, Io io) {
   const std::string iface = *args.get("IFACE");
   DriverConfig config;
@@ -73,9 +87,17 @@ int identify_main(const ParsedArgs& args, Io io) {
     return 1;
   }
   DriverSession& s = **session;
+  // Identified, then the firmware version (asked once the settings are decided) answered, or
+  // known to be unavailable.
   const bool finished = s.run_until(
-      [](const DriverSnapshot& snap) { return snap.identification && snap.identification->done(); },
-      config.identification.timeout + 2s);
+      [](const DriverSnapshot& snap) {
+        if (!snap.identification || !snap.identification->done()) return false;
+        const auto v = snap.firmware.state;
+        return !snap.identification->decided_ok() || v == FirmwareVersion::State::kAnswered ||
+               v == FirmwareVersion::State::kUnanswered ||
+               v == FirmwareVersion::State::kUnsupported;
+      },
+      config.identification.timeout + 3s);
   s.stop();
   const auto snap = s.snapshot();
   if (!finished || !snap->identification) {
@@ -89,6 +111,7 @@ int identify_main(const ParsedArgs& args, Io io) {
     return usage_error(identify_command(), io, st.error().message);
   }
   print_identification(id, profile, s.simulated(), io.out);
+  io.out << "firmware: " << firmware_text(snap->firmware) << "\n";
   if (!id.decided_ok()) {
     io.err << "ranger_can identify: " << id.message << "\n";
     return 1;
@@ -104,7 +127,8 @@ const CommandSpec& identify_command() {
       "identify which protocol settings a chassis speaks, before anything moves",
       "Runs the driver with --protocol auto until it has identified the chassis, then prints the\n"
       "decision: every protocol setting (decided from evidence, or kept at the preset's value),\n"
-      "the confidence and the evidence, one line each.\n"
+      "the confidence and the evidence, one line each, then the chassis's firmware version\n"
+      "(0x4A1, asked once the settings are decided; agx_v2 chassis only).\n"
       "\n"
       "The driver first listens without sending anything (the IDs only the vendor's revision\n"
       "sends, frame lengths, the 0x211 byte-7 counter, the BMS voltage scale), then takes CAN\n"

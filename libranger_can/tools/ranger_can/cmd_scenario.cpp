@@ -40,6 +40,7 @@ int scenario_main(const ParsedArgs& args, Io io) {
   if (!vehicle) return usage_error(scenario_command(), io, vehicle.error().message);
   if (vehicle->model) options.chassis = sim::chassis_for_model(*vehicle->model);
   options.chassis.profile = vehicle->profile;
+  options.chassis.boot_in_remote_mode = args.has("--remote");
   apply_vehicle(*vehicle, options.driver);
   // auto (the default, as in the node): the driver identifies the chassis before it moves.
   if (protocol_is_auto(args)) options.driver.protocol = ProtocolChoice::kAuto;
@@ -102,17 +103,21 @@ const CommandSpec& scenario_command() {
       "in-process bus, in lock-step under a simulated clock (1 ms steps: the chassis, then the\n"
       "driver), driven by a script: the commander's twists and requests, faults injected into\n"
       "the chassis, waits, and `expect` checks that make a script self-checking. The whole script\n"
-      "is checked before anything runs. The chassis boots in standby at t = 0.\n"
+      "is checked before anything runs. The chassis boots in standby at t = 0 (--remote: under "
+      "its\n"
+      "remote control).\n"
       "\n"
       "Prints one JSON object per line at t = 0, SEC, 2*SEC, ... (--every) until the script ends:\n"
       "  {\"t\":s,\"truth\":{\"x\",\"y\",\"yaw\",\"vx\",\"vy\",\"wz\",\"speed\"},\n"
       "   \"odom\":{\"x\",\"y\",\"yaw\",\"vx\",\"vy\",\"wz\"},\"control_mode\":\"can\",\n"
       "   \"motion_mode\":\"ackermann\",\"refusal\":\"none\",\"faults\":[...],\n"
-      "   \"rearm_required\":false,\"latched\":[...],\"steer_first_factor\":1.0}\n"
+      "   \"rearm_required\":false,\"latched\":[...],\"steer_first_factor\":1.0,\n"
+      "   \"identification\":\"decided\"}\n"
       "truth: the chassis's ground truth (m, rad; velocities in the body frame, REP-103; speed:\n"
       "its fastest point, body centre or a wheel); odom: the driver's odometry; the modes as the\n"
       "driver knows them (null: never reported); refusal: why the requested motion is not driven\n"
-      "(\"none\" while it is). Numbers have fixed decimals (t 3, others 6): the same script gives\n"
+      "(\"none\" while it is); identification: its phase under --protocol auto (\"none\" when the\n"
+      "protocol is given). Numbers have fixed decimals (t 3, others 6): the same script gives\n"
       "the same bytes.",
       {optional_arg("FILE", "the script; standard input when absent or '-'", any_text())},
       {
@@ -125,6 +130,9 @@ const CommandSpec& scenario_command() {
                      " (default manual); it applies over --model, --protocol and --set, which "
                      "configure the driver and the chassis alike",
                  one_of(sim::variant_names())),
+          flag("--remote",
+               "the chassis boots under its remote control (remote mode from the first frame; "
+               "`remote swd` and `remote sticks` drive it)"),
           model_option(),
           protocol_option(),
           set_option(),

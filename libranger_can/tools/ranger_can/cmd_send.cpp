@@ -18,6 +18,7 @@
 #include "ranger_can/wire/candump_log.hpp"
 #include "ranger_can/wire/codec.hpp"
 #include "ranger_can/wire/interpretation.hpp"
+#include "ranger_can/wire/protocol.hpp"
 
 namespace ranger::cli {
 
@@ -33,7 +34,54 @@ Result<Message> parse_mode(const Words& w) {
   if (w[0] == "ackermann") return Message{MotionModeCommand{protocol::MotionMode::kAckermann}};
   if (w[0] == "oblique") return Message{MotionModeCommand{protocol::MotionMode::kOblique}};
   if (w[0] == "spin") return Message{MotionModeCommand{protocol::MotionMode::kSpin}};
-  return bad("mode: unknown motion mode '" + w[0] + "' (ackermann, oblique or spin)");
+  if (w[0] == "side_slip") return Message{MotionModeCommand{protocol::MotionMode::kSideSlip}};
+  return bad("mode: unknown motion mode '" + w[0] + "' (ackermann, oblique, spin or side_slip)");
+}
+
+Result<Message> parse_park(const Words& w) {
+  // Park off: back to dual Ackermann, the mode every chassis starts in.
+  if (w[0] == "on") return Message{MotionModeCommand{protocol::MotionMode::kPark}};
+  if (w[0] == "off") return Message{MotionModeCommand{protocol::MotionMode::kAckermann}};
+  return bad("park: expected 'on' or 'off', got '" + w[0] + "'");
+}
+
+// One light: off | on | breathing | custom:PCT (brightness 0..100).
+Status parse_light(const std::string& what, const std::string& word, protocol::LightMode& mode,
+                   std::uint8_t& brightness) {
+  brightness = 0;
+  if (word == "off")
+    mode = protocol::LightMode::kOff;
+  else if (word == "on")
+    mode = protocol::LightMode::kOn;
+  else if (word == "breathing")
+    mode = protocol::LightMode::kBreathing;
+  else if (word.rfind("custom:", 0) == 0) {
+    auto pct = parse_integer("lights " + what + " custom:PCT", word.substr(7), 0, 100);
+    if (!pct) return pct.error();
+    mode = protocol::LightMode::kCustom;
+    brightness = static_cast<std::uint8_t>(*pct);
+  } else {
+    return bad("lights " + what + ": expected off, on, breathing or custom:PCT, got '" + word +
+               "'");
+  }
+  return ok_status();
+}
+
+Result<Message> parse_lights(const Words& w) {
+  LightCommand c;
+  c.enable = true;
+  if (w.size() == 1 && w[0] == "release") {
+    c.enable = false;  // the chassis's own lights again
+    return Message{c};
+  }
+  if (w.size() != 2) return bad("usage: send IFACE lights FRONT REAR | release");
+  if (Status st = parse_light("FRONT", w[0], c.front_mode, c.front_custom); !st) return st.error();
+  if (Status st = parse_light("REAR", w[1], c.rear_mode, c.rear_custom); !st) return st.error();
+  return Message{c};
+}
+
+Result<Message> parse_version(const Words&) {
+  return Message{VersionRequest{}};
 }
 
 Result<Message> parse_control(const Words& w) {
@@ -86,7 +134,18 @@ struct SendCommand {
 
 const std::vector<SendCommand>& send_commands() {
   static const std::vector<SendCommand> commands = {
-      {"mode", "ackermann|oblique|spin", 1, 1, "0x141 motion mode", parse_mode},
+      {"mode", "ackermann|oblique|spin|side_slip", 1, 1,
+       "0x141 motion mode (side_slip: MINI V1 and agx_v2 numbering only)", parse_mode},
+      {"park", "on|off", 1, 1,
+       "0x141 park (on) or dual Ackermann (off); agx_v2 numbering only (the manual and the MINI "
+       "V1 have no park)",
+       parse_park},
+      {"lights", "FRONT REAR|release", 1, 2,
+       "0x121 lights (agx_v2): FRONT and REAR each off, on, breathing or custom:PCT (brightness "
+       "0-100); release hands the lights back to the chassis",
+       parse_lights},
+      {"version", "", 0, 0, "0x4A1 firmware version request (agx_v2; the answer is not waited for)",
+       parse_version},
       {"control", "can|standby", 1, 1, "0x421 control mode (CAN command mode / standby)",
        parse_control},
       {"clear-errors", "[CODE]", 0, 1,
@@ -150,6 +209,13 @@ int send_main(const ParsedArgs& args, Io io) {
   auto message = parse_command(*args.get("COMMAND"), args.all("ARGS"));
   if (!message) return usage_error(send_command(), io, message.error().message);
   apply_spin_field(*message, *vehicle);
+  if (const auto* m = std::get_if<MotionModeCommand>(&*message);
+      m && !protocol::motion_mode_to_wire(m->mode, vehicle->profile.mode_numbering)) {
+    io.err << "ranger_can send: " << protocol::to_string(m->mode) << ": unsupported by protocol "
+           << vehicle->profile.revision << " (its motion-mode numbering has no "
+           << protocol::to_string(m->mode) << " mode)\n";
+    return 1;
+  }
   auto frame = encode(*message, vehicle->profile);
   if (!frame) {
     io.err << "ranger_can send: " << frame.error().message << "\n";

@@ -115,6 +115,7 @@ Result<SimOptions> options_from(const ParsedArgs& args) {
   }
   o.config.ultrasonic_enabled = args.has("--avoidance");
   o.config.boot_in_remote_mode = args.has("--remote");
+  if (auto v = args.get("--firmware")) o.config.version = *v;
   o.estop = args.has("--estop");
   o.errors = args.all("--error");
   o.stuck = args.has("--stuck-mode-switch");
@@ -486,6 +487,9 @@ const CommandSpec& sim_command() {
                  checked_by([](const std::string& t) { return check_with(parse_ultrasonic, t); })),
           flag("--avoidance", "start with ultrasonic obstacle avoidance enabled"),
           flag("--remote", "boot with the remote control in charge (remote mode)"),
+          option("--firmware", "TEXT",
+                 "the firmware version the chassis answers 0x4A1 with (agx_v2 variants; "
+                 "default 'ranger_sim 0.1.0'; the control command 'version TEXT' changes it)"),
           flag("--estop", "boot with the emergency stop pressed"),
           option(
               "--error", "BIT|NAME", "boot with this 0x211 error bit raised",

@@ -13,6 +13,8 @@
 #include <nav_msgs/Odometry.h>
 #include <ranger_msgs/ActuatorStateArray.h>
 #include <ranger_msgs/BmsStateArray.h>
+#include <ranger_msgs/RemoteState.h>
+#include <ranger_msgs/SetLights.h>
 #include <ranger_msgs/SystemState.h>
 #include <ranger_msgs/UltrasonicState.h>
 #include <ros/time.h>
@@ -78,6 +80,15 @@ std::vector<std::string> cause_names(ranger::StopCauses causes);
 
 ranger_msgs::SystemState to_system_state(const ranger::DriverSnapshot& snapshot,
                                          const ros::Time& stamp);
+// ---- the vendor's additions (agx_v2) ------------------------------------------------------------
+ranger_msgs::RemoteState to_remote_state(const ranger::RemoteState& remote, const ros::Time& stamp);
+// The service's request as the driver's; kInvalidArgument naming the field for a mode above
+// CUSTOM or a brightness above 100 (a brightness outside CUSTOM is ignored: sent as 0).
+ranger::Result<ranger::LightsRequest> to_lights_request(const ranger_msgs::SetLights::Request& r);
+// The lights the chassis last reported (0x231) into the response; nothing when it never did.
+void fill_lights_response(const std::optional<ranger::LightsState>& lights,
+                          ranger_msgs::SetLights::Response& out);
+
 // Sets the SystemErrors fields by meaning: each row of the fault table (protocol::kFaultTable)
 // with a bit in `layout` sets the field of its name from that bit; the others stay as they are.
 void fill_system_errors(std::uint32_t error_word, ranger::ErrorWordLayout layout,

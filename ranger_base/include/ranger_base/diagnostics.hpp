@@ -1,6 +1,7 @@
 // /diagnostics for the chassis, through diagnostic_updater: one status per concern (CAN link,
-// control mode, protocol settings, errors, battery, frame rates), each computed from a ranger::DriverSnapshot so the
-// same rules are unit-tested without ROS plumbing. ranger_bringup's aggregator config groups them.
+// control mode, protocol settings, errors, battery, frame rates), each computed from a
+// ranger::DriverSnapshot so the same rules are unit-tested without ROS plumbing. ranger_bringup's
+// aggregator config groups them.
 #pragma once
 
 #include <diagnostic_updater/DiagnosticStatusWrapper.h>

@@ -17,11 +17,13 @@
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <geometry_msgs/Twist.h>
 #include <ranger_msgs/ClearErrors.h>
+#include <ranger_msgs/SetLights.h>
 #include <ranger_msgs/SetMotionMode.h>
 #include <ranger_msgs/SetUltrasonic.h>
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <std_msgs/String.h>
+#include <std_srvs/SetBool.h>
 #include <std_srvs/Trigger.h>
 #include <tf2_ros/transform_broadcaster.h>
 
@@ -78,6 +80,8 @@ class RangerNode {
                          ranger_msgs::SetUltrasonic::Response& res);
   bool on_set_motion_mode(ranger_msgs::SetMotionMode::Request& req,
                           ranger_msgs::SetMotionMode::Response& res);
+  bool on_set_lights(ranger_msgs::SetLights::Request& req, ranger_msgs::SetLights::Response& res);
+  bool on_park(std_srvs::SetBool::Request& req, std_srvs::SetBool::Response& res);
   // The outcome of request `id` once answered or failed, after `timeout`, or at shutdown.
   ranger::RequestOutcome wait_for(std::uint64_t id, std::chrono::nanoseconds timeout);
 
@@ -108,10 +112,11 @@ class RangerNode {
   ros::Subscriber cmd_vel_sub_, sim_inject_sub_;
   ros::Publisher odom_pub_, joint_state_pub_, system_state_pub_, actuator_state_pub_,
       bms_state_pub_, battery_state_pub_, ultrasonic_state_pub_, cmd_vel_out_pub_,
-      ground_truth_pub_;
+      ground_truth_pub_, remote_state_pub_;
   std::array<ros::Publisher, 8> range_pubs_;
   tf2_ros::TransformBroadcaster tf_broadcaster_;
-  ros::ServiceServer resume_srv_, clear_errors_srv_, set_ultrasonic_srv_, set_motion_mode_srv_;
+  ros::ServiceServer resume_srv_, clear_errors_srv_, set_ultrasonic_srv_, set_motion_mode_srv_,
+      set_lights_srv_, park_srv_;
 
   diagnostic_updater::Updater updater_;
   std::unique_ptr<ChassisDiagnostics> diagnostics_;
@@ -126,6 +131,7 @@ class RangerNode {
       next_diagnostics_publication_;
   ranger::Timestamp last_odom_stamp_{0}, last_joints_stamp_{0};
   std::array<ranger::Timestamp, 2> last_ultrasonic_stamp_{};
+  ranger::Timestamp last_remote_received_{0};  // the driver's clock
   // For logging transitions once instead of every cycle (the driver thread: publish_states).
   std::optional<ranger::MotionRefusal> last_refusal_;
   std::optional<ranger::LinkState> last_link_;

@@ -19,6 +19,10 @@ class Segment:
     vy: float = 0.0  # m/s
     wz: float = 0.0  # rad/s
     duration: float = 1.0  # s of driving, counted once the chassis is in `mode`
+    # rad, spins only: the segment turns this far (in wz's direction) by the driver's odometry,
+    # slowing down before the end (spin_rate), instead of driving for `duration`, which then
+    # bounds how long it may take. 0: driven for `duration`.
+    turn: float = 0.0
 
 
 # About 20 s of driving and five motion-mode switches; the shape (arc, crab, spin) is chosen so
@@ -28,9 +32,31 @@ DEFAULT_ROUTE = (
     Segment("arc left, radius 2 m", ACKERMANN, vx=0.8, wz=0.4, duration=4.0),
     Segment("crab left", OBLIQUE, vy=0.5, duration=3.0),
     Segment("crab back-right diagonal", OBLIQUE, vx=-0.35, vy=-0.35, duration=3.0),
-    Segment("spin left half a turn", SPIN, wz=0.9, duration=3.5),
+    Segment("spin left half a turn", SPIN, wz=0.9, duration=10.0, turn=math.pi),
     Segment("arc right, radius 2 m", ACKERMANN, vx=0.8, wz=-0.4, duration=3.0),
 )
+
+# A spin by angle (Segment.turn): full rate until the rest of the turn is TURN_GAIN * rate away,
+# then the rate in proportion to what is left (never below MIN_SPIN_RATE), done within
+# TURN_TOLERANCE. The slowing down keeps what the chassis turns while it brakes small.
+TURN_GAIN = 1.0  # 1/s
+MIN_SPIN_RATE = 0.15  # rad/s
+TURN_TOLERANCE = math.radians(0.5)
+
+
+def spin_rate(segment, turned):
+    """The yaw rate to command in a spin segment with a `turn`, after `turned` rad (signed, in the
+    direction of segment.wz) of it; 0.0 once the turn is done."""
+    remaining = segment.turn - turned
+    if remaining <= TURN_TOLERANCE:
+        return 0.0
+    rate = min(abs(segment.wz), max(MIN_SPIN_RATE, TURN_GAIN * remaining))
+    return math.copysign(rate, segment.wz)
+
+
+def driving_time(segment):
+    """The segment's nominal driving time (s): its duration, or for a turn the turn at its rate."""
+    return segment.turn / abs(segment.wz) if segment.turn else segment.duration
 
 
 def validate_route(route):
@@ -45,6 +71,8 @@ def validate_route(route):
             raise ValueError(f"{where}: crab needs vy != 0 and wz = 0")
         if s.mode == SPIN and (s.vx != 0 or s.vy != 0 or s.wz == 0):
             raise ValueError(f"{where}: spin needs wz != 0 and no linear velocity")
+        if s.turn and (s.mode != SPIN or not math.isfinite(s.turn) or s.turn < 0):
+            raise ValueError(f"{where}: a turn is a spin's, finite and >= 0")
         if s.mode not in MODE_TITLES:
             raise ValueError(f"{where}: unknown mode {s.mode!r}")
 
@@ -119,6 +147,13 @@ def path_length(samples, t0=-math.inf, t1=math.inf):
 def rotation(samples, t0=-math.inf, t1=math.inf):
     pts = [s for s in samples if t0 <= s[0] <= t1]
     return sum(abs(wrap(b[3] - a[3])) for a, b in zip(pts, pts[1:]))
+
+
+def yaw_change(samples, t0=-math.inf, t1=math.inf):
+    """The signed yaw turned between t0 and t1 (rad, counter-clockwise positive; several turns
+    add up)."""
+    pts = [s for s in samples if t0 <= s[0] <= t1]
+    return sum(wrap(b[3] - a[3]) for a, b in zip(pts, pts[1:]))
 
 
 # ---- the analysis --------------------------------------------------------------------------------

@@ -89,6 +89,9 @@ enum class MotionRefusal {
   // stop causes, standby and an unknown mode (the probe needs CAN mode and a known motion mode);
   // ControllerState::identifying says what is going on.
   kIdentifying,
+  // The commander asked for park (request_park): the chassis is held in (or brought to) park
+  // mode and motion is refused until park is released. After the stop causes and standby.
+  kParked,
 };
 std::string_view to_string(MotionRefusal r);  // "none", "link_lost", "remote", ...
 inline constexpr MotionRefusal kAllMotionRefusals[] = {
@@ -107,6 +110,7 @@ inline constexpr MotionRefusal kAllMotionRefusals[] = {
     MotionRefusal::kCmdTimeout,
     MotionRefusal::kBelowMinimum,
     MotionRefusal::kIdentifying,
+    MotionRefusal::kParked,
 };
 
 enum class LinkState { kNeverConnected, kConnected, kStale };
@@ -150,7 +154,7 @@ struct ControllerConfig {
   bool auto_command_mode = true;  // request CAN command mode by itself (at start-up)
   // shutdown() also hands control back: 0x421 standby after the stop (`ranger_can commission`).
   bool release_control_on_shutdown = false;
-  bool auto_reclaim_after_remote = false;  // the old behaviour: reclaim after remote hands back
+  bool auto_reclaim_after_remote = false;  // re-arm by itself when the remote hands back
   bool listen_only = false;                // never send anything (monitoring, log replay)
   std::chrono::nanoseconds link_timeout = std::chrono::milliseconds(100);
   std::chrono::nanoseconds control_mode_retry_period = std::chrono::milliseconds(100);
@@ -187,6 +191,8 @@ struct ControllerCounters {
   std::uint64_t error_clear_requests = 0;  // 0x441
   std::uint64_t ultrasonic_requests = 0;   // 0x451
   std::uint64_t rearms = 0;                // latch cleared by a zero twist or resume()
+  std::uint64_t light_commands = 0;        // 0x121
+  std::uint64_t version_requests = 0;      // 0x4A1
 };
 
 struct ControllerState {
@@ -204,6 +210,12 @@ struct ControllerState {
   bool chassis_switching = false;                   // 0x291 switching bit
   ModeSwitchStatus mode_switch;
   std::optional<protocol::MotionMode> mode_override;  // request_motion_mode()
+  // The last 0x291's mode whatever it is, park and side slip included (motion_mode holds only
+  // the modes this driver can command in).
+  std::optional<protocol::MotionMode> chassis_mode;
+  // Park (request_park): wanted by the commander; the chassis reports park (0x291, not switching).
+  bool park_requested = false;
+  bool parked() const { return chassis_mode == protocol::MotionMode::kPark && !chassis_switching; }
 
   // Vehicle status, faults and the re-arm latch
   std::optional<protocol::VehicleStatus> vehicle_status;
@@ -298,7 +310,11 @@ class ChassisController {
     return set_command(MotionRequest{twist, std::nullopt}, now);
   }
 
-  // Forces every later command into `mode` (nullopt: automatic selection again).
+  // Whether a twist can be driven in `mode` under the profile: ackermann, oblique, spin, and side
+  // slip where the mode numbering has it (MINI V1, agx_v2); never park.
+  bool can_drive_in(protocol::MotionMode mode) const;
+  // Forces every later command into `mode` (nullopt: automatic selection again); a mode
+  // can_drive_in refuses is ignored.
   void request_motion_mode(std::optional<protocol::MotionMode> mode, Timestamp now);
 
   // Sends 0x421 once (for auto_command_mode = false, or to hand control back with kStandby).
@@ -310,6 +326,18 @@ class ChassisController {
 
   // Sends 0x451; confirmed when 0x45A reports the same, resent up to ultrasonic_max_attempts.
   Status set_ultrasonic(bool enable, Timestamp now);
+
+  // Park (agx_v2: motion mode 0x03). on: motion is refused (kParked), the chassis is brought to
+  // rest and switched to park; off: motion is allowed again and the chassis is switched out of
+  // park (to the forced mode, else Ackermann) at once. kInvalidArgument ("unsupported by ...",
+  // nothing changes) when the profile's mode numbering has no park (manual, MINI V1).
+  Status request_park(bool on, Timestamp now);
+  // Sends 0x121 once (the counter in byte 7 is the controller's). The chassis reports what it
+  // does in 0x231 (feedback().light_state); a profile without lights is the caller's to refuse.
+  Status set_lights(const LightCommand& lights, Timestamp now);
+  // Sends the 0x4A1 version request (DLC 1) and forgets the previous answer
+  // (feedback().version starts empty again).
+  Status request_version(Timestamp now);
 
   // The explicit re-arm: clears the latch and lifts the remote's hold on CAN mode requests.
   // Refused (kInvalidArgument, naming it) while a cause is still active — nothing is sent then.
@@ -382,7 +410,9 @@ class ChassisController {
   int ultrasonic_attempts_ = 0;
   std::string implausible_reason_;
   std::optional<protocol::MotionMode> probe_mode_;
-  bool faults_valid_ = false;  // state_.faults matches faults_signature_
+  bool leave_park_ = false;         // park released: switch out of it even without a command
+  std::uint8_t light_counter_ = 0;  // 0x121 byte 7
+  bool faults_valid_ = false;       // state_.faults matches faults_signature_
   std::uint64_t faults_signature_ = 0;
 };
 

@@ -25,6 +25,7 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "ranger_can/clock.hpp"
@@ -55,8 +56,10 @@ struct DriverConfig {
   // kAuto: the driver listens before it sends anything, decides the settings from the chassis's
   // frames and a zero-speed steering probe, and refuses speed (kIdentifying) until then; a
   // chassis it cannot identify within identification.timeout stays at rest, the snapshot's
-  // identification.message saying what to set. controller.profile is then only the fallback
-  // for decoding nothing (it is replaced by the decision). kForced (the default) as before.
+  // identification.message saying what to set. controller.profile is replaced by the decision,
+  // except for the settings the identification only kept from its revision's preset: where
+  // controller.profile is of the decided revision (a model's profile: the MINI V1's mode
+  // numbering, spin field and sign), its values stand for those. kForced (the default) as before.
   ProtocolChoice protocol = ProtocolChoice::kForced;
   // kAuto only: start from this preset ("manual", "agx_v2") instead of deciding it.
   std::optional<std::string> identify_revision;
@@ -73,6 +76,11 @@ struct DriverConfig {
   std::chrono::nanoseconds reconnect_interval = std::chrono::seconds(1);
   // How long clear_errors waits for the chassis's answer (a 0x211 sent after the 0x441 arrived).
   std::chrono::nanoseconds request_answer_timeout = std::chrono::milliseconds(500);
+  // The vendor's features (lights 0x121/0x231, the remote state 0x241, the version 0x4A1) are
+  // known present as soon as the chassis sends 0x231 or 0x241, and absent once it has been heard
+  // (0x211) this long without either: light requests are then refused and the version is not
+  // asked for (a manual chassis never hears a frame its protocol lacks).
+  std::chrono::nanoseconds vendor_frames_wait = std::chrono::milliseconds(200);
   std::string thread_name = "ranger_driver";  // for top -H and the performance script
 
   Status validate() const;  // the controller's, odometry's, identification's, monitors' checks
@@ -90,6 +98,67 @@ struct RequestOutcome {
   Timestamp sent{0};  // driver clock
 };
 std::string_view to_string(RequestOutcome::State s);  // "pending", "sent", "answered", "failed"
+
+// Whether the chassis speaks the vendor's additions (0x231 light state, 0x241 remote state, 0x4A1
+// version answers).
+enum class VendorFrames {
+  kUnknown,  // not heard long enough to tell
+  kPresent,  // 0x231 or 0x241 received
+  kAbsent,   // heard for DriverConfig::vendor_frames_wait without either
+};
+std::string_view to_string(VendorFrames v);  // "unknown", "present", "absent"
+
+// The remote control's switches and sticks (0x241), sticks and knob normalised to -1..1
+// (protocol::kRemoteAxisFullScale; saturated).
+struct RemoteState {
+  protocol::RemoteSwitch swa = protocol::RemoteSwitch::kUndefined;
+  protocol::RemoteSwitch swb = protocol::RemoteSwitch::kUndefined;
+  protocol::RemoteSwitch swc = protocol::RemoteSwitch::kUndefined;
+  protocol::RemoteSwitch swd = protocol::RemoteSwitch::kUndefined;
+  double left_vertical = 0.0;     // + forward
+  double left_horizontal = 0.0;   // + right
+  double right_vertical = 0.0;    // + forward
+  double right_horizontal = 0.0;  // + right
+  double knob = 0.0;              // VRA
+  Timestamp received{0};          // driver clock
+};
+RemoteState remote_state_from(const RemoteControlState& rc, Timestamp received);
+
+// The lights as 0x231 reports them.
+struct LightsState {
+  bool can_control = false;  // byte 0: the lights follow CAN (0x121) commands
+  protocol::LightMode front = protocol::LightMode::kOff;
+  std::uint8_t front_brightness = 0;  // custom mode's brightness, 0..100
+  protocol::LightMode rear = protocol::LightMode::kOff;
+  std::uint8_t rear_brightness = 0;
+  Timestamp received{0};  // driver clock
+};
+
+// What set_lights asks for.
+struct LightsRequest {
+  protocol::LightMode front = protocol::LightMode::kOn;
+  std::uint8_t front_brightness = 0;  // custom mode only: 0..100
+  protocol::LightMode rear = protocol::LightMode::kOn;
+  std::uint8_t rear_brightness = 0;
+};
+// "front on, rear custom 40"
+std::string describe(protocol::LightMode front, std::uint8_t front_brightness,
+                     protocol::LightMode rear, std::uint8_t rear_brightness);
+
+// The chassis's firmware version (0x4A1), asked once the chassis is heard speaking the vendor's
+// revision.
+struct FirmwareVersion {
+  enum class State {
+    kNotAsked,     // the chassis is not heard yet, or not long enough to tell
+    kAsked,        // 0x4A1 request sent, the answer not complete
+    kAnswered,     // `text` is the chassis's answer
+    kUnanswered,   // no answer within request_answer_timeout
+    kUnsupported,  // the chassis does not speak the vendor's revision (VendorFrames::kAbsent)
+  };
+  State state = State::kNotAsked;
+  std::string text;  // the answer's frames, in order
+};
+std::string_view to_string(FirmwareVersion::State s);  // "not_asked", "asked", ...
 
 // A zero-speed probe at standstill (`ranger_can commission`): the wheels stand in `mode` at
 // `steering` (REP-103 rad: the front wheels' reference angle in Ackermann, the direction of travel
@@ -137,8 +206,23 @@ struct DriverSnapshot {
   std::vector<RequestOutcome> requests;  // the most recent ones, oldest first (at most 16)
   std::uint64_t loop_iterations = 0;
 
+  // The vendor's additions: whether the chassis has them, the remote control's and the lights'
+  // last reported state (nullopt until received), and the firmware version.
+  VendorFrames vendor_frames = VendorFrames::kUnknown;
+  std::optional<RemoteState> remote;
+  std::optional<LightsState> lights;
+  FirmwareVersion firmware;
+
   // The outcome of request `id`, if it is still in the list.
   const RequestOutcome* request(std::uint64_t id) const;
+};
+
+// A lights or version request the driver thread holds until it knows whether the chassis has the
+// vendor's frames (internal to Driver).
+struct DriverVendorAction {
+  enum class Kind { kLights, kVersion } kind = Kind::kVersion;
+  std::uint64_t id = 0;
+  LightsRequest lights;
 };
 
 class Driver {
@@ -181,6 +265,19 @@ class Driver {
   std::uint64_t set_ultrasonic(bool enable);
   // Also clears a plausibility stop (the operator takes it on): the monitors start over.
   std::uint64_t resume();
+  // Lights (0x121). Answered with the state 0x231 reports once it matches the request; failed
+  // ("unsupported by protocol ...") on a chassis without the vendor's frames, or when 0x231
+  // reports something else after request_answer_timeout. While the vendor frames are not known
+  // yet, the request waits for the answer to that. kInvalidArgument (nothing posted) for a
+  // brightness above 100.
+  Result<std::uint64_t> set_lights(const LightsRequest& lights);
+  // Park (motion mode park, 0x141 = 0x03 on agx_v2). on: motion is refused (kParked) from now
+  // on, the chassis brought to rest and switched to park; answered once 0x291 reports park.
+  // off: motion allowed again, answered once the chassis has left park. Failed, naming why,
+  // where the mode numbering has no park (manual, MINI V1).
+  std::uint64_t set_park(bool on);
+  // Asks for the firmware version again (it is asked once by itself); answered with the text.
+  std::uint64_t request_firmware_version();
   // While set (after the identification, if any): speed is refused (kIdentifying, "standstill
   // probe ...") and the probe is commanded; nullopt ends it.
   void standstill_probe(std::optional<StandstillProbe> probe);
@@ -207,10 +304,18 @@ class Driver {
   void apply_mail(Timestamp now);
   void handle_frame(const CanFrame& frame, Timestamp now);
   void run_identification(Timestamp now);
+  ProtocolProfile with_configured_settings(const IdentificationStatus& st) const;
   void run_plausibility(Timestamp now);
   void run_standstill_probe();
   void use_profile(const ProtocolProfile& profile, bool reset_odometry = true);
+  // Under protocol auto, before the decision: whether what the joint states / the odometry read
+  // is decided (nothing is published that would be a guess).
+  bool joints_readable() const;
+  bool odometry_readable() const;
   void update_requests(Timestamp now);
+  void update_vendor(Timestamp now);
+  // Applies a lights or version action; false while the vendor frames are not known yet.
+  bool apply_vendor_action(const DriverVendorAction& a, Timestamp now);
   void publish(Timestamp now);
   void deliver_events();
   RequestOutcome& add_request(std::string what);  // mail lock held
@@ -232,13 +337,23 @@ class Driver {
   std::optional<StandstillProbe> probe_;
   bool probe_active_ = false;
   Odometry odometry_;
+  bool odometry_fed_ = false;  // the odometry has integrated frames (a new profile keeps its pose)
   WheelJointTracker joints_;
   FrameStats frames_;
   std::string bus_error_;
   Timestamp next_open_attempt_{0};
   std::uint64_t loop_iterations_ = 0;
-  std::uint64_t status_frames_ = 0;  // 0x211 received (to tell an answer from a stale frame)
-  std::vector<SentEvent> events_;    // sent during this iteration, delivered after it
+  std::uint64_t status_frames_ = 0;        // 0x211 received (to tell an answer from a stale frame)
+  std::optional<Timestamp> first_status_;  // first 0x211 (vendor_frames_wait counts from it)
+  VendorFrames vendor_frames_ = VendorFrames::kUnknown;
+  std::optional<RemoteState> remote_;
+  std::optional<LightsState> lights_;
+  FirmwareVersion firmware_;
+  Timestamp version_asked_{0};
+  Timestamp last_version_frame_{0};
+  std::vector<DriverVendorAction> deferred_;  // waiting for vendor_frames_ to be known
+  std::vector<std::pair<std::uint64_t, LightsRequest>> sent_lights_;  // request id, what
+  std::vector<SentEvent> events_;  // sent during this iteration, delivered after it
   bool stopped_ = false;
 
   // ---- the mailbox ----

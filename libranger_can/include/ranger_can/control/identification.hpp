@@ -1,5 +1,5 @@
 // Identification: which protocol settings a chassis speaks, decided from its own frames before
-// anything moves (issue 15).
+// anything moves.
 //
 // ChassisIdentifier is pure and clock-free, like the controller: the owner feeds every received
 // frame (on_frame) and the time (tick), reads what to command (request()) and the result
@@ -19,6 +19,12 @@
 //      scale under which they agree (a 48 V pack reads 4.8 V under the wrong one);
 //    * while the wheels roll (a log, or a remote control driving): under which 0x271 unit and sign
 //      the four wheels' angles and speeds form one rigid-body motion (fit_body_twist residuals).
+//    Under the remote control (0x211 control mode remote) the identification then waits for CAN
+//    command mode without a timeout (counted from the hand-back instead), and goes on learning
+//    the 0x271 reading from the remote's driving: the rigid-body fit as above, or the spin
+//    position (below) while the remote spins. status().message says what it has and what it
+//    still lacks (the 0x111 readings, probed when CAN command mode is granted);
+//    wheel_angles_known() tells the driver when joint states and wheel odometry are no guess.
 //    Listening ends after `listen_time` with at least `min_status_frames` 0x211 frames.
 // 2. Steering probe (at standstill, zero speed, in CAN mode): what rest cannot tell.
 //    * spin check (optional): after a switch to spin mode every wheel stands at
@@ -94,6 +100,11 @@ enum class IdentificationPhase {
   kFailed,
 };
 std::string_view to_string(IdentificationPhase p);  // "listening", ..., "decided", "failed"
+inline constexpr IdentificationPhase kAllIdentificationPhases[] = {
+    IdentificationPhase::kListening, IdentificationPhase::kAwaitingControl,
+    IdentificationPhase::kSpinCheck, IdentificationPhase::kSteerProbe,
+    IdentificationPhase::kReturning, IdentificationPhase::kDecided,
+    IdentificationPhase::kFailed};
 
 // One decided (or kept) setting and why.
 struct IdentifiedSetting {
@@ -154,6 +165,15 @@ class ChassisIdentifier {
 
   const IdentificationStatus& status() const { return status_; }
   IdentificationRequest request() const;
+  // The owner's word on whether the probe may start: non-empty while the controller refuses
+  // motion for a cause of the commander's (a re-arm pending after the remote control or a stop,
+  // an e-stop). Meanwhile the identification stays in kAwaitingControl without a timeout, its
+  // message saying why, instead of judging a probe that was never sent.
+  void hold_probe(std::string reason) { probe_hold_ = std::move(reason); }
+  // Whether the 0x271 reading (unit and sign) is decided: by the rigid-body fit of rolling wheels,
+  // the spin position, or the decision. Until then joint states and wheel odometry would be
+  // guesses.
+  bool wheel_angles_known() const { return verdict_271_.has_value() || status_.decided_ok(); }
 
   // After the decision: a setting the identification could not decide (one of
   // status().undecided) found out while driving (the plausibility monitors), e.g. spin_sign = cw
@@ -173,6 +193,14 @@ class ChassisIdentifier {
   void begin_step(IdentificationPhase phase, Timestamp now);
   bool settled(Timestamp now) const;
   void evaluate_spin(Timestamp now);
+  // The 0x271 reading from the spin position / the rigid-body fit of the rolling wheels; true
+  // when decided (verdict_271_ set). `quiet_if_unclear`: no evidence line for an unclear result
+  // (checked again and again under the remote control).
+  bool judge_spin_position(const std::string& context, bool quiet_if_unclear);
+  bool judge_rigid_body(bool quiet_if_unclear);
+  bool under_remote() const;  // 0x211 says the remote control has the chassis
+  // Under the remote control, awaiting CAN command mode: what the remote's driving tells.
+  void observe_remote_driving(Timestamp now);
   void evaluate_steer(Timestamp now);
   void fail(std::string why, Timestamp now);
   void decide(Timestamp now);
@@ -212,6 +240,8 @@ class ChassisIdentifier {
   // ---- probe state
   IdentificationPhase step_ = IdentificationPhase::kListening;
   Timestamp step_started_{0};
+  Timestamp timeout_from_{0};  // the timeout counts from here (start; the remote's hand-back)
+  std::string probe_hold_;     // hold_probe()
   std::optional<std::uint8_t> control_mode_raw_;  // 0x211 byte 1
   std::optional<protocol::MotionMode> mode_;      // 0x291 under the proposal's numbering
   bool switching_ = false;

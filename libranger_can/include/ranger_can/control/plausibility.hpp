@@ -1,7 +1,7 @@
 // Plausibility monitors: while driving, what the chassis reports is compared with what it should
 // report if the protocol settings are right, whatever the settings came from (identification,
 // a forced preset, a commissioning file). A wrong sign or unit is a runaway in waiting: detect,
-// stop, say why (issue 15, point 2).
+// stop, say why.
 //
 // Pure and clock-free, like the controller: the driver feeds raw frames (on_frame), the frames
 // the codec refused (on_rejected), and after every controller tick the controller's state, the
@@ -40,9 +40,13 @@
 //    other scale: bms_voltage_scale (warns).
 // Transients (acceleration, steer-first, mode switches, the command changing) reset the timers:
 // nothing is judged while the chassis switches modes, while motion is refused, or before the
-// command has held for the settle time.
+// command has held for the settle time. Feedback older than `feedback_freshness` is not judged.
+// Each check decides with a pure function returning a value (judge_steering, judge_reference,
+// judge_feedback_speed below); the finding's text is written from that value
+// only when something is off.
 #pragma once
 
+#include <array>
 #include <chrono>
 #include <cstdint>
 #include <optional>
@@ -80,9 +84,59 @@ struct PlausibilityConfig {
   int out_of_range_frames = 10;
   double rigid_residual = 0.05;  // relative RMS velocity error of the wheels' rigid-body fit
   double margin = 3.0;           // another reading must fit this many times better
+  // Feedback (0x221, 0x271, 0x281) older than this is not judged: one 50 Hz period and a half of
+  // jitter margin would do; 100 ms also covers a chassis sending at half rate.
+  std::chrono::nanoseconds feedback_freshness = std::chrono::milliseconds(100);
 
-  Status validate() const;  // durations >= 0 (stop_after > 0), ratios > 1, angles > 0
+  // durations >= 0 (stop_after, feedback_freshness > 0), ratios > 1, angles > 0
+  Status validate() const;
 };
+
+// ---- the decisions, as values --------------------------------------------------------------
+// The steering check's verdict: which setting the measured wheels (0x271, scale s271 of measured
+// over commanded) and 0x221's witness (scale s221) point at.
+enum class SteeringMismatch {
+  kNone,
+  kSign111,       // the wheels turned the other way, 0x221 agrees with them
+  kSign271,       // 0x271 shows the other way, 0x221 the commanded one
+  kSign111Or271,  // the wheels turned the other way, no witness to tell which
+  kUnit111,       // several times more or less than asked, 0x221 agrees with the wheels
+  kUnit271,       // 0x271 several times off, 0x221 shows what was asked
+  kUnit111Or271,  // several times off, no witness to tell which
+  kSign221,       // the wheels are right, 0x221 reports the other way
+  kUnit221,       // the wheels are right, 0x221 several times off
+};
+struct SteeringJudgement {
+  SteeringMismatch mismatch = SteeringMismatch::kNone;
+  bool more = false;  // unit mismatches: the wheels steered more than asked (else less)
+};
+// `s271`: least-squares scale of the measured over the commanded wheel angles; `s221`: 0x221's
+// reported over its expected angle (nullopt: stale or nothing to compare); `unit_ratio` as in
+// PlausibilityConfig.
+SteeringJudgement judge_steering(double s271, std::optional<double> s221, double unit_ratio);
+
+// The steering reference check: the commanded wheel angles under our reading and under the other
+// one, against the measured ones (max abs errors, rad). `other_fits`: the other reading fits
+// clearly better.
+struct ReferenceJudgement {
+  double error = 0.0;        // measured against our reading
+  double error_other = 0.0;  // ... against the other reading
+  double gap = 0.0;          // between the two readings' commands
+  bool other_fits = false;
+};
+ReferenceJudgement judge_reference(const std::array<double, kWheelCount>& measured,
+                                   const std::array<double, kWheelCount>& ours,
+                                   const std::array<double, kWheelCount>& other);
+
+// The 0x221 speed check: the reported speed against the wheels' mean and the body centre's.
+// `other_fits`: the reading that is not ours explains it, ours does not.
+struct FeedbackSpeedJudgement {
+  double mean_wheel = 0.0;   // m/s, signed as the body's vx
+  double body_centre = 0.0;  // m/s
+  bool other_fits = false;
+};
+FeedbackSpeedJudgement judge_feedback_speed(double reported, double mean_wheel, double body_centre,
+                                            FeedbackSpeed ours);
 
 // One mismatch: which check, the suspected setting and the value to try, what was seen.
 struct PlausibilityFinding {
@@ -131,6 +185,9 @@ class PlausibilityMonitor {
   void hold(Timer& t, PlausibilityFinding f, Timestamp now, std::chrono::nanoseconds stop_after,
             std::chrono::nanoseconds warn_after);
   void check_steering(Timestamp now, const ControllerState& c, const ChassisFeedback& fb);
+  void check_reference(Timestamp now, const MotionCommand& cmd,
+                       const std::array<double, kWheelCount>& wanted,
+                       const std::array<double, kWheelCount>& measured);
   void check_yaw(Timestamp now, const ControllerState& c, const OdometryState& odo);
   void check_speed(Timestamp now, const ControllerState& c, const ChassisFeedback& fb);
   void check_rigid(Timestamp now, const ChassisFeedback& fb);

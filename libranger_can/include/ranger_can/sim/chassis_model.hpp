@@ -7,7 +7,10 @@
 //    and the speed of the body centre; the centre of rotation lies on the body's y axis;
 //  * oblique (crab): the direction of travel and the speed along it; no rotation;
 //  * spin: the wheels stand tangent to the circle through them; the speed is the wheels'
-//    tangential speed (open point 5), counter-clockwise positive.
+//    tangential speed (open point 5), counter-clockwise positive;
+//  * side slip (MINI V1, agx_v2 mode 4): every wheel at 90 deg; the speed is the body's lateral
+//    speed, left positive;
+//  * park (agx_v2): the wheels stand as for spin and nothing moves (speed held at zero).
 // Steering slews towards its target at a finite rate and the speed follows with finite
 // acceleration. The body twist follows from (mode, steering, speed) and each wheel's velocity is
 // the rigid-body velocity of its contact point, v_i = (vx - wz*y_i, vy + wz*x_i), so the reported
@@ -22,11 +25,11 @@
 
 #include <array>
 
-#include "ranger_can/wire/codec.hpp"
 #include "ranger_can/control/geometry.hpp"
-#include "ranger_can/wire/interpretation.hpp"
 #include "ranger_can/control/kinematics.hpp"  // BodyTwist, WheelState(s)
 #include "ranger_can/control/odometry.hpp"    // Pose2D
+#include "ranger_can/wire/codec.hpp"
+#include "ranger_can/wire/interpretation.hpp"
 #include "ranger_can/wire/protocol.hpp"
 
 namespace ranger::sim {

@@ -8,7 +8,8 @@
 //                                       twist (m/s, m/s, rad/s) every 50 ms, the first at once
 //                 cmd none              the commander stops publishing
 //                 resume                Driver::resume() (the explicit re-arm)
-//                 mode auto|ackermann|oblique|spin    Driver::set_motion_mode()
+//                 mode auto|ackermann|oblique|spin|side_slip    Driver::set_motion_mode()
+//                 park on|off           Driver::set_park()
 //                 clear-errors CODE     Driver::clear_errors(): 0x441 code, 0-16 or 0x00-0x10
 //   chassis side  every command of sim::parse_chassis_command (remote, estop, error, clear,
 //                 battery, silent, garbage, stuck, ultrasonic, pose, status): applied to the
@@ -83,6 +84,7 @@ struct ScenarioAction {
     kResume,
     kMode,         // mode auto|ackermann|oblique|spin
     kClearErrors,  // clear-errors CODE
+    kPark,         // park on|off
     kChassis,      // a sim::parse_chassis_command line
     kWait,
     kExpect,
@@ -93,6 +95,7 @@ struct ScenarioAction {
   BodyTwist twist;                           // kCommand
   std::optional<protocol::MotionMode> mode;  // kMode (nullopt: auto)
   std::uint8_t code = 0;                     // kClearErrors
+  bool enable = false;                       // kPark
   ChassisAction chassis;                     // kChassis
   std::chrono::milliseconds wait{0};         // kWait
   Expectation expect;                        // kExpect
@@ -149,6 +152,7 @@ struct ScenarioSample {
   bool rearm_required = false;
   std::vector<std::string> latched;  // the latched stop causes
   double steer_first_factor = 1.0;
+  std::string identification = "none";  // its phase under protocol auto, else "none"
 };
 
 // The sample as one JSON object (no newline), with fixed formatting: seconds with 3 decimals,

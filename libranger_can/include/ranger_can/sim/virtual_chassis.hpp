@@ -27,6 +27,12 @@
 //    CAN mode (a host that only switched modes has not lost anything); the bit describes the link,
 //    so it clears when 0x111 resumes (that 0x111 is obeyed) or on 0x441 code 0x00, which also
 //    disarms the watchdog until the next 0x111.
+//  * Park (agx_v2 mode 3) and side slip (MINI V1 mode 3, agx_v2 mode 4) are modes like the others
+//    (chassis_model.hpp). A 0x141 park is obeyed only at standstill (reading); while parked a
+//    0x111 keeps the watchdog fed and moves nothing. In side slip 0x111's lateral speed is read
+//    from bytes 4-5 with the spin sign (the MINI V1's negated field), and 0x221 reports it in
+//    bytes 0-1, left positive, with 90 deg as the angle (reading).
+//  * Lights: chassis_lights.hpp (0x121 in CAN mode, the remote's SWA while it has the chassis).
 //  * 0x141 starts a switch: the body brakes to rest, then the wheels turn for
 //    `mode_switch_duration`; meanwhile 0x291 reports the mode being left with switching = 1 and
 //    speed commands are ignored. A 0x141 naming the current mode changes nothing.
@@ -41,6 +47,20 @@
 //  * With vendor_frames (the vendor's revision has them, the manual does not): 0x231 light state
 //    (what the last 0x121 set) and 0x241 remote-control state every 20 ms, each with a counter in
 //    byte 7, and an answer to every 0x4A1 version request (`version`, 8 characters a frame).
+//  * Under the remote control (control mode remote) the operator drives, per the manual's section
+//    2.3 (RemoteInput below): SWD up is dual Ackermann (left stick the speed, right stick the
+//    steering) and, with the left stick centred, spin (the right stick its direction); SWD down is
+//    oblique (left stick the speed, right stick the direction of travel, full deflection the
+//    chassis's oblique limit: 90 deg, lateral, on a RANGER). Full deflection is the chassis's own
+//    limit (MotionLimits): max_linear_speed, max_ackermann_angle, max_oblique_angle,
+//    max_spin_speed; a stick within kRemoteStickDeadband of centre reads as centred. A mode the
+//    sticks ask for is switched to as 0x141 would (brake to rest, turn the wheels), and the
+//    chassis drives the same model as under 0x111, so 0x221/0x271/0x281/0x291 report it as they
+//    report CAN driving. SWA down under the remote switches the lights off (0x231 reports both
+//    lights off), up on (ChassisLights);
+//    SWC in the middle enables the ultrasonic obstacle avoidance, up or down disables it. 0x241
+//    (vendor_frames) reports the switches and the sticks (int8, +-100 = full deflection; stick
+//    up and stick right positive).
 //  * Motion is refused (the chassis brakes to rest and ignores 0x111's motion) while: not in CAN
 //    mode, e-stop, a critical error bit (protocol::is_critical_error), battery under-voltage
 //    (set whenever SOC < 10 %, latched until 0x441 0x09 / 0x00 finds the SOC back at >= 10 %),
@@ -61,6 +81,7 @@
 #include <vector>
 
 #include "ranger_can/control/geometry.hpp"
+#include "ranger_can/sim/chassis_lights.hpp"
 #include "ranger_can/sim/chassis_model.hpp"
 #include "ranger_can/sim/drivetrain_model.hpp"
 #include "ranger_can/transport/bus.hpp"
@@ -70,6 +91,20 @@
 #include "ranger_can/wire/protocol.hpp"
 
 namespace ranger::sim {
+
+// A stick within this of centre reads as centred (a real stick's dead band).
+inline constexpr double kRemoteStickDeadband = 0.05;
+// 0x241's int8 stick value at full deflection.
+inline constexpr double kRemoteStickFullScale = 100.0;
+
+// The remote control as its operator holds it (manual section 2.3).
+struct RemoteInput {
+  protocol::RemoteSwitch swa = protocol::RemoteSwitch::kUp;  // lights: up on, down off
+  protocol::RemoteSwitch swc = protocol::RemoteSwitch::kUp;  // middle: ultrasonic avoidance on
+  protocol::RemoteSwitch swd = protocol::RemoteSwitch::kUp;  // up: Ackermann + spin; down: oblique
+  double left = 0.0;                                         // left stick, -1..1: + forward, - back
+  double right = 0.0;  // right stick, -1..1: + pushed right, - pushed left
+};
 
 struct VirtualChassisConfig {
   VehicleGeometry geometry;
@@ -116,8 +151,9 @@ struct ChassisSnapshot {
   std::string motion_refused_reason;  // empty when allowed
   bool silent = false;
   bool ultrasonic_enabled = false;
-  MotionTarget target;  // REP-103
-  double speed = 0.0;   // model speed (see MotionTarget)
+  RemoteInput remote;                 // the remote control's switches and sticks
+  MotionTarget target;                // REP-103
+  double speed = 0.0;                 // model speed (see MotionTarget)
   double steering = 0.0;
   BodyTwist twist;
   WheelStates wheels{};
@@ -125,6 +161,7 @@ struct ChassisSnapshot {
   double distance_travelled = 0.0;  // m, path length of the body centre since boot
   double yaw_travelled = 0.0;       // rad, total |rotation| since boot
   BatteryTelemetry battery;
+  LightState lights;  // what 0x231 reports (agx_v2 only sends it)
 };
 
 struct VirtualChassisCounters {
@@ -189,7 +226,19 @@ class VirtualChassis {
   bool clear_errors(std::uint8_t code);
   void set_ultrasonic(int sensor, std::int16_t raw);  // sensor 1..8
   void set_ultrasonic_enabled(bool enabled);          // the remote's SWC switch (no 0x451 involved)
+  // The remote control's switches and sticks (RemoteInput). They drive the chassis while the
+  // control mode is remote; SWC acts in every control mode (as it moves), SWA only under the
+  // remote (manual).
+  // Sticks are clamped to -1..1; a non-finite value reads as centred (the parsers refuse both).
+  void set_remote_swa(protocol::RemoteSwitch position);
+  void set_remote_swc(protocol::RemoteSwitch position);
+  void set_remote_swd(protocol::RemoteSwitch position);
+  void set_remote_sticks(double left, double right);
+  const RemoteInput& remote() const { return remote_; }
   void set_pose(const Pose2D& pose) { motion_.set_pose(pose); }
+  // The 0x4A1 answer from now on (vendor_frames only).
+  void set_version(std::string version) { config_.version = std::move(version); }
+  const ChassisLights& lights() const { return lights_; }
 
  private:
   struct Schedule {
@@ -207,6 +256,10 @@ class VirtualChassis {
   void update_conditions(Timestamp t);
   void apply_motion_policy();
   std::string refusal_reason() const;
+  std::string drive_refusal() const;  // what stops any driver, CAN or remote
+  void drive_by_remote();
+  protocol::MotionMode remote_mode() const;
+  MotionTarget remote_target() const;
   void event(std::string text);
 
   void handle_motion_command(const MotionCommand& cmd);
@@ -245,7 +298,8 @@ class VirtualChassis {
   std::uint32_t last_reported_errors_ = 0;
   std::uint8_t status_counter_ = 0;  // 0x211 byte 7 under agx16: +1 per frame
   std::uint8_t vendor_counter_ = 0;  // 0x231 / 0x241 byte 7: +1 per frame
-  LightCommand lights_;              // what the last 0x121 set (reported in 0x231)
+  ChassisLights lights_;             // what 0x231 reports (0x121, the remote's SWA)
+  RemoteInput remote_;               // the remote control's switches and sticks
   std::string last_refusal_;
 
   VirtualChassisCounters counters_;

@@ -184,6 +184,9 @@ std::optional<std::uint8_t> motion_mode_to_wire(MotionMode mode, ModeNumbering n
 
 // 0x241 switch positions (two bits per switch; wire values). 0 is not defined.
 enum class RemoteSwitch : std::uint8_t { kUndefined = 0, kMiddle = 1, kUp = 2, kDown = 3 };
+// 0x241 bytes 1-5: int8 stick and knob positions. Reading (no RANGER source states it): the
+// vendor's remote reports -100..100, full deflection at +-100, as on its other chassis.
+inline constexpr double kRemoteAxisFullScale = 100.0;
 // 0x121 / 0x231 light modes (wire values).
 enum class LightMode : std::uint8_t { kOff = 0, kOn = 1, kBreathing = 2, kCustom = 3 };
 

@@ -1,0 +1,252 @@
+// What the vendor's revision adds, through the driver runtime in lock-step with the virtual
+// chassis (sim:agx_v2, sim:mini_v1, sim): park, lights, the remote state and the firmware
+// version, and their refusals by name where the revision or the model lacks them.
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "ranger_can/control/driver.hpp"
+#include "ranger_can/control/model.hpp"
+#include "ranger_can/sim/chassis_commands.hpp"
+#include "ranger_can/sim/sim_bus_source.hpp"
+
+namespace ranger {
+namespace {
+
+using namespace std::chrono_literals;
+
+// The driver configured for a variant the way its `driver` options say.
+DriverConfig config_for(const std::string& variant) {
+  DriverConfig c;
+  if (variant == "agx_v2") c.controller.profile = *protocol_preset("agx_v2");
+  if (variant == "mini_v1") {
+    const auto model = model_preset("ranger_mini_v1");
+    EXPECT_TRUE(model.ok());
+    c.controller.geometry = model->geometry;
+    c.controller.limits = model->limits;
+    c.controller.profile = model->profile;
+  }
+  return c;
+}
+
+class Rig {
+ public:
+  explicit Rig(const std::string& variant, const std::string& firmware = "") {
+    sim::SimSourceOptions options;
+    options.lock_step = true;
+    if (!firmware.empty()) options.chassis.version = firmware;
+    auto source =
+        sim::open_bus_source(variant == "manual" ? "sim" : "sim:" + variant, clock_, options);
+    EXPECT_TRUE(source.ok());
+    sim_ = std::static_pointer_cast<sim::SimBusSource>(*source);
+    driver_ = std::make_unique<Driver>(config_for(variant), *source, clock_);
+    driver_->set_sent_observer([this](const SentEvent& e) { sent_.push_back(e.sent.frame.id); });
+  }
+  ~Rig() { driver_.reset(); }  // its shutdown stop is still observed
+
+  void step() {
+    clock_.advance(1ms);
+    sim_->step(clock_.now());
+    driver_->step(clock_.now());
+  }
+  bool run_until(const std::function<bool()>& done, std::chrono::nanoseconds timeout) {
+    const Timestamp end = clock_.now() + timeout;
+    while (!done()) {
+      if (clock_.now() >= end) return false;
+      step();
+    }
+    return true;
+  }
+  void drive(const BodyTwist& twist, std::chrono::nanoseconds d) {
+    const Timestamp end = clock_.now() + d;
+    while (clock_.now() < end) {
+      driver_->command(MotionRequest{twist, std::nullopt});
+      for (int i = 0; i < 50; ++i)
+        step();
+    }
+  }
+  bool ready() {
+    return run_until(
+        [&] {
+          const auto s = driver_->snapshot();
+          return s->controller.control_mode == protocol::ControlMode::kCan &&
+                 s->controller.motion_mode && s->vendor_frames != VendorFrames::kUnknown;
+        },
+        3s);
+  }
+  // Waits for request `id` to end (answered or failed).
+  RequestOutcome outcome(std::uint64_t id, std::chrono::nanoseconds timeout = 8s) {
+    run_until(
+        [&] {
+          const RequestOutcome* r = driver_->snapshot()->request(id);
+          return r && (r->state == RequestOutcome::State::kAnswered ||
+                       r->state == RequestOutcome::State::kFailed);
+        },
+        timeout);
+    const RequestOutcome* r = driver_->snapshot()->request(id);
+    return r ? *r : RequestOutcome{};
+  }
+
+  Driver& driver() { return *driver_; }
+  std::shared_ptr<const DriverSnapshot> snap() const { return driver_->snapshot(); }
+  sim::ChassisSnapshot chassis() { return sim_->snapshot(); }
+  sim::SimBusSource& sim() { return *sim_; }
+  bool sent(std::uint32_t id) const {
+    return std::find(sent_.begin(), sent_.end(), id) != sent_.end();
+  }
+
+ private:
+  ManualClock clock_{Timestamp(1000s)};
+  std::shared_ptr<sim::SimBusSource> sim_;
+  std::unique_ptr<Driver> driver_;
+  std::vector<std::uint32_t> sent_;
+};
+
+TEST(DriverPark, RefusesMotionByNameUntilReleased) {
+  Rig rig("agx_v2");
+  ASSERT_TRUE(rig.ready());
+  rig.drive({0.5, 0, 0}, 1s);
+  ASSERT_GT(rig.chassis().speed, 0.3);
+  // Park while moving: brought to rest first, then switched to park.
+  const RequestOutcome on = rig.outcome(rig.driver().set_park(true));
+  ASSERT_EQ(on.state, RequestOutcome::State::kAnswered) << on.message;
+  EXPECT_EQ(rig.chassis().motion_mode, protocol::MotionMode::kPark);
+  EXPECT_NEAR(rig.chassis().speed, 0.0, 1e-9);
+  // Motion refused by name; the chassis stays where it is.
+  const Pose2D parked_at = rig.chassis().pose;
+  rig.drive({0.5, 0, 0}, 1s);
+  EXPECT_EQ(rig.snap()->controller.refusal, MotionRefusal::kParked);
+  EXPECT_EQ(to_string(rig.snap()->controller.refusal), "parked");
+  EXPECT_NEAR(rig.chassis().pose.x, parked_at.x, 1e-6);
+  // Released: the chassis leaves park by itself and the next twist drives.
+  const RequestOutcome off = rig.outcome(rig.driver().set_park(false));
+  ASSERT_EQ(off.state, RequestOutcome::State::kAnswered) << off.message;
+  EXPECT_NE(rig.chassis().motion_mode, protocol::MotionMode::kPark);
+  rig.drive({0.5, 0, 0}, 2s);
+  EXPECT_EQ(rig.snap()->controller.refusal, MotionRefusal::kNone);
+  EXPECT_GT(rig.chassis().pose.x, parked_at.x + 0.3);
+}
+
+TEST(DriverPark, ParkReleasedWithoutATwistLeavesParkAtOnce) {
+  Rig rig("agx_v2");
+  ASSERT_TRUE(rig.ready());
+  ASSERT_EQ(rig.outcome(rig.driver().set_park(true)).state, RequestOutcome::State::kAnswered);
+  ASSERT_EQ(rig.outcome(rig.driver().set_park(false)).state, RequestOutcome::State::kAnswered);
+  EXPECT_EQ(rig.chassis().motion_mode, protocol::MotionMode::kAckermann);
+  EXPECT_FALSE(rig.snap()->controller.park_requested);
+}
+
+TEST(DriverPark, RefusedByNameWhereTheModeNumberingHasNoPark) {
+  for (const std::string variant : {"manual", "mini_v1"}) {
+    Rig rig(variant);
+    ASSERT_TRUE(rig.ready()) << variant;
+    const RequestOutcome r = rig.outcome(rig.driver().set_park(true));
+    EXPECT_EQ(r.state, RequestOutcome::State::kFailed) << variant;
+    EXPECT_NE(r.message.find("park: unsupported by protocol"), std::string::npos) << r.message;
+    EXPECT_FALSE(rig.snap()->controller.park_requested);
+    rig.drive({0.3, 0, 0}, 1s);
+    EXPECT_EQ(rig.snap()->controller.refusal, MotionRefusal::kNone) << variant;
+  }
+}
+
+TEST(DriverLights, AnsweredWithTheStateTheChassisReports) {
+  Rig rig("agx_v2");
+  ASSERT_TRUE(rig.ready());
+  ASSERT_TRUE(rig.snap()->lights.has_value());
+  EXPECT_EQ(rig.snap()->lights->front, protocol::LightMode::kOn) << "lights on at power-on";
+  LightsRequest req;
+  req.front = protocol::LightMode::kBreathing;
+  req.rear = protocol::LightMode::kCustom;
+  req.rear_brightness = 40;
+  auto id = rig.driver().set_lights(req);
+  ASSERT_TRUE(id.ok());
+  const RequestOutcome r = rig.outcome(*id);
+  ASSERT_EQ(r.state, RequestOutcome::State::kAnswered) << r.message;
+  EXPECT_EQ(r.message, "the chassis reports front breathing, rear custom 40");
+  const auto& l = *rig.snap()->lights;
+  EXPECT_TRUE(l.can_control);
+  EXPECT_EQ(l.front, protocol::LightMode::kBreathing);
+  EXPECT_EQ(l.rear, protocol::LightMode::kCustom);
+  EXPECT_EQ(l.rear_brightness, 40);
+  EXPECT_EQ(rig.chassis().lights.rear_custom, 40);
+  // A brightness above 100 is refused before anything is posted.
+  req.rear_brightness = 101;
+  EXPECT_FALSE(rig.driver().set_lights(req).ok());
+}
+
+TEST(DriverLights, UnderTheRemoteTheRequestFailsSayingWhatTheChassisReports) {
+  Rig rig("agx_v2");
+  ASSERT_TRUE(rig.ready());
+  rig.sim().with_chassis([](sim::VirtualChassis& c) { c.remote_takeover(); });
+  LightsRequest req;
+  req.front = req.rear = protocol::LightMode::kOff;
+  const RequestOutcome r = rig.outcome(*rig.driver().set_lights(req));
+  EXPECT_EQ(r.state, RequestOutcome::State::kFailed);
+  EXPECT_NE(r.message.find("front on, rear on"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("remote control"), std::string::npos) << r.message;
+}
+
+TEST(DriverLights, RefusedOnAChassisWithoutTheVendorFrames) {
+  Rig rig("manual");
+  ASSERT_TRUE(rig.ready());
+  EXPECT_EQ(rig.snap()->vendor_frames, VendorFrames::kAbsent);
+  const RequestOutcome r = rig.outcome(*rig.driver().set_lights(LightsRequest{}));
+  EXPECT_EQ(r.state, RequestOutcome::State::kFailed);
+  EXPECT_NE(r.message.find("lights: unsupported by protocol manual"), std::string::npos)
+      << r.message;
+  EXPECT_FALSE(rig.sent(protocol::kLightCommandId));
+  EXPECT_FALSE(rig.snap()->lights.has_value());
+  EXPECT_FALSE(rig.snap()->remote.has_value());
+}
+
+TEST(DriverFirmware, AskedOnceTheChassisIsHeardAndShown) {
+  Rig rig("agx_v2", "RANGER fw 5.7.3 sim");
+  ASSERT_TRUE(rig.run_until(
+      [&] { return rig.snap()->firmware.state == FirmwareVersion::State::kAnswered; }, 3s));
+  EXPECT_EQ(rig.snap()->firmware.text, "RANGER fw 5.7.3 sim");
+  EXPECT_EQ(rig.snap()->controller.counters.version_requests, 1u);
+  // Asked again after the chassis changed its answer (the control language's `version`).
+  rig.sim().with_chassis(
+      [](sim::VirtualChassis& c) { return *sim::apply_chassis_command("version 6.0.1", c); });
+  const RequestOutcome r = rig.outcome(rig.driver().request_firmware_version());
+  ASSERT_EQ(r.state, RequestOutcome::State::kAnswered) << r.message;
+  EXPECT_EQ(r.message, "6.0.1");
+  EXPECT_EQ(rig.snap()->firmware.text, "6.0.1");
+}
+
+TEST(DriverFirmware, NeverAskedOfAManualChassis) {
+  Rig rig("manual");
+  ASSERT_TRUE(rig.ready());
+  rig.drive({}, 1s);
+  EXPECT_EQ(rig.snap()->firmware.state, FirmwareVersion::State::kUnsupported);
+  EXPECT_FALSE(rig.sent(protocol::kVersionId));
+  const RequestOutcome r = rig.outcome(rig.driver().request_firmware_version());
+  EXPECT_EQ(r.state, RequestOutcome::State::kFailed);
+  EXPECT_NE(r.message.find("unsupported by protocol manual"), std::string::npos) << r.message;
+}
+
+TEST(DriverRemote, TheRemoteStateIsInTheSnapshot) {
+  Rig rig("agx_v2");
+  ASSERT_TRUE(rig.ready());
+  ASSERT_TRUE(rig.snap()->remote.has_value());
+  EXPECT_EQ(rig.snap()->remote->swb, protocol::RemoteSwitch::kUp);
+  EXPECT_EQ(rig.snap()->vendor_frames, VendorFrames::kPresent);
+}
+
+TEST(DriverRemote, SticksAreNormalisedAndSaturated) {
+  RemoteControlState rc;
+  rc.stick_left_v = 50;
+  rc.stick_right_h = -100;
+  rc.var_a = 127;
+  rc.swd = protocol::RemoteSwitch::kDown;
+  const RemoteState r = remote_state_from(rc, Timestamp(1s));
+  EXPECT_DOUBLE_EQ(r.left_vertical, 0.5);
+  EXPECT_DOUBLE_EQ(r.right_horizontal, -1.0);
+  EXPECT_DOUBLE_EQ(r.knob, 1.0);
+  EXPECT_EQ(r.swd, protocol::RemoteSwitch::kDown);
+}
+
+}  // namespace
+}  // namespace ranger

@@ -1,0 +1,172 @@
+#!/usr/bin/env bash
+# The repository as ROS 1 users get it: cloned as it is into the src/ of a fresh workspace and
+# built with the standard tools; the driver run from catkin_make's devel space; the plain CMake
+# build (tests included) configured and built with the oldest CMake we declare; catkin_lint.
+#
+#   scripts/test_workspaces.sh [STEP...]     (default: lint catkin_make colcon cmake316)
+#
+#   lint                  catkin_lint -W1 over the repository: no error, no warning
+#   catkin_make           `catkin_make` in build/workspaces/catkin_make, then the driver from its
+#                         devel space: `source devel/setup.bash; roslaunch ranger_bringup
+#                         ranger_minimal.launch sim:=true` until it reaches CAN command mode
+#   catkin_make_isolated  `catkin_make_isolated` in build/workspaces/catkin_make_isolated
+#   catkin_build          `catkin build` (catkin_tools) in build/workspaces/catkin_build
+#   colcon                `colcon build` in build/workspaces/colcon
+#   cmake316              CMake 3.16 (pip, in a venv cached under build/cmake-3.16): the top-level
+#                         build configured (library, tool, unit tests, system suites) and the tool
+#                         and two test executables built and run; RANGER_CMAKE316_FULL=1 builds and
+#                         runs everything
+#
+# Every build must print no CMake warning (nor "Manually-specified variables were not used").
+# The workspaces are fresh copies of the tracked files (with their working-tree contents).
+# Environment: RANGER_JOBS (default nproc); ROS_MASTER_URI is not used: the driver's run gets a
+# free port of its own.
+set -uo pipefail
+cd "$(dirname "$0")/.."
+root=$(pwd)
+work=$root/build/workspaces
+jobs=${RANGER_JOBS:-$(nproc)}
+steps=${*:-lint catkin_make colcon cmake316}
+export PATH=/usr/bin:$PATH  # the ROS tools need Debian's python3, not a pyenv one
+if [ -f /opt/ros/noetic/setup.bash ]; then set +u; source /opt/ros/noetic/setup.bash; set -u; fi
+mkdir -p "$work" && touch "$root/build/COLCON_IGNORE" "$root/build/CATKIN_IGNORE"
+failed=()
+
+# A fresh workspace WS with the repository in WS/src/ranger_ros.
+fresh_workspace() {
+  local ws=$1
+  rm -rf "$ws" && mkdir -p "$ws/src/ranger_ros"
+  git ls-files -z | tar --null -T - --ignore-failed-read -c 2>/dev/null \
+    | tar -x -C "$ws/src/ranger_ros"
+}
+
+# Runs a build command with its output in LOG; fails on a failed build or a CMake warning.
+checked_build() {  # log command...
+  local log=$1
+  shift
+  local start=$SECONDS
+  if ! "$@" >"$log" 2>&1; then
+    tail -40 "$log"
+    echo "FAILED: $* (log: $log)"
+    return 1
+  fi
+  if grep -nE "CMake (Deprecation )?Warning|Manually-specified variables were not used" "$log"; then
+    echo "FAILED: $* printed CMake warnings (log: $log)"
+    return 1
+  fi
+  echo "ok: $* ($((SECONDS - start)) s)"
+}
+
+step_lint() {
+  catkin_lint -W1 --strict . 2>&1 | grep -v "rosdep" ; return "${PIPESTATUS[0]}"
+}
+
+# The driver from a sourced workspace: ranger_minimal.launch sim:=true on a master of its own,
+# until /system_state reports CAN command mode with the protocol identified.
+run_driver() {  # setup.bash
+  (
+    set +u
+    source "$1"
+    set -u
+    port=$(python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0))
+print(s.getsockname()[1])')
+    export ROS_MASTER_URI=http://localhost:$port ROS_HOSTNAME=localhost
+    export ROS_HOME=$work/ros_home
+    log=$work/driver.log
+    roslaunch -p "$port" ranger_bringup ranger_minimal.launch sim:=true >"$log" 2>&1 &
+    launch=$!
+    python3 - <<'EOF'
+import sys
+import time
+
+import rospy
+from ranger_msgs.msg import SystemState
+
+rospy.init_node("workspace_check", anonymous=True, disable_signals=True)
+end = time.monotonic() + 90
+while time.monotonic() < end:
+    try:
+        m = rospy.wait_for_message("/system_state", SystemState, timeout=5)
+    except rospy.ROSException:
+        continue
+    if m.control_mode == 1 and m.identification == "decided":
+        print("driver: CAN command mode, protocol identified")
+        sys.exit(0)
+print("driver: no CAN command mode within 90 s")
+sys.exit(1)
+EOF
+    rc=$?
+    kill -INT "$launch" 2>/dev/null
+    wait "$launch"
+    [ $rc -eq 0 ] || tail -40 "$log"
+    exit $rc
+  )
+}
+
+step_catkin_make() {
+  local ws=$work/catkin_make
+  fresh_workspace "$ws"
+  (cd "$ws" && checked_build "$ws/build.log" catkin_make -j"$jobs") || return 1
+  run_driver "$ws/devel/setup.bash"
+}
+
+step_catkin_make_isolated() {
+  local ws=$work/catkin_make_isolated
+  fresh_workspace "$ws"
+  (cd "$ws" && checked_build "$ws/build.log" catkin_make_isolated -j"$jobs")
+}
+
+step_catkin_build() {
+  local ws=$work/catkin_build
+  fresh_workspace "$ws"
+  (cd "$ws" && catkin init >/dev/null &&
+    checked_build "$ws/build.log" catkin build --no-status --no-notify -j"$jobs" -p 1)
+}
+
+step_colcon() {
+  local ws=$work/colcon
+  fresh_workspace "$ws"
+  (cd "$ws" && checked_build "$ws/build.log" colcon build --event-handlers console_direct+ \
+    --executor sequential --cmake-args -DCMAKE_BUILD_TYPE=RelWithDebInfo)
+}
+
+step_cmake316() {
+  local venv=$root/build/cmake-3.16 build=$root/build/cmake316
+  if [ ! -x "$venv/bin/cmake" ]; then
+    /usr/bin/python3 -m venv "$venv" && "$venv/bin/pip" install -q cmake==3.16.8 || return 1
+  fi
+  "$venv/bin/cmake" --version | head -1
+  rm -rf "$build"
+  local generator=()
+  command -v ninja >/dev/null && generator=(-G Ninja)
+  checked_build "$build.configure.log" "$venv/bin/cmake" -S . -B "$build" "${generator[@]}" \
+    -DCMAKE_BUILD_TYPE=RelWithDebInfo || return 1
+  if [ "${RANGER_CMAKE316_FULL:-0}" = 1 ]; then
+    checked_build "$build.build.log" "$venv/bin/cmake" --build "$build" -j "$jobs" || return 1
+    (cd "$build" && "$venv/bin/ctest" -LE vcan -j "$jobs" --output-on-failure)
+  else
+    # A unit test of the library (GTest::Main, the test support library) and a system suite
+    # (tests/): linked and discovered as CMake 3.16 does it.
+    checked_build "$build.build.log" "$venv/bin/cmake" --build "$build" -j "$jobs" \
+      --target ranger_can_tool test_codec test_bus_loopback || return 1
+    (cd "$build" && "$venv/bin/ctest" -R '^(Codec|LoopbackNetwork|Loopback/)' -j "$jobs" \
+      --output-on-failure)
+  fi
+}
+
+for s in $steps; do
+  if [ "$(type -t "step_$s")" != function ]; then
+    echo "test_workspaces: unknown step '$s'" >&2
+    failed+=("$s")
+    continue
+  fi
+  echo "---- workspace step: $s"
+  start=$SECONDS
+  if "step_$s"; then
+    echo "---- $s: ok ($((SECONDS - start)) s)"
+  else
+    echo "---- $s: FAILED ($((SECONDS - start)) s)"
+    failed+=("$s")
+  fi
+done
+[ ${#failed[@]} -eq 0 ] || { echo "workspace steps failed: ${failed[*]}"; exit 1; }
