@@ -13,6 +13,7 @@
 
 #include "cli_commands.hpp"
 #include "ranger_can/control/controller.hpp"
+#include "ranger_can/control/identification.hpp"
 #include "ranger_can/sim/scenario.hpp"
 #include "ranger_can/text.hpp"
 #include "ranger_can/wire/protocol.hpp"
@@ -106,6 +107,33 @@ TEST(ScenarioParse, EveryActionWithItsLineNumber) {
   EXPECT_EQ(s.actions[10].expect.number, -0.5);
   EXPECT_EQ(s.duration, 1251ms);
   EXPECT_EQ(s.expectations, 4u);
+}
+
+// The enumerators 0, 1, ... of a contiguous enum until to_string says "unknown" are exactly its
+// `all` list: an enumerator added without its name in the list fails here.
+template <typename Enum, std::size_t N>
+void expect_all_list_complete(const Enum (&all)[N], const char* what) {
+  std::vector<std::string> named;
+  for (int i = 0; i < 256; ++i) {
+    const std::string_view name = to_string(static_cast<Enum>(i));
+    if (name == "unknown") break;
+    named.emplace_back(name);
+  }
+  EXPECT_EQ(named, text::names_of(all)) << what;
+}
+
+TEST(EnumNames, EveryAllListHoldsEveryEnumerator) {
+  expect_all_list_complete(kAllMotionRefusals, "MotionRefusal");
+  expect_all_list_complete(kAllControllerFaults, "ControllerFault");
+  expect_all_list_complete(kAllLinkStates, "LinkState");
+  expect_all_list_complete(kAllIdentificationPhases, "IdentificationPhase");
+  expect_all_list_complete(protocol::kAllFaults, "Fault");
+  expect_all_list_complete(protocol::kAllMotionModes, "MotionMode");
+  expect_all_list_complete(protocol::kAllControlModes, "ControlMode");
+  expect_all_list_complete(protocol::kAllVehicleStatuses, "VehicleStatus");
+  expect_all_list_complete(protocol::kAllRemoteSwitches, "RemoteSwitch");
+  expect_all_list_complete(protocol::kAllLightModes, "LightMode");
+  expect_all_list_complete(protocol::kAllDirections, "Direction");
 }
 
 // Every name the driver can report, taken from the enums' `all` lists and the fault table (a new

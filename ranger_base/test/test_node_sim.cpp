@@ -789,7 +789,7 @@ TEST_F(MiniV1, SideSlipThroughSetMotionModeMovesSidewaysWithOdometry) {
       << p.response.message;
 }
 
-// ---- safety through ROS (issue 13): the re-arm latch, resume, sim/inject ------------------------
+// ---- safety through ROS: the re-arm latch, resume, sim/inject ------------------------
 
 class Safety : public NodeSim {
  protected:

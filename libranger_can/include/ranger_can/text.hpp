@@ -43,12 +43,15 @@ inline std::string hex(std::uint32_t value, int width = 3) {
   return buf;
 }
 
-// `value` as the body of a JSON string (without the quotes): quote, backslash and control
-// characters escaped; other bytes (UTF-8 included) as they are.
+// `value` as the body of a JSON string (without the quotes): quote, backslash, \n, \r and \t
+// escaped as such, every other control byte and every byte outside ASCII (which may be bad UTF-8)
+// as \u00XX.
 inline std::string json_escape(std::string_view value) {
+  static constexpr char kHex[] = "0123456789abcdef";
   std::string out;
   out.reserve(value.size());
-  for (const char c : value) {
+  for (const char ch : value) {
+    const auto c = static_cast<unsigned char>(ch);
     switch (c) {
       case '"':
         out += "\\\"";
@@ -66,12 +69,12 @@ inline std::string json_escape(std::string_view value) {
         out += "\\t";
         break;
       default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned char>(c));
-          out += buf;
+        if (c < 0x20 || c >= 0x7F) {
+          out += "\\u00";
+          out += kHex[c >> 4];
+          out += kHex[c & 0x0F];
         } else {
-          out += c;
+          out += ch;
         }
     }
   }

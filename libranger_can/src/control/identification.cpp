@@ -9,6 +9,7 @@
 
 #include "ranger_can/control/kinematics.hpp"
 #include "ranger_can/control/odometry.hpp"
+#include "ranger_can/text.hpp"
 #include "ranger_can/wire/interpretation.hpp"
 
 namespace ranger {
@@ -42,9 +43,7 @@ std::string secs(std::chrono::nanoseconds d) {
   return fmt("%.2f", seconds(d)) + " s";
 }
 std::string hex_id(std::uint32_t id) {
-  char buf[16];
-  std::snprintf(buf, sizeof buf, "0x%03X", static_cast<unsigned>(id));
-  return buf;
+  return text::hex(id);
 }
 
 const std::array<AngleUnit, 2> kUnits = {AngleUnit::kCentidegree, AngleUnit::kMilliradian};

@@ -36,36 +36,9 @@ const char* const kActionsHelp =
     "\n"
     "chassis side, applied to the virtual chassis at once (what `status` prints goes to stderr):\n";
 
-const char* const kExpectHelp =
-    "\n"
-    "checks:\n"
-    "  expect refusal NAME      why motion is refused: none, link_lost, remote, estop,\n"
-    "                           critical_error, low_battery, mode_switch_failed,\n"
-    "                           implausible_feedback, rearm_required, standby, mode_unknown,\n"
-    "                           switching, cmd_timeout, below_minimum, parked\n"
-    "  expect control_mode standby|can|remote|null\n"
-    "  expect motion_mode ackermann|oblique|spin|park|side_slip|null   (the chassis's 0x291)\n"
-    "  expect rearm_required true|false\n"
-    "  expect identification listening|awaiting_control|spin_check|steer_probe|returning|\n"
-    "                           decided|failed|none   the identification's phase (none: the\n"
-    "                           protocol was given)\n"
-    "  expect moving | still    ground truth: the fastest point of the chassis (body centre or a\n"
-    "                           wheel) is faster than 1 mm/s | not faster\n"
-    "  expect fault NAME | no-fault NAME | no-faults\n"
-    "                           NAME as in the output's faults (emergency_stop, link_lost,\n"
-    "                           low_battery, over_current, ...)\n"
-    "  expect FIELD OP NUMBER   FIELD: t, truth.x|y|yaw|vx|vy|wz|speed, odom.x|y|yaw|vx|vy|wz,\n"
-    "                           steer_first_factor; OP: > < >= <= ==; the value as printed\n";
+// The checks, with the names each accepts (from the enums' `all` lists).
+std::string expect_help();
 }  // namespace
-
-const std::string& scenario_language_help() {
-  static const std::string text = [] {
-    std::string chassis = kChassisCommandHelp;
-    chassis.erase(0, chassis.find('\n') + 1);  // its own "commands (one per line):" heading
-    return std::string(kActionsHelp) + chassis + kExpectHelp;
-  }();
-  return text;
-}
 
 namespace {
 
@@ -164,13 +137,21 @@ const std::vector<std::string>& motion_mode_names() {
   return names;
 }
 
+// The fault table's names (protocol::kFaultTable), in its order.
+std::vector<std::string> fault_table_names() {
+  std::vector<std::string> n;
+  for (const protocol::FaultInfo& f : protocol::kFaultTable)
+    n.emplace_back(f.name);
+  return n;
+}
+
 // Every name ControllerState::faults can hold: the controller's own, the fault table's (either
 // layout) and a reserved bit's "reserved_bit_N".
 const std::vector<std::string>& fault_names() {
   static const std::vector<std::string> names = [] {
     std::vector<std::string> n = text::names_of(kAllControllerFaults);
-    for (const protocol::FaultInfo& f : protocol::kFaultTable)
-      n.emplace_back(f.name);
+    for (auto& name : fault_table_names())
+      n.push_back(std::move(name));
     for (int bit = 0; bit < 32; ++bit)
       n.push_back("reserved_bit_" + std::to_string(bit));
     return n;
@@ -181,6 +162,54 @@ const std::vector<std::string>& fault_names() {
 const std::vector<std::string>& bool_names() {
   static const std::vector<std::string> names = {"true", "false"};
   return names;
+}
+
+// One help entry: `head` in the first 27 columns, then `text` wrapped at 100 columns, its
+// continuation lines indented to column 27.
+std::string help_entry(const std::string& head, const std::string& text) {
+  constexpr std::size_t kIndent = 27;
+  std::string out;
+  std::string line =
+      head.size() < kIndent ? head + std::string(kIndent - head.size(), ' ') : head + " ";
+  const std::size_t start = line.size();
+  std::istringstream words(text);
+  std::string w;
+  while (words >> w) {
+    if (line.size() > start && line.size() + 1 + w.size() > 100) {
+      out += line + "\n";
+      line = std::string(kIndent, ' ');
+    } else if (line.size() > start || line.size() > kIndent) {
+      if (line.back() != ' ') line += ' ';
+    }
+    line += w;
+  }
+  while (!line.empty() && line.back() == ' ')
+    line.pop_back();
+  return out + line + "\n";
+}
+
+std::string expect_help() {
+  return "\n"
+         "checks:\n" +
+         help_entry("  expect refusal NAME", "why motion is refused: " + join(refusal_names())) +
+         help_entry("  expect control_mode " + join(control_mode_names(), "|"), "") +
+         help_entry("  expect motion_mode " + join(motion_mode_names(), "|"),
+                    "(the chassis's 0x291)") +
+         help_entry("  expect rearm_required true|false", "") +
+         help_entry("  expect identification NAME",
+                    "the identification's phase: " + join(identification_names()) +
+                        " (none: the protocol was given)") +
+         help_entry("  expect moving | still",
+                    "ground truth: the fastest point of the chassis (body centre or a wheel) is "
+                    "faster than 1 mm/s | not faster") +
+         help_entry("  expect fault NAME | no-fault NAME | no-faults", "") +
+         help_entry("", "NAME as in the output's faults: the driver's (" +
+                            join(text::names_of(kAllControllerFaults)) +
+                            "), a 0x211 fault of either error-word layout (" +
+                            join(fault_table_names()) + ") or reserved_bit_N") +
+         help_entry("  expect FIELD OP NUMBER",
+                    "FIELD: t, truth.x|y|yaw|vx|vy|wz|speed, odom.x|y|yaw|vx|vy|wz, "
+                    "steer_first_factor; OP: > < >= <= ==; the value as printed");
 }
 
 bool contains(const std::vector<std::string>& names, const std::string& name) {
@@ -216,19 +245,7 @@ std::string seconds_text(std::chrono::milliseconds t) {
 
 void append_string(std::string& out, std::string_view s) {
   out += '"';
-  for (char c : s) {
-    const auto u = static_cast<unsigned char>(c);
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (u < 0x20 || u >= 0x7F) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", u);
-      out += buf;
-    } else {
-      out += c;
-    }
-  }
+  out += text::json_escape(s);
   out += '"';
 }
 
@@ -970,6 +987,15 @@ Result<ScenarioResult> run_scenario(const Scenario& scenario, const ScenarioOpti
         << " more failed expectation(s) not shown\n";
   }
   return result;
+}
+
+const std::string& scenario_language_help() {
+  static const std::string text = [] {
+    std::string chassis = kChassisCommandHelp;
+    chassis.erase(0, chassis.find('\n') + 1);  // its own "commands (one per line):" heading
+    return std::string(kActionsHelp) + chassis + expect_help();
+  }();
+  return text;
 }
 
 }  // namespace ranger::sim

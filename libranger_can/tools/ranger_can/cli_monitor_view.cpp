@@ -8,6 +8,7 @@
 
 #include "cli_json.hpp"
 #include "ranger_can/control/geometry.hpp"
+#include "ranger_can/text.hpp"
 #include "ranger_can/wire/interpretation.hpp"
 #include "ranger_can/wire/protocol.hpp"
 
@@ -57,9 +58,7 @@ std::string age_text(Timestamp received, Timestamp now) {
 }
 
 std::string hex_id(std::uint32_t id) {
-  char buf[16];
-  std::snprintf(buf, sizeof buf, "0x%03X", id);
-  return buf;
+  return text::hex(id);
 }
 
 // Nominal frames per second of a feedback ID (0 for commands and on-change frames): the frame
