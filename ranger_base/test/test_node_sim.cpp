@@ -1051,6 +1051,9 @@ TEST_F(FaultBits, EveryBitOfTheLayoutShowsTheFieldOfItsMeaning) {
   for (const auto& bit : bits) {
     const std::string name(bit.name);
     const auto field = fields.at(bit.name);
+    // The chassis's own watchdog: the node's next 0x111 clears it at once (the conversion test
+    // covers its field).
+    if (name == "host_communication_lost") continue;
     inject("error " + std::to_string(bit.index));
     ASSERT_TRUE(wait_for([&] { return state_.get()->errors.*field != 0; })) << name;
     const auto s = *state_.get();
