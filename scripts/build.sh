@@ -33,3 +33,6 @@ colcon --log-base build/log build --base-paths . --build-base build/ws --install
   --event-handlers console_cohesion- summary+ \
   --parallel-workers "$jobs" \
   --cmake-args -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE="$build_type"
+# The install space holds the packages' manifests too: a catkin tool run in a workspace around
+# this checkout must not find them there (colcon leaves COLCON_IGNORE in it itself).
+touch install/CATKIN_IGNORE

@@ -10,8 +10,8 @@
 #   ros_vcan  the node against `ranger_can sim vcan0` over real SocketCAN (native or in the VM):
 #             stop on SIGINT / rosnode kill, the chassis's own stop after SIGKILL
 #   workspaces  the repository in the src/ of fresh ROS 1 workspaces (scripts/test_workspaces.sh):
-#             catkin_make (and the driver run from its devel space), catkin_make_isolated,
-#             catkin build, colcon; the plain build with CMake 3.16; catkin_lint -W1
+#             catkin_make (and the driver run from its devel space), catkin build, colcon; the
+#             plain build with CMake 3.16; catkin_lint -W1
 #   sanitize  ASan+UBSan and TSan builds of the library and its tests, ASan build of the ROS node
 #   fuzz      every libFuzzer target for a bounded time (RANGER_FUZZ_SECONDS, default 60)
 #

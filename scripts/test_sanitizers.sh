@@ -110,7 +110,7 @@ run_ros_build() {
       --cmake-args -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=Debug \
       "-DCMAKE_CXX_FLAGS=$common_flags $asan_flags" \
       "-DCMAKE_EXE_LINKER_FLAGS=$asan_flags" "-DCMAKE_SHARED_LINKER_FLAGS=$asan_flags" \
-      -DCATKIN_ENABLE_TESTING=ON -DRANGER_BUILD_TESTS=OFF -DRANGER_BUILD_BENCHMARKS=OFF
+      -DCATKIN_ENABLE_TESTING=ON
   ) || { echo "== asan-ros: BUILD FAILED"; return 1; }
   echo "== asan-ros: built in $((SECONDS - start)) s"
 

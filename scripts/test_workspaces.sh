@@ -3,9 +3,11 @@
 # built with the standard tools; the driver run from catkin_make's devel space; the plain CMake
 # build (tests included) configured and built with the oldest CMake we declare; catkin_lint.
 #
-#   scripts/test_workspaces.sh [STEP...]     (default: lint catkin_make colcon cmake316)
+#   scripts/test_workspaces.sh [STEP...]     (default: lint catkin_make catkin_build colcon
+#                                             cmake316)
 #
-#   lint                  catkin_lint -W1 over the repository: no error, no warning
+#   lint                  catkin_lint -W1 over the repository: no error, no warning; the catkin
+#                         tools find each package once (not again in build/ or install/)
 #   catkin_make           `catkin_make` in build/workspaces/catkin_make, then the driver from its
 #                         devel space: `source devel/setup.bash; roslaunch ranger_bringup
 #                         ranger_minimal.launch sim:=true` until it reaches CAN command mode
@@ -26,7 +28,7 @@ cd "$(dirname "$0")/.."
 root=$(pwd)
 work=$root/build/workspaces
 jobs=${RANGER_JOBS:-$(nproc)}
-steps=${*:-lint catkin_make colcon cmake316}
+steps=${*:-lint catkin_make catkin_build colcon cmake316}
 export PATH=/usr/bin:$PATH  # the ROS tools need Debian's python3, not a pyenv one
 if [ -f /opt/ros/noetic/setup.bash ]; then set +u; source /opt/ros/noetic/setup.bash; set -u; fi
 mkdir -p "$work" && touch "$root/build/COLCON_IGNORE" "$root/build/CATKIN_IGNORE"
@@ -57,8 +59,16 @@ checked_build() {  # log command...
   echo "ok: $* ($((SECONDS - start)) s)"
 }
 
+# catkin_lint, and the packages as the catkin tools find them in this checkout, build/ and
+# install/ included: each once (catkin_pkg refuses a name found twice), with CATKIN_IGNORE as the
+# only marker (older catkin_pkg, e.g. Noetic's, knows no COLCON_IGNORE).
 step_lint() {
-  catkin_lint -W1 --strict . 2>&1 | grep -v "rosdep" ; return "${PIPESTATUS[0]}"
+  catkin_lint -W1 --strict . 2>&1 | grep -v "rosdep"
+  [ "${PIPESTATUS[0]}" -eq 0 ] || return 1
+  python3 -c 'from catkin_pkg.packages import find_packages
+names = sorted(p.name for p in find_packages(".", ignore_markers={"CATKIN_IGNORE"}).values())
+print("catkin finds:", " ".join(names))
+assert len(names) == 5, names'
 }
 
 # The driver from a sourced workspace: ranger_minimal.launch sim:=true on a master of its own,
@@ -103,6 +113,25 @@ EOF
   )
 }
 
+# CMake 3.16.8 (Ubuntu 20.04's, the oldest we declare) from PyPI, in a venv cached under build/;
+# its cmake and ctest alone in build/cmake-3.16/tools (the venv's python3 must not shadow the
+# system one the ROS tools need).
+cmake316=$root/build/cmake-3.16
+cmake316_tools() {
+  if [ ! -x "$cmake316/bin/cmake" ]; then
+    /usr/bin/python3 -m venv "$cmake316" && "$cmake316/bin/pip" install -q cmake==3.16.8 || return 1
+  fi
+  mkdir -p "$cmake316/tools"
+  ln -sf ../bin/cmake "$cmake316/tools/cmake" && ln -sf ../bin/ctest "$cmake316/tools/ctest"
+}
+# CMake < 3.17 ignores the CMAKE_CXX_COMPILER_LAUNCHER environment variable (e.g. ccache).
+launcher_args=()
+[ -n "${CMAKE_CXX_COMPILER_LAUNCHER:-}" ] &&
+  launcher_args=(-DCMAKE_CXX_COMPILER_LAUNCHER="$CMAKE_CXX_COMPILER_LAUNCHER")
+
+# The ROS tools run the system's CMake: Debian's catkin finds GoogleTest through the targets of
+# CMake >= 3.20 (Noetic's catkin on Ubuntu 20.04 does not), so catkin with CMake 3.16 is a
+# combination no user has.
 step_catkin_make() {
   local ws=$work/catkin_make
   fresh_workspace "$ws"
@@ -131,25 +160,23 @@ step_colcon() {
 }
 
 step_cmake316() {
-  local venv=$root/build/cmake-3.16 build=$root/build/cmake316
-  if [ ! -x "$venv/bin/cmake" ]; then
-    /usr/bin/python3 -m venv "$venv" && "$venv/bin/pip" install -q cmake==3.16.8 || return 1
-  fi
-  "$venv/bin/cmake" --version | head -1
+  local build=$root/build/cmake316 tools=$cmake316/tools
+  cmake316_tools || return 1
+  "$tools/cmake" --version | head -1
   rm -rf "$build"
   local generator=()
   command -v ninja >/dev/null && generator=(-G Ninja)
-  checked_build "$build.configure.log" "$venv/bin/cmake" -S . -B "$build" "${generator[@]}" \
-    -DCMAKE_BUILD_TYPE=RelWithDebInfo || return 1
+  checked_build "$build.configure.log" "$tools/cmake" -S . -B "$build" "${generator[@]}" \
+    -DCMAKE_BUILD_TYPE=RelWithDebInfo "${launcher_args[@]}" || return 1
   if [ "${RANGER_CMAKE316_FULL:-0}" = 1 ]; then
-    checked_build "$build.build.log" "$venv/bin/cmake" --build "$build" -j "$jobs" || return 1
-    (cd "$build" && "$venv/bin/ctest" -LE vcan -j "$jobs" --output-on-failure)
+    checked_build "$build.build.log" "$tools/cmake" --build "$build" -j "$jobs" || return 1
+    (cd "$build" && "$tools/ctest" -LE vcan -j "$jobs" --output-on-failure)
   else
     # A unit test of the library (GTest::Main, the test support library) and a system suite
     # (tests/): linked and discovered as CMake 3.16 does it.
-    checked_build "$build.build.log" "$venv/bin/cmake" --build "$build" -j "$jobs" \
+    checked_build "$build.build.log" "$tools/cmake" --build "$build" -j "$jobs" \
       --target ranger_can_tool test_codec test_bus_loopback || return 1
-    (cd "$build" && "$venv/bin/ctest" -R '^(Codec|LoopbackNetwork|Loopback/)' -j "$jobs" \
+    (cd "$build" && "$tools/ctest" -R '^(Codec|LoopbackNetwork|Loopback/)' -j "$jobs" \
       --output-on-failure)
   fi
 }

@@ -138,6 +138,27 @@ TEST(DriverPark, ParkReleasedWithoutATwistLeavesParkAtOnce) {
   EXPECT_FALSE(rig.snap()->controller.park_requested);
 }
 
+TEST(DriverPark, AChassisFoundInParkIsLeftByReleasingIt) {
+  Rig rig("agx_v2");
+  ASSERT_TRUE(rig.ready());
+  // Parked by someone else (a previous session): nothing this driver can command in.
+  rig.sim().with_chassis([](sim::VirtualChassis& c) {
+    auto frame = encode(MotionModeCommand{protocol::MotionMode::kPark}, c.profile());
+    ASSERT_TRUE(frame.ok());
+    c.on_frame(*frame, c.now());
+  });
+  ASSERT_TRUE(rig.run_until([&] { return rig.snap()->controller.parked(); }, 2s));
+  rig.drive({0.3, 0, 0}, 500ms);
+  EXPECT_EQ(rig.snap()->controller.refusal, MotionRefusal::kModeUnknown);
+  EXPECT_EQ(rig.chassis().motion_mode, protocol::MotionMode::kPark);
+  // Releasing it switches the chassis out, and the twist drives.
+  const RequestOutcome off = rig.outcome(rig.driver().set_park(false));
+  ASSERT_EQ(off.state, RequestOutcome::State::kAnswered) << off.message;
+  rig.drive({0.3, 0, 0}, 2s);
+  EXPECT_EQ(rig.snap()->controller.refusal, MotionRefusal::kNone);
+  EXPECT_GT(rig.chassis().speed, 0.2);
+}
+
 TEST(DriverPark, RefusedByNameWhereTheModeNumberingHasNoPark) {
   for (const std::string variant : {"manual", "mini_v1"}) {
     Rig rig(variant);

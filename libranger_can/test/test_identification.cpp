@@ -237,6 +237,23 @@ TEST(DriverAuto, IdentifiesTheManualChassisThenDrivesTheRoute) {
   rig.expect_route("sim auto");
 }
 
+// While listening the driver withholds every frame from the controller on purpose: the library
+// itself refuses with `identifying` (the phase as an enum), never `link_lost`, so the node, the CLI
+// and the scenario all report the same.
+TEST(DriverAuto, ListeningIsRefusedAsIdentifyingNotAsALostLink) {
+  IdentifyRig rig("sim", test::auto_config());
+  rig.command({0.5, 0.0, 0.0});
+  rig.run_for(500ms);
+  const auto s = rig.snapshot();
+  ASSERT_EQ(s->identification->phase, IdentificationPhase::kListening);
+  EXPECT_EQ(s->controller.refusal, MotionRefusal::kIdentifying);
+  EXPECT_EQ(s->controller.identifying, IdentificationPhase::kListening);
+  EXPECT_TRUE(s->controller.quiet);
+  EXPECT_FALSE(rig.saw_refusal(MotionRefusal::kLinkLost));
+  ASSERT_TRUE(rig.run_until([&] { return rig.snapshot()->identification->done(); }, 12s));
+  EXPECT_FALSE(rig.snapshot()->controller.identifying.has_value());
+}
+
 TEST(DriverAuto, AChassisThatNeverAnswersStaysAtRestSayingWhy) {
   DriverConfig c = test::auto_config();
   c.identification.timeout = 3s;
@@ -249,8 +266,9 @@ TEST(DriverAuto, AChassisThatNeverAnswersStaysAtRestSayingWhy) {
   rig.run_for(4s);
   const auto s = rig.snapshot();
   ASSERT_EQ(s->identification->phase, IdentificationPhase::kFailed);
-  EXPECT_NE(s->controller.identifying.find("protocol: manual"), std::string::npos)
-      << s->controller.identifying;
+  EXPECT_EQ(s->controller.identifying, IdentificationPhase::kFailed);
+  EXPECT_NE(s->identification->message.find("protocol: manual"), std::string::npos)
+      << s->identification->message;
   EXPECT_TRUE(rig.sent().empty()) << "nothing is ever said to a chassis that is not heard";
 }
 
@@ -506,9 +524,9 @@ TEST_P(EveryVariant, AutoIdentifiesItAndDrivesTheRoute) {
     rig.run_for(3s);
     const auto after = rig.snapshot();
     EXPECT_EQ(after->controller.refusal, MotionRefusal::kIdentifying);
-    EXPECT_NE(after->controller.identifying.find("ranger_can commission IFACE --wheels-lifted"),
+    EXPECT_NE(after->identification->message.find("ranger_can commission IFACE --wheels-lifted"),
               std::string::npos)
-        << after->controller.identifying;
+        << after->identification->message;
     EXPECT_EQ(rig.truth().distance_travelled, 0.0) << "at rest";
     return;
   }

@@ -61,7 +61,7 @@ TEST(ProfilePresets, AgxV2FollowsTheVendorsSoftware) {
   EXPECT_EQ(v.steering_reference, SteeringReference::kInnerFront);
   EXPECT_EQ(v.spin_field, SpinField::kYawRate);
   EXPECT_EQ(v.spin_sign, +1);
-  EXPECT_EQ(v.feedback_speed, FeedbackSpeed::kMeanWheel);  // assumed
+  EXPECT_EQ(v.feedback_speed, FeedbackSpeed::kBodyCentre);  // its ROS 1 driver's odometry
   EXPECT_EQ(v.error_word, ErrorWordLayout::kAgxV2_16);
   EXPECT_TRUE(v.vehicle_status_1_is_estop);
   EXPECT_EQ(v.bms_voltage_scale, 0.1);
@@ -109,7 +109,7 @@ const std::vector<SettingCase>& setting_cases() {
       {"steering_reference", {"mean_front", "inner_front"}, "mean_front", "inner_front"},
       {"spin_field", {"wheel_speed", "yaw_rate"}, "wheel_speed", "yaw_rate"},
       {"spin_sign", {"ccw", "cw"}, "ccw", "ccw"},
-      {"feedback_speed", {"mean_wheel", "body_centre"}, "mean_wheel", "mean_wheel"},
+      {"feedback_speed", {"mean_wheel", "body_centre"}, "mean_wheel", "body_centre"},
       {"error_word", {"manual32", "agx16"}, "manual32", "agx16"},
       {"vehicle_status_1_is_estop", {"true", "false"}, "true", "true"},
       {"bms_voltage_scale", {"0.01", "0.1"}, "0.01", "0.1"},

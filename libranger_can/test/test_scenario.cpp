@@ -284,7 +284,7 @@ TEST(ScenarioParams, SetTheDriverSettingsByName) {
   DriverConfig c;
   ASSERT_TRUE(apply_scenario_param(c, "steer_first_threshold=0").ok());
   EXPECT_EQ(c.controller.steer_first_threshold, 0.0);
-  ASSERT_TRUE(apply_scenario_param(c, "cmd_timeout=2.5").ok());
+  ASSERT_TRUE(apply_scenario_param(c, "cmd_vel_timeout=2.5").ok());
   EXPECT_EQ(c.controller.cmd_timeout, 2500ms);
   ASSERT_TRUE(apply_scenario_param(c, "auto_reclaim_after_remote=true").ok());
   EXPECT_TRUE(c.controller.auto_reclaim_after_remote);
@@ -306,8 +306,9 @@ TEST(ScenarioParams, BadAssignmentsSayWhatIsWrong) {
       {"steer_first=0", "unknown parameter 'steer_first' (valid: steer_first_threshold"},
       {"steer_first_threshold=2", "steer_first_threshold: '2' is outside [0, 1.5708]"},
       {"steer_first_threshold=", "steer_first_threshold: '' is not a number"},
-      {"cmd_timeout=0", "cmd_timeout: '0' is outside"},
-      {"cmd_timeout=nan", "not a finite number"},
+      {"cmd_vel_timeout=0", "cmd_vel_timeout: '0' is outside [0.02, 60] s"},
+      {"cmd_vel_timeout=nan", "not a finite number"},
+      {"mode_switch_max_attempts=1.5", "mode_switch_max_attempts: '1.5' is outside [1, 100]"},
       {"auto_reclaim_after_remote=1", "expected true or false, got '1'"},
       {"low_battery_soc=101", "low_battery_soc"},
   };
@@ -397,7 +398,7 @@ TEST(ScenarioRun, TheCommanderDrivesAndGoingQuietTimesOut) {
 
 TEST(ScenarioRun, TheCmdTimeoutParameterIsTheDriverOne) {
   ScenarioOptions o;
-  ASSERT_TRUE(apply_scenario_param(o.driver, "cmd_timeout=3").ok());
+  ASSERT_TRUE(apply_scenario_param(o.driver, "cmd_vel_timeout=3").ok());
   const RunOutcome r =
       run("cmd 0.5 0 0\nwait 2\ncmd none\nwait 1\nexpect refusal none\nexpect moving\n", o);
   EXPECT_TRUE(r.result.passed()) << ::testing::PrintToString(r.failures);

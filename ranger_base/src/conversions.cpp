@@ -284,20 +284,16 @@ std::vector<std::string> cause_names(ranger::StopCauses causes) {
 }
 
 bool listening(const ranger::ControllerState& c) {
-  return c.quiet && !c.identifying.empty();
+  return c.quiet && c.identifying.has_value();
 }
 
 std::string refusal_name(const ranger::ControllerState& c) {
   if (c.refusal == ranger::MotionRefusal::kNone) return "";
-  // While the identification listens, the controller hears nothing on purpose: the reason
-  // motion waits is the identification, not a lost link.
-  if (c.refusal == ranger::MotionRefusal::kLinkLost && listening(c)) {
-    return std::string(ranger::to_string(ranger::MotionRefusal::kIdentifying));
-  }
   return std::string(ranger::to_string(c.refusal));
 }
 
-std::string describe_refusal(const ranger::ControllerState& c) {
+std::string describe_refusal(const ranger::DriverSnapshot& snapshot) {
+  const ranger::ControllerState& c = snapshot.controller;
   using R = ranger::MotionRefusal;
   using ranger::text::join;
   switch (c.refusal) {
@@ -309,11 +305,6 @@ std::string describe_refusal(const ranger::ControllerState& c) {
       }
       return "";
     case R::kLinkLost:
-      if (listening(c)) {
-        return c.identifying +
-               " (nothing is sent until the chassis has been heard; motion waits "
-               "for the identification)";
-      }
       return c.link == ranger::LinkState::kNeverConnected
                  ? "no chassis heard yet (waiting for its system status)"
                  : "chassis silent (link lost): motion stopped";
@@ -343,6 +334,10 @@ std::string describe_refusal(const ranger::ControllerState& c) {
       return c.awaiting_command_mode ? "standby: requesting CAN command mode"
                                      : "standby (auto_command_mode is off)";
     case R::kModeUnknown:
+      if (c.chassis_mode == protocol::MotionMode::kPark) {
+        return "the chassis is in park mode (parked before this driver ran): call park with "
+               "data = false to leave it";
+      }
       return "motion mode unknown (no motion-mode feedback yet)";
     case R::kSwitching:
       return "motion-mode switch in progress";
@@ -351,10 +346,20 @@ std::string describe_refusal(const ranger::ControllerState& c) {
     case R::kBelowMinimum:
       return "below_minimum: cmd_vel is below what the chassis can express (mode_selection/"
              "min_linear_speed, min_yaw_rate): not driven";
-    case R::kIdentifying:
+    case R::kIdentifying: {
+      if (c.standstill_probe && !c.identifying) return "standstill probe (ranger_can commission)";
       // The identification's own words: its phase, or (failed) what to set.
-      return c.identifying.empty() ? std::string("identifying the chassis's protocol settings")
-                                   : c.identifying;
+      const auto& id = snapshot.identification;
+      std::string words = id && !id->message.empty()
+                              ? id->message
+                              : std::string("identifying the chassis's protocol settings");
+      if (listening(c)) {
+        words +=
+            " (nothing is sent until the chassis has been heard; motion waits for the "
+            "identification)";
+      }
+      return words;
+    }
     case R::kParked:
       return c.parked() ? "parked: call park with data = false to drive again"
                         : "parking (bringing the chassis to rest, then to park mode): call park "
@@ -397,7 +402,7 @@ ranger_msgs::SystemState to_system_state(const ranger::DriverSnapshot& snapshot,
   if (snapshot.identification) {
     out.identification = std::string(ranger::to_string(snapshot.identification->phase));
   }
-  out.motion_inhibited_detail = describe_refusal(state);
+  out.motion_inhibited_detail = describe_refusal(snapshot);
   out.rearm_required = state.rearm_required();
   out.latched_causes = cause_names(state.latched_causes);
   out.active_causes = cause_names(state.active_causes);

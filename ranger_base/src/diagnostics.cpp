@@ -129,7 +129,7 @@ void diagnose_control(const DriverSnapshot& s, DiagnosticStatusWrapper& out) {
   if (c.last_solution) {
     out.add("Last command limits", ranger::kinematics_flags_to_string(c.last_solution->flags));
   }
-  const std::string detail = describe_refusal(c);
+  const std::string detail = describe_refusal(s);
   const bool identification_failed =
       s.identification && s.identification->phase == ranger::IdentificationPhase::kFailed;
 

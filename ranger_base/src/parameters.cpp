@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include <ranger_can/control/commissioning.hpp>
+#include <ranger_can/control/parameters.hpp>
 #include <ranger_can/sim/chassis_commands.hpp>
 #include <ranger_can/text.hpp>
 #include <ranger_can/transport/bus_source.hpp>
@@ -164,6 +165,32 @@ class Reader {
       default:
         fail(name, "= " + show(*raw) + ": expected " + expected);
         return std::nullopt;
+    }
+  }
+
+  // A row of the library's parameter table (ranger_can/control/parameters.hpp): its type, range
+  // and unit from the table, its default the value `config` holds.
+  void driver_parameter(const ranger::DriverParameter& row, ranger::DriverConfig& config) {
+    const std::string name(row.name);
+    if (!source_.get(name)) {
+      names_.push_back(name);
+      return;
+    }
+    const ranger::ParameterRange& range = row.range;
+    const double now = row.get(config);
+    switch (row.type) {
+      case ranger::ParameterType::kBool:
+        row.set(config, flag(name, now != 0.0) ? 1.0 : 0.0);
+        break;
+      case ranger::ParameterType::kInteger:
+        row.set(config, integer(name, static_cast<int>(now), static_cast<int>(range.lo),
+                                static_cast<int>(range.hi)));
+        break;
+      case ranger::ParameterType::kNumber:
+      case ranger::ParameterType::kSeconds:
+        row.set(config, number(name, now, {range.lo, range.hi, range.lo_open, range.hi_open},
+                               std::string(row.unit)));
+        break;
     }
   }
 
@@ -326,9 +353,6 @@ void read_protocol(Reader& r, const ranger::ModelPreset& model, NodeParameters& 
     pp.settings.emplace_back(name, *value);
   }
 
-  d.identification.timeout =
-      r.seconds("identify_timeout", d.identification.timeout, closed(1.0, 600.0));
-
   // The profile: a commissioning file, else the model's on the revision `protocol` names (the
   // model's own revision for auto: the fallback an identification starts from); then every
   // interpretation parameter.
@@ -392,8 +416,6 @@ NodeParameters read_all(Reader& r) {
   p.state_publish_rate =
       r.number("state_publish_rate", p.state_publish_rate, open_closed(0.0, 100.0), "Hz");
   p.publish_cmd = r.flag("publish_cmd", p.publish_cmd);
-  p.driver.reconnect_interval =
-      r.seconds("reconnect_interval", p.driver.reconnect_interval, closed(0.05, 60.0));
 
   // ---- the vehicle model: its geometry, limits and protocol profile are the defaults of the
   // geometry and limit parameters below and of the protocol settings; the virtual chassis (port
@@ -412,21 +434,10 @@ NodeParameters read_all(Reader& r) {
   c.limits = model.limits;
   p.sim.chassis = ranger::sim::chassis_for_model(model, p.sim.chassis);
 
-  // ---- control
-  c.cmd_timeout = r.seconds("cmd_vel_timeout", c.cmd_timeout, closed(0.02, 60.0));
-  c.auto_command_mode = r.flag("auto_command_mode", c.auto_command_mode);
-  c.auto_reclaim_after_remote = r.flag("auto_reclaim_after_remote", c.auto_reclaim_after_remote);
-  c.link_timeout = r.seconds("link_timeout", c.link_timeout, closed(0.02, 10.0));
-  c.min_command_interval =
-      r.seconds("min_command_interval", c.min_command_interval, closed(0.001, 0.02));
-  c.mode_switch_timeout =
-      r.seconds("mode_switch_timeout", c.mode_switch_timeout, closed(0.1, 30.0));
-  c.mode_switch_max_attempts =
-      r.integer("mode_switch_max_attempts", c.mode_switch_max_attempts, 1, 100);
-  c.standstill_speed = r.number("standstill_speed", c.standstill_speed, closed(0.0, 1.0), "m/s");
-  c.steer_first_threshold = r.number("steer_first_threshold", c.steer_first_threshold,
-                                     closed(0.0, M_PI / 2), "rad (0 disables)");
-  c.low_battery_soc = r.number("low_battery_soc", c.low_battery_soc, closed(0.0, 100.0), "%");
+  // ---- the library's parameter table: control, identify_timeout, reconnect_interval, automatic
+  // motion-mode selection, odometry timing and variance growth (ranger_can/control/parameters.hpp)
+  for (const ranger::DriverParameter& row : ranger::driver_parameters())
+    r.driver_parameter(row, p.driver);
 
   // ---- geometry (the model's; ranger_description/config/geometry.yaml for the RANGER)
   ranger::VehicleGeometry g = model.geometry;
@@ -472,28 +483,6 @@ NodeParameters read_all(Reader& r) {
   c.limit_vy = read_speed_limits(r, "linear/y", "m", 10.0);
   c.limit_wz = read_speed_limits(r, "angular/z", "rad", 10.0);
 
-  // ---- automatic motion-mode selection
-  auto& m = c.mode_selection;
-  m.lateral_enter =
-      r.number("mode_selection/lateral_enter", m.lateral_enter, closed(0.0, 10.0), "m/s");
-  m.lateral_exit =
-      r.number("mode_selection/lateral_exit", m.lateral_exit, closed(0.0, 10.0), "m/s");
-  m.linear_enter =
-      r.number("mode_selection/linear_enter", m.linear_enter, closed(0.0, 10.0), "m/s");
-  m.linear_exit = r.number("mode_selection/linear_exit", m.linear_exit, closed(0.0, 10.0), "m/s");
-  m.rotation_enter =
-      r.number("mode_selection/rotation_enter", m.rotation_enter, closed(0.0, 10.0), "rad/s");
-  m.rotation_exit =
-      r.number("mode_selection/rotation_exit", m.rotation_exit, closed(0.0, 10.0), "rad/s");
-  m.min_linear_speed =
-      r.number("mode_selection/min_linear_speed", m.min_linear_speed, closed(0.0, 1.0), "m/s");
-  m.min_yaw_rate =
-      r.number("mode_selection/min_yaw_rate", m.min_yaw_rate, closed(0.0, 1.0), "rad/s");
-  m.confirm_time = r.seconds("mode_selection/confirm_time", m.confirm_time, closed(0.0, 10.0));
-  m.min_dwell = r.seconds("mode_selection/min_dwell", m.min_dwell, closed(0.0, 60.0));
-  m.oblique_side_band = r.number("mode_selection/oblique_side_band", m.oblique_side_band,
-                                 Interval{0.0, M_PI / 2, false, true}, "rad (< 90 deg)");
-
   // ---- odometry
   const std::string source = r.text("odometry_source", std::string(ranger::to_string(o.source)));
   if (auto parsed = ranger::parse_odometry_source(source)) {
@@ -501,19 +490,12 @@ NodeParameters read_all(Reader& r) {
   } else {
     r.fail("odometry_source", "= \"" + source + "\": expected \"wheels\" or \"motion\"");
   }
-  o.wheel_data_timeout = r.seconds("wheel_data_timeout", o.wheel_data_timeout, closed(0.02, 5.0));
   p.pose_covariance_diagonal = r.diagonal("pose_covariance_diagonal", p.pose_covariance_diagonal);
   p.twist_covariance_diagonal =
       r.diagonal("twist_covariance_diagonal", p.twist_covariance_diagonal);
   // The node adds the floor above; the library models only the growth.
   o.initial_pose_variance_xy = 0.0;
   o.initial_pose_variance_yaw = 0.0;
-  o.pose_variance_per_meter =
-      r.number("pose_variance_per_meter", o.pose_variance_per_meter, closed(0.0, 1e3), "m^2/m");
-  o.yaw_variance_per_radian =
-      r.number("yaw_variance_per_radian", o.yaw_variance_per_radian, closed(0.0, 1e3), "rad^2/rad");
-  o.yaw_variance_per_meter =
-      r.number("yaw_variance_per_meter", o.yaw_variance_per_meter, closed(0.0, 1e3), "rad^2/m");
 
   // ---- ultrasonic as sensor_msgs/Range
   auto& u = p.ultrasonic;

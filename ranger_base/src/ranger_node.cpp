@@ -603,7 +603,7 @@ void RangerNode::log_state_changes(const ranger::DriverSnapshot& s) {
   log_protocol_changes(s);  // the identification's decision before "accepts motion"
   if (!last_refusal_ || *last_refusal_ != c.refusal) {
     using R = ranger::MotionRefusal;
-    const std::string detail = describe_refusal(c);
+    const std::string detail = describe_refusal(s);
     switch (c.refusal) {
       case R::kNone:
         ROS_INFO("chassis accepts motion commands");

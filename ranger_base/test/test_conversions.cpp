@@ -215,33 +215,34 @@ TEST(SystemState, ReArmNamesTheLatchedCausesAndWhatToDo) {
 }
 
 TEST(SystemState, ReclaimBlockedSteerFirstAndBelowMinimumAreSaid) {
-  ranger::ControllerState c;
+  ranger::DriverSnapshot snap;
+  ranger::ControllerState& c = snap.controller;
   c.link = ranger::LinkState::kConnected;
   c.refusal = ranger::MotionRefusal::kStandby;
   c.reclaim_blocked = true;
-  EXPECT_EQ(describe_refusal(c), "remote control had the chassis: call resume to take CAN control");
+  EXPECT_EQ(describe_refusal(snap),
+            "remote control had the chassis: call resume to take CAN control");
   c.reclaim_blocked = false;
   c.refusal = ranger::MotionRefusal::kBelowMinimum;
-  EXPECT_NE(describe_refusal(c).find("below_minimum"), std::string::npos);
+  EXPECT_NE(describe_refusal(snap).find("below_minimum"), std::string::npos);
   c.refusal = ranger::MotionRefusal::kNone;
-  EXPECT_EQ(describe_refusal(c), "");
+  EXPECT_EQ(describe_refusal(snap), "");
   c.steer_first_factor = 0.25;
-  EXPECT_NE(describe_refusal(c).find("steering first"), std::string::npos);
-  EXPECT_NE(describe_refusal(c).find("25 %"), std::string::npos) << describe_refusal(c);
-  ranger::DriverSnapshot snap;
-  snap.controller = c;
+  EXPECT_NE(describe_refusal(snap).find("steering first"), std::string::npos);
+  EXPECT_NE(describe_refusal(snap).find("25 %"), std::string::npos) << describe_refusal(snap);
   EXPECT_FLOAT_EQ(to_system_state(snap, ros::Time(1.0)).steer_first_factor, 0.25f);
 }
 
 TEST(SystemState, IdentifyingAndImplausibleAreSaidWithTheirReasons) {
   ranger::DriverSnapshot snap;
   auto& c = snap.controller;
-  // Listening: nothing sent, the controller deaf on purpose: "identifying", not "link_lost".
-  c.refusal = ranger::MotionRefusal::kLinkLost;
+  // Listening: nothing sent, the controller deaf on purpose: the library says "identifying".
+  c.refusal = ranger::MotionRefusal::kIdentifying;
   c.quiet = true;
-  c.identifying = "identifying the chassis: listening (0.4 s of 1.2 s)";
+  c.identifying = ranger::IdentificationPhase::kListening;
   snap.protocol = ranger::ProtocolChoice::kAuto;
   snap.identification = ranger::IdentificationStatus{};
+  snap.identification->message = "identifying the chassis: listening (0.4 s of 1.2 s)";
   auto state = to_system_state(snap, ros::Time(1.0));
   EXPECT_EQ(state.motion_inhibited_reason, "identifying");
   EXPECT_NE(state.motion_inhibited_detail.find("listening (0.4 s of 1.2 s)"), std::string::npos)
@@ -253,12 +254,13 @@ TEST(SystemState, IdentifyingAndImplausibleAreSaidWithTheirReasons) {
   c.quiet = false;
   c.link = ranger::LinkState::kConnected;
   c.refusal = ranger::MotionRefusal::kIdentifying;
-  c.identifying = "identifying the chassis: steering probe";
+  c.identifying = ranger::IdentificationPhase::kSteerProbe;
+  snap.identification->message = "identifying the chassis: steering probe";
   state = to_system_state(snap, ros::Time(1.0));
   EXPECT_EQ(state.motion_inhibited_reason, "identifying");
   EXPECT_EQ(state.motion_inhibited_detail, "identifying the chassis: steering probe");
   // A plausibility stop names the setting and the value to try.
-  c.identifying.clear();
+  c.identifying.reset();
   c.refusal = ranger::MotionRefusal::kImplausible;
   c.implausible_reason = "spin_sign: try cw (turns the other way)";
   snap.protocol = ranger::ProtocolChoice::kForced;
@@ -275,12 +277,13 @@ TEST(SystemState, IdentifyingAndImplausibleAreSaidWithTheirReasons) {
 
 // Every refusal has its words (the switch in describe_refusal is exhaustive: -Wswitch).
 TEST(SystemState, EveryRefusalIsDescribed) {
-  ranger::ControllerState c;
+  ranger::DriverSnapshot snap;
+  ranger::ControllerState& c = snap.controller;
   c.link = ranger::LinkState::kConnected;
   for (int r = static_cast<int>(ranger::MotionRefusal::kLinkLost);
        r <= static_cast<int>(ranger::MotionRefusal::kParked); ++r) {
     c.refusal = static_cast<ranger::MotionRefusal>(r);
-    EXPECT_FALSE(describe_refusal(c).empty()) << ranger::to_string(c.refusal);
+    EXPECT_FALSE(describe_refusal(snap).empty()) << ranger::to_string(c.refusal);
     EXPECT_EQ(refusal_name(c), std::string(ranger::to_string(c.refusal)));
   }
 }
@@ -298,6 +301,15 @@ TEST(SystemState, ParkAndTheFirmwareVersion) {
   EXPECT_NE(m.motion_inhibited_detail.find("call park with data = false"), std::string::npos);
   EXPECT_EQ(m.firmware_version, "fw 5.7.3");
   EXPECT_EQ(m.firmware_version_state, "answered");
+}
+
+TEST(SystemState, AChassisFoundInParkSaysHowToLeaveIt) {
+  ranger::DriverSnapshot snap;
+  ranger::ControllerState& c = snap.controller;
+  c.link = ranger::LinkState::kConnected;
+  c.refusal = ranger::MotionRefusal::kModeUnknown;
+  c.chassis_mode = ranger::protocol::MotionMode::kPark;
+  EXPECT_NE(describe_refusal(snap).find("call park with data = false"), std::string::npos);
 }
 
 // ---- the vendor's additions

@@ -244,7 +244,7 @@ TEST(ProtocolDiagnostics, AFailedIdentificationIsAnErrorNamingWhatToSetAndTheCom
   }
   // Control mode says why motion is refused, pointing at Protocol.
   s.controller.refusal = ranger::MotionRefusal::kIdentifying;
-  s.controller.identifying = s.identification->message;
+  s.controller.identifying = ranger::IdentificationPhase::kFailed;
   DiagnosticStatusWrapper control;
   diagnose_control(s, control);
   EXPECT_EQ(control.level, DiagnosticStatus::ERROR) << control.message;
@@ -284,9 +284,9 @@ TEST(ProtocolDiagnostics, WarningsAreWarnWithTheValueToTryAndAStopIsAnError) {
 TEST(ProtocolDiagnostics, ListeningIsNotAMissingChassis) {
   auto s = healthy();
   s.controller.link = ranger::LinkState::kNeverConnected;
-  s.controller.refusal = ranger::MotionRefusal::kLinkLost;
+  s.controller.refusal = ranger::MotionRefusal::kIdentifying;
   s.controller.quiet = true;
-  s.controller.identifying = "identifying the chassis: listening";
+  s.controller.identifying = ranger::IdentificationPhase::kListening;
   s.now = ranger::Timestamp(1s);
   s.frames.record(protocol::kSystemStatusId, s.now, true, 0);
   DiagnosticStatusWrapper link, control;

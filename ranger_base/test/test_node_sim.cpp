@@ -1259,6 +1259,94 @@ TEST_F(Implausible, AWrongSteeringReferenceIsWarnedThenStopped) {
 
 }  // namespace
 
+// ---- driving by the remote control (node_sim_remote.test) -------------------------------------
+// The virtual chassis boots under its remote (sim/boot_in_remote_mode) with protocol auto: the
+// node listens, learns the wheels' reading from the remote's driving, and its odometry follows the
+// chassis in every mode the remote drives (sim/inject's remote lines), the modes in system_state
+// being the chassis's own; handed back (SWB up) and re-armed, the identification decides.
+
+class Remote : public NodeSim {
+ protected:
+  void SetUp() override {
+    ASSERT_TRUE(wait_for([] {
+      const auto s = state_.get();
+      return s && s->link_up && s->control_mode == SystemState::CONTROL_MODE_REMOTE &&
+             inject_pub_.getNumSubscribers() > 0 && truth_.get();
+    })) << "the node never heard the chassis under its remote control";
+  }
+
+  struct Pose {
+    double x, y, yaw;
+  };
+  static Pose pose_of(const nav_msgs::Odometry& o) {
+    return {o.pose.pose.position.x, o.pose.pose.position.y, tf2::getYaw(o.pose.pose.orientation)};
+  }
+  // `to` in the frame of `from`.
+  static Pose relative(const Pose& from, const Pose& to) {
+    const double dx = to.x - from.x, dy = to.y - from.y;
+    const double c = std::cos(from.yaw), s = std::sin(from.yaw);
+    return {c * dx + s * dy, -s * dx + c * dy, std::remainder(to.yaw - from.yaw, 2 * M_PI)};
+  }
+  static bool still() {
+    const auto t = truth_.get();
+    const auto o = odom_.get();
+    return t && o && speed(*t) < 1e-3 && speed(*o) < 1e-3;
+  }
+
+  // The remote drives one segment from rest to rest; the odometry's displacement against the
+  // ground truth's, each in its own frame at the start (the e2e budget plus 1 cm for the topics'
+  // timing).
+  static void drive(const std::string& swd, const std::string& sticks, std::uint8_t mode,
+                    double seconds) {
+    SCOPED_TRACE(swd + " " + sticks);
+    ASSERT_TRUE(wait_for(still));
+    const Pose truth0 = pose_of(*truth_.get()), odom0 = pose_of(*odom_.get());
+    inject("remote swd " + swd);
+    inject("remote sticks " + sticks);
+    ASSERT_TRUE(wait_for([&] {
+      const auto s = state_.get();
+      return s->motion_mode == mode && !s->motion_mode_switching && speed(*truth_.get()) > 0.05;
+    })) << "the chassis's motion mode is reported, not one the node asked for";
+    wait_for([] { return false; }, seconds);
+    inject("remote sticks 0 0");
+    ASSERT_TRUE(wait_for(still));
+    wait_for([] { return false; }, 0.5);
+    const Pose truth = relative(truth0, pose_of(*truth_.get()));
+    const Pose odom = relative(odom0, pose_of(*odom_.get()));
+    const double distance = std::hypot(truth.x, truth.y);
+    EXPECT_NEAR(odom.x, truth.x, 0.01 + 0.01 * distance);
+    EXPECT_NEAR(odom.y, truth.y, 0.01 + 0.01 * distance);
+    EXPECT_NEAR(odom.yaw, truth.yaw, 1.0 * M_PI / 180.0);
+    EXPECT_GT(distance + std::abs(truth.yaw), 0.2) << "the segment must move";
+  }
+};
+
+TEST_F(Remote, OdometryFollowsTheRemoteInEveryModeThenTheIdentificationDecides) {
+  EXPECT_EQ(state_.get()->identification, "awaiting_control");
+  // Nothing published before the wheels' reading is known; the remote drives, and it is.
+  inject("remote sticks 0.2 -0.3");
+  ASSERT_TRUE(wait_for([] { return static_cast<bool>(odom_.get()) && joints_count_ > 0; }))
+      << "no odometry from the remote's driving";
+  EXPECT_EQ(state_.get()->identification, "awaiting_control");
+  inject("remote sticks 0 0");
+  drive("top", "0.2 -0.3", SystemState::MOTION_MODE_ACKERMANN, 4.0);
+  drive("top", "0 0.5", SystemState::MOTION_MODE_SPIN, 3.0);
+  drive("bottom", "0.2 0.5", SystemState::MOTION_MODE_OBLIQUE, 3.0);
+  drive("top", "0.2 0.3", SystemState::MOTION_MODE_ACKERMANN, 3.0);
+  EXPECT_EQ(state_.get()->identification, "awaiting_control");
+  EXPECT_EQ(odom_stamp_regressions_, 0);
+  // SWB up, the re-arm: the probe at standstill, decided; cmd_vel drives.
+  inject("remote can");
+  ASSERT_TRUE(wait_for([] { return state_.get()->control_mode == SystemState::CONTROL_MODE_CAN; }));
+  const auto resumed = call_resume();
+  EXPECT_TRUE(resumed.success) << resumed.message;
+  ASSERT_TRUE(wait_for([] { return state_.get()->identification == "decided"; }, 30.0))
+      << state_.get()->motion_inhibited_detail;
+  EXPECT_TRUE(
+      drive_until(twist(0.3, 0, 0), [] { return truth_.get()->twist.twist.linear.x > 0.2; }));
+  stop_and_settle();
+}
+
 int main(int argc, char** argv) {
   ::testing::InitGoogleTest(&argc, argv);
   ros::init(argc, argv, "test_node_sim");

@@ -1,14 +1,16 @@
 // Parameter loading and validation, without a ROS master (MapParameterSource).
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <string>
-#include <unistd.h>
 
 #include "ranger_base/parameters.hpp"
+
+#include <ranger_can/control/parameters.hpp>
 
 namespace ranger_base {
 namespace {
@@ -209,45 +211,42 @@ TEST_P(RejectsBadValue, NamingTheParameterAndTheValidRange) {
 
 INSTANTIATE_TEST_SUITE_P(
     Parameters, RejectsBadValue,
-    ::testing::Values(BadValue{"publish_rate", -5.0, "(0, 1000] Hz"},
-                      BadValue{"publish_rate", 0.0, "(0, 1000] Hz"},
-                      BadValue{"publish_rate", "fast", "expected a number"},
-                      BadValue{"cmd_vel_timeout", 0.0, "[0.02, 60] s"},
-                      BadValue{"cmd_vel_timeout", std::numeric_limits<double>::quiet_NaN(),
-                               "[0.02, 60] s"},
-                      BadValue{"wheelbase", -0.89, "(0, 10] m"},
-                      BadValue{"track", 0.0, "(0, 10] m"},
-                      BadValue{"max_linear_speed", 3.0, "not in (0, 2.6"},
-                      BadValue{"max_ackermann_steering", 1.0, "40 deg"},
-                      BadValue{"max_spin_wheel_speed", 1.5, "(0, 1] m/s"},
-                      BadValue{"model", "ranger_maxi", "ranger_mini_v1, ranger_mini_v2"},
-                      BadValue{"protocol", "agx_v3", "auto, manual, agx_v2"},
-                      BadValue{"protocol", true, "expected a string"},
-                      BadValue{"steering_unit_111", "mrad", "centideg, millirad"},
-                      BadValue{"spin_sign", "left", "ccw, cw"},
-                      BadValue{"tx_dlc", 5, "0, 8"},
-                      BadValue{"bms_voltage_scale", 1.0, "0.01, 0.1"},
-                      BadValue{"vehicle_status_1_is_estop", "maybe", "true, false"},
-                      BadValue{"steering_reference", list({1, 2}), "mean_front, inner_front"},
-                      BadValue{"identify_timeout", 0.0, "[1, 600] s"},
-                      BadValue{"commissioning_file", "/nonexistent/ranger.yaml",
-                               "/nonexistent/ranger.yaml"},
-                      BadValue{"odometry_source", "gps", "\"wheels\" or \"motion\""},
-                      BadValue{"port_name", "", "CAN interface name"},
-                      BadValue{"port_name", "a/b", "CAN interface name"},
-                      BadValue{"port_name", "replay:", "replay:FILE"},
-                      BadValue{"steer_first_threshold", 2.0, "[0, 1.5708] rad"},
-                      BadValue{"frame_prefix", "/robot1/", "no leading '/'"},
-                      BadValue{"odom_frame", "/odom", "no leading '/'"},
-                      BadValue{"base_frame", "odom", "must differ from odom_frame"},
-                      BadValue{"publish_odom_tf", 1, "expected true or false"},
-                      BadValue{"pose_covariance_diagonal", list({1, 2, 3, 4, 5}), "list of 6"},
-                      BadValue{"twist_covariance_diagonal", list({1, 1, 1, -1, 1, 1}), "list of 6"},
-                      BadValue{"linear/x/max_acceleration", -1.0, "(0, 1000] m/s^2"},
-                      BadValue{"low_battery_soc", 120.0, "[0, 100] %"},
-                      BadValue{"mode_switch_max_attempts", 0, "[1, 100]"},
-                      BadValue{"ultrasonic/max_range", 0.01, "m"},
-                      BadValue{"sim/errors", XmlRpcValue("motor_driver_9"), "list of strings"}));
+    ::testing::Values(
+        BadValue{"publish_rate", -5.0, "(0, 1000] Hz"},
+        BadValue{"publish_rate", 0.0, "(0, 1000] Hz"},
+        BadValue{"publish_rate", "fast", "expected a number"},
+        BadValue{"cmd_vel_timeout", 0.0, "[0.02, 60] s"},
+        BadValue{"cmd_vel_timeout", std::numeric_limits<double>::quiet_NaN(), "[0.02, 60] s"},
+        BadValue{"wheelbase", -0.89, "(0, 10] m"}, BadValue{"track", 0.0, "(0, 10] m"},
+        BadValue{"max_linear_speed", 3.0, "not in (0, 2.6"},
+        BadValue{"max_ackermann_steering", 1.0, "40 deg"},
+        BadValue{"max_spin_wheel_speed", 1.5, "(0, 1] m/s"},
+        BadValue{"model", "ranger_maxi", "ranger_mini_v1, ranger_mini_v2"},
+        BadValue{"protocol", "agx_v3", "auto, manual, agx_v2"},
+        BadValue{"protocol", true, "expected a string"},
+        BadValue{"steering_unit_111", "mrad", "centideg, millirad"},
+        BadValue{"spin_sign", "left", "ccw, cw"}, BadValue{"tx_dlc", 5, "0, 8"},
+        BadValue{"bms_voltage_scale", 1.0, "0.01, 0.1"},
+        BadValue{"vehicle_status_1_is_estop", "maybe", "true, false"},
+        BadValue{"steering_reference", list({1, 2}), "mean_front, inner_front"},
+        BadValue{"identify_timeout", 0.0, "[1, 600] s"},
+        BadValue{"commissioning_file", "/nonexistent/ranger.yaml", "/nonexistent/ranger.yaml"},
+        BadValue{"odometry_source", "gps", "\"wheels\" or \"motion\""},
+        BadValue{"port_name", "", "CAN interface name"},
+        BadValue{"port_name", "a/b", "CAN interface name"},
+        BadValue{"port_name", "replay:", "replay:FILE"},
+        BadValue{"steer_first_threshold", 2.0, "[0, 1.5708] rad"},
+        BadValue{"frame_prefix", "/robot1/", "no leading '/'"},
+        BadValue{"odom_frame", "/odom", "no leading '/'"},
+        BadValue{"base_frame", "odom", "must differ from odom_frame"},
+        BadValue{"publish_odom_tf", 1, "expected true or false"},
+        BadValue{"pose_covariance_diagonal", list({1, 2, 3, 4, 5}), "list of 6"},
+        BadValue{"twist_covariance_diagonal", list({1, 1, 1, -1, 1, 1}), "list of 6"},
+        BadValue{"linear/x/max_acceleration", -1.0, "(0, 1000] m/s^2"},
+        BadValue{"low_battery_soc", 120.0, "[0, 100] %"},
+        BadValue{"mode_switch_max_attempts", 0, "[1, 100]"},
+        BadValue{"ultrasonic/max_range", 0.01, "m"},
+        BadValue{"sim/errors", XmlRpcValue("motor_driver_9"), "list of strings"}));
 
 // ---- protocol settings: protocol, model, the interpretation parameters, commissioning_file --
 
@@ -324,8 +323,8 @@ TEST(Protocol, InterpretationParametersForceTheirSettingsAfterThePreset) {
   MapParameterSource source;
   source.values["protocol"] = "manual";
   source.values["steering_unit_111"] = "millirad";
-  source.values["tx_dlc"] = 8;                          // an int
-  source.values["bms_voltage_scale"] = 0.1;             // a double
+  source.values["tx_dlc"] = 8;                         // an int
+  source.values["bms_voltage_scale"] = 0.1;            // a double
   source.values["vehicle_status_1_is_estop"] = false;  // a bool
   auto p = load_parameters(source);
   ASSERT_TRUE(p.ok()) << p.error().message;
@@ -337,8 +336,8 @@ TEST(Protocol, InterpretationParametersForceTheirSettingsAfterThePreset) {
   EXPECT_EQ(p->driver.controller.profile, expected);
   EXPECT_EQ(p->driver.protocol, ranger::ProtocolChoice::kForced);
   ASSERT_EQ(p->protocol.settings.size(), 4u);  // in the settings table's order
-  EXPECT_EQ(p->protocol.settings[0], std::make_pair(std::string("steering_unit_111"),
-                                                    std::string("millirad")));
+  EXPECT_EQ(p->protocol.settings[0],
+            std::make_pair(std::string("steering_unit_111"), std::string("millirad")));
   EXPECT_NE(p->protocol.source.find("with steering_unit_111: millirad"), std::string::npos)
       << p->protocol.source;
 }
@@ -358,11 +357,12 @@ TEST(Protocol, InterpretationParametersWithAutoForceTheProfile) {
 }
 
 TEST(Protocol, ACommissioningFileIsForcedOverProtocolAndModelAndUnderTheParameters) {
-  const TempFile file("# ranger_can commission sim:spin_cw --wheels-lifted\nprotocol: manual\n"
-                      "spin_sign: cw\nfeedback_speed: body_centre\n");
+  const TempFile file(
+      "# ranger_can commission sim:spin_cw --wheels-lifted\nprotocol: manual\n"
+      "spin_sign: cw\nfeedback_speed: body_centre\n");
   MapParameterSource source;
   source.values["commissioning_file"] = file.path();
-  source.values["protocol"] = "agx_v2";         // the file wins
+  source.values["protocol"] = "agx_v2";            // the file wins
   source.values["feedback_speed"] = "mean_wheel";  // a parameter wins over the file
   auto p = load_parameters(source);
   ASSERT_TRUE(p.ok()) << p.error().message;
@@ -400,9 +400,9 @@ TEST(Protocol, UnknownModelProtocolAndValuesAreRefusedAllAtOnceListingTheValidOn
   source.values["protocol"] = "vendor";
   source.values["steering_sign_271"] = "up";
   const std::string message = load_error(source);
-  for (const char* expected : {"~model", "ranger, ranger_mini_v1, ranger_mini_v2, ranger_mini_v3",
-                               "~protocol", "auto, manual, agx_v2", "~steering_sign_271",
-                               "right_positive, left_positive"}) {
+  for (const char* expected :
+       {"~model", "ranger, ranger_mini_v1, ranger_mini_v2, ranger_mini_v3", "~protocol",
+        "auto, manual, agx_v2", "~steering_sign_271", "right_positive, left_positive"}) {
     EXPECT_NE(message.find(expected), std::string::npos) << expected << " in:\n" << message;
   }
 }
@@ -463,6 +463,36 @@ TEST(Parameters, EveryParameterIsDocumentedInTheReadme) {
   for (const auto& name : known_parameter_names()) {
     EXPECT_NE(text.str().find("`" + name + "`"), std::string::npos)
         << name << " is not documented in ranger_base/README.md";
+  }
+}
+
+// The library's parameter table is the one source of names, ranges and defaults: the node reads
+// every row (defaults included), and the README's rows are the table's, character for character.
+TEST(Parameters, TheLibrarysTableIsWhatTheNodeReadsAndTheReadmeShows) {
+  MapParameterSource empty;
+  const auto p = load_parameters(empty);
+  ASSERT_TRUE(p.ok()) << p.error().message;
+  const auto& known = known_parameter_names();
+  std::ifstream in(std::string(RANGER_BASE_SOURCE_DIR) + "/README.md");
+  ASSERT_TRUE(in) << "README.md not found";
+  std::stringstream text;
+  text << in.rdbuf();
+  for (const ranger::DriverParameter& row : ranger::driver_parameters()) {
+    const std::string name(row.name);
+    EXPECT_NE(std::find(known.begin(), known.end(), name), known.end()) << name;
+    EXPECT_EQ(row.get(p->driver), ranger::default_value(row)) << name;
+    EXPECT_NE(text.str().find(ranger::markdown_row(row) + "\n"), std::string::npos)
+        << "ranger_base/README.md should have the row\n"
+        << ranger::markdown_row(row);
+    // Out of range: the node names the parameter and the table's range.
+    MapParameterSource bad;
+    bad.values[name] = row.type == ranger::ParameterType::kBool ? XmlRpcValue(3.0)
+                                                                : XmlRpcValue(row.range.hi + 1.0);
+    const std::string message = load_error(bad);
+    EXPECT_NE(message.find("~" + name), std::string::npos) << message;
+    if (row.type != ranger::ParameterType::kBool) {
+      EXPECT_NE(message.find(ranger::valid_text(row)), std::string::npos) << message;
+    }
   }
 }
 

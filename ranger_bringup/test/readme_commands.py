@@ -669,8 +669,8 @@ RULES = [
     Rule(r"colcon list", colcon_list, "runs; lists the five packages"),
     Rule(r"cd ~/catkin_ws && (?P<tool>catkin_make|catkin_make_isolated|catkin build|colcon build)"
          r" && source (?P<space>devel|devel_isolated|install)/setup\.bash", workspace_build_in_ci,
-         "verified: scripts/test_workspaces.sh (test.sh's workspaces stage) runs that tool in a "
-         "fresh workspace"),
+         "verified: scripts/test_workspaces.sh (test.sh's workspaces stage; catkin_make_isolated "
+         "on request) has a step running that tool in a fresh workspace"),
     Rule(r"(RANGER_STAGES=(?P<stages>\S+|\"[^\"]*\") )?\./scripts/test\.sh", test_sh_is_what_ci_runs,
          "verified: it runs this check; .ci/run runs it; the stages named exist"),
     Rule(r"\./scripts/demo\.sh|scripts/demo\.sh --no-setup --no-build --headless",

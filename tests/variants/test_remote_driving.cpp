@@ -7,6 +7,7 @@
 // complete from the remote's own driving. Lock-step under a ManualClock (1 ms: the chassis, then
 // the driver); no threads, no sleeping. Prints "[remote-odometry] ..." per segment and
 // "[remote-identification] ..." with the simulated time the identification took.
+#include <algorithm>
 #include <optional>
 #include <string>
 #include <vector>
@@ -222,8 +223,8 @@ namespace {
 // the pose kept.
 struct AutoCase {
   std::string variant;
-  // What the operator drives first: "arc" (Ackermann, steered) or "spin" at once, or "idle_arc"
-  // (the arc after 15 s at rest).
+  // What the operator drives first: "arc" (Ackermann, steered) or "spin" at once, "idle_arc"
+  // (the arc after 15 s at rest), or "spin_at_rest" (a switch to spin mode, nothing rolling).
   const char* first;
 };
 void PrintTo(const AutoCase& c, std::ostream* os) {
@@ -250,14 +251,26 @@ TEST_P(RemoteIdentification, CompletesFromTheRemotesDrivingAndTheOdometryHolds) 
     EXPECT_NE(idle->identification->message.find("not known yet"), std::string::npos)
         << idle->identification->message;
   }
-  const Timestamp driving = rig.now();
+  Timestamp driving = rig.now();
   // The operator drives.
   const RemoteSegment first =
       std::string(c.first) == "spin"
           ? RemoteSegment{"spin", "top", 0.0, -0.5, MotionMode::kSpin, 3}
           : RemoteSegment{"arc", "top", 0.2, -0.3, MotionMode::kAckermann, 3};
-  rig.remote(std::string("remote swd ") + first.swd);
-  rig.remote("remote sticks " + std::to_string(first.left) + " " + std::to_string(first.right));
+  const bool spin_at_rest = std::string(c.first) == "spin_at_rest";
+  if (spin_at_rest) {
+    // Past the listening, the operator pushes the right stick only long enough for the switch
+    // to spin mode to begin, then lets go: the wheels turn to the spin position and stand there,
+    // nothing rolls. The spin position alone tells the reading.
+    rig.run_for(2s);
+    driving = rig.now();
+    rig.remote("remote sticks 0 0.5");
+    rig.run_for(300ms);
+    rig.remote("remote sticks 0 0");
+  } else {
+    rig.remote(std::string("remote swd ") + first.swd);
+    rig.remote("remote sticks " + std::to_string(first.left) + " " + std::to_string(first.right));
+  }
   std::optional<Timestamp> wheels_known;
   ASSERT_TRUE(rig.run_until(
       [&] {
@@ -277,6 +290,13 @@ TEST_P(RemoteIdentification, CompletesFromTheRemotesDrivingAndTheOdometryHolds) 
   EXPECT_NE(s->identification->message.find("steering_unit_111"), std::string::npos)
       << s->identification->message;
   EXPECT_EQ(s->profile.steering_unit_271, s->identification->profile.steering_unit_271);
+  if (spin_at_rest) {
+    EXPECT_EQ(rig.chassis().distance_travelled + rig.chassis().yaw_travelled, 0.0);
+    const auto& evidence = s->identification->evidence;
+    EXPECT_TRUE(std::any_of(evidence.begin(), evidence.end(), [](const std::string& e) {
+      return e.find("spin position while the remote control spins") != std::string::npos;
+    })) << ::testing::PrintToString(evidence);
+  }
   std::printf(
       "[remote-identification] variant=%s first=%s wheels_known_after=%.3f s from boot, %.3f s "
       "of driving (simulated)\n",
@@ -324,18 +344,18 @@ TEST_P(RemoteIdentification, CompletesFromTheRemotesDrivingAndTheOdometryHolds) 
   EXPECT_EQ(got.steering_reference, want.steering_reference);
 }
 
-INSTANTIATE_TEST_SUITE_P(LockStep, RemoteIdentification,
-                         ::testing::Values(AutoCase{"manual", "arc"}, AutoCase{"manual", "spin"},
-                                           AutoCase{"agx_v2", "arc"}, AutoCase{"agx_v2", "spin"},
-                                           AutoCase{"mini_v1", "arc"}, AutoCase{"mini_v1", "spin"},
-                                           AutoCase{"steer_left_positive", "arc"},
-                                           AutoCase{"inner_angle", "spin"},
-                                           AutoCase{"manual", "idle_arc"},
-                                           AutoCase{"agx_v2", "idle_arc"},
-                                           AutoCase{"mini_v1", "idle_arc"}),
-                         [](const ::testing::TestParamInfo<AutoCase>& p) {
-                           return p.param.variant + "_" + p.param.first;
-                         });
+INSTANTIATE_TEST_SUITE_P(
+    LockStep, RemoteIdentification,
+    ::testing::Values(AutoCase{"manual", "arc"}, AutoCase{"manual", "spin"},
+                      AutoCase{"agx_v2", "arc"}, AutoCase{"agx_v2", "spin"},
+                      AutoCase{"mini_v1", "arc"}, AutoCase{"mini_v1", "spin"},
+                      AutoCase{"steer_left_positive", "arc"}, AutoCase{"inner_angle", "spin"},
+                      AutoCase{"manual", "idle_arc"}, AutoCase{"agx_v2", "idle_arc"},
+                      AutoCase{"mini_v1", "idle_arc"}, AutoCase{"manual", "spin_at_rest"},
+                      AutoCase{"agx_v2", "spin_at_rest"}, AutoCase{"mini_v1", "spin_at_rest"}),
+    [](const ::testing::TestParamInfo<AutoCase>& p) {
+      return p.param.variant + "_" + p.param.first;
+    });
 
 }  // namespace
 }  // namespace ranger::variants

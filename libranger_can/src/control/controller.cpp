@@ -7,6 +7,7 @@
 #include <utility>
 #include <variant>
 
+#include "ranger_can/control/parameters.hpp"
 #include "ranger_can/transport/error_frame.hpp"
 #include "ranger_can/wire/interpretation.hpp"
 
@@ -146,13 +147,13 @@ Status ControllerConfig::validate() const {
   if (!std::isfinite(standstill_speed) || standstill_speed < 0.0) {
     return Error{Errc::kOutOfRange, "controller: standstill_speed must be finite and >= 0"};
   }
-  if (!std::isfinite(steer_first_threshold) || steer_first_threshold < 0.0 ||
-      steer_first_threshold > M_PI / 2) {
-    return Error{Errc::kOutOfRange,
-                 "controller: steer_first_threshold must be in [0, pi/2] rad (0 disables)"};
-  }
-  if (!std::isfinite(low_battery_soc) || low_battery_soc < 0.0 || low_battery_soc > 100.0) {
-    return Error{Errc::kOutOfRange, "controller: low_battery_soc must be in [0, 100] %"};
+  // The ranges the parameter table gives (control/parameters.hpp).
+  for (const auto& [name, value] :
+       {std::pair<const char*, double>{"steer_first_threshold", steer_first_threshold},
+        {"low_battery_soc", low_battery_soc}}) {
+    if (Status st = check_value(*find_driver_parameter(name), value); !st) {
+      return Error{st.error().code, "controller: " + st.error().message};
+    }
   }
   return ok_status();
 }
@@ -372,7 +373,14 @@ Status ChassisController::request_park(bool on, Timestamp now) {
                                              config_.profile.revision +
                                              " (its motion-mode numbering has no park mode)"};
   }
-  if (on == state_.park_requested) return ok_status();
+  if (on == state_.park_requested) {
+    // A chassis found in park (parked before this driver ran): releasing switches it out.
+    if (!on && state_.chassis_mode == MotionMode::kPark && !leave_park_) {
+      leave_park_ = true;
+      command_changed_ = true;
+    }
+    return ok_status();
+  }
   state_.park_requested = on;
   leave_park_ = !on;
   mode_switch_.cancel();  // towards park, or out of it: a switch under way is abandoned
@@ -425,10 +433,20 @@ void ChassisController::set_implausible(std::string reason) {
   update_faults();
 }
 
-void ChassisController::set_identifying(std::string reason) {
-  if (reason == state_.identifying) return;
-  state_.identifying = std::move(reason);
-  if (state_.identifying.empty()) {
+void ChassisController::set_identifying(std::optional<IdentificationPhase> phase) {
+  if (phase == state_.identifying) return;
+  state_.identifying = phase;
+  if (!state_.identifying && !state_.standstill_probe) {
+    probe_mode_.reset();
+    state_.probe.reset();
+  }
+  command_changed_ = true;
+}
+
+void ChassisController::set_standstill_probe(bool active) {
+  if (active == state_.standstill_probe) return;
+  state_.standstill_probe = active;
+  if (!state_.identifying && !state_.standstill_probe) {
     probe_mode_.reset();
     state_.probe.reset();
   }
@@ -587,6 +605,9 @@ void ChassisController::run_ultrasonic(Timestamp now) {
 
 MotionRefusal ChassisController::evaluate_refusal() const {
   const StopCauses active = state_.active_causes;
+  const bool identifying = state_.identifying.has_value() || state_.standstill_probe;
+  // Listening: the driver withholds every frame on purpose, so the link is not what is missing.
+  if (state_.quiet && identifying) return MotionRefusal::kIdentifying;
   if (state_.link != LinkState::kConnected) return MotionRefusal::kLinkLost;
   if (has(active, StopCause::kRemote)) return MotionRefusal::kRemote;
   if (has(active, StopCause::kEstop)) return MotionRefusal::kEstop;
@@ -599,7 +620,7 @@ MotionRefusal ChassisController::evaluate_refusal() const {
   if (state_.park_requested) return MotionRefusal::kParked;
   // A released park is left by a switch (run_motion); park itself commands nothing.
   if (!state_.motion_mode && !(leave_park_ && state_.parked())) return MotionRefusal::kModeUnknown;
-  if (!state_.identifying.empty()) return MotionRefusal::kIdentifying;
+  if (identifying) return MotionRefusal::kIdentifying;
   if (state_.cmd_timed_out) return MotionRefusal::kCmdTimeout;
   if (selector_.below_minimum(state_.requested.twist)) return MotionRefusal::kBelowMinimum;
   return MotionRefusal::kNone;
@@ -647,7 +668,8 @@ void ChassisController::run_motion(Timestamp now) {
   MotionRefusal refusal = evaluate_refusal();
   // A switch that failed goes on retrying at its bounded rate (it stops nothing else).
   // The identification's probe: zero speed, a steering angle, possibly in another mode.
-  const bool probing = refusal == MotionRefusal::kIdentifying && state_.probe.has_value();
+  const bool probing = refusal == MotionRefusal::kIdentifying && state_.probe.has_value() &&
+                       state_.motion_mode.has_value() && !state_.quiet;
   // Park wanted: to rest, then 0x141 park. Park released: out of it without waiting for a twist.
   const bool parking = refusal == MotionRefusal::kParked && state_.chassis_mode.has_value();
   const bool leaving_park =

@@ -122,6 +122,24 @@ std::string describe(protocol::LightMode front, std::uint8_t front_brightness,
          light_text(rear, rear_brightness);
 }
 
+std::string_view to_string(RequestOutcome::Kind k) {
+  switch (k) {
+    case RequestOutcome::Kind::kClearErrors:
+      return "clear_errors";
+    case RequestOutcome::Kind::kUltrasonic:
+      return "ultrasonic";
+    case RequestOutcome::Kind::kResume:
+      return "resume";
+    case RequestOutcome::Kind::kLights:
+      return "lights";
+    case RequestOutcome::Kind::kPark:
+      return "park";
+    case RequestOutcome::Kind::kFirmwareVersion:
+      return "firmware_version";
+  }
+  return "unknown";
+}
+
 std::string_view to_string(RequestOutcome::State s) {
   switch (s) {
     case RequestOutcome::State::kPending:
@@ -173,7 +191,7 @@ struct Driver::Mail {
   std::optional<std::optional<protocol::MotionMode>> mode;
   std::optional<std::optional<StandstillProbe>> probe;
   struct Action {
-    enum Kind { kClearErrors, kUltrasonic, kResume, kPark } kind;
+    RequestOutcome::Kind kind;  // kClearErrors, kUltrasonic, kPark or kResume
     std::uint64_t id;
     std::uint8_t code;
     bool enable;
@@ -257,9 +275,11 @@ void Driver::set_motion_mode(std::optional<protocol::MotionMode> mode) {
   wake();
 }
 
-RequestOutcome& Driver::add_request(std::string what) {
+RequestOutcome& Driver::add_request(RequestOutcome::Kind kind, std::string what, bool on) {
   RequestOutcome r;
   r.id = next_request_id_++;
+  r.kind = kind;
+  r.on = on;
   r.what = std::move(what);
   requests_.push_back(std::move(r));
   while (requests_.size() > kMaxRequests)
@@ -276,8 +296,8 @@ Result<std::uint64_t> Driver::clear_errors(std::uint8_t code) {
   std::uint64_t id = 0;
   {
     std::lock_guard<std::mutex> lock(mail_mutex_);
-    id = add_request("clear_errors " + hex2(code)).id;
-    mail_->actions.push_back({Mail::Action::kClearErrors, id, code, false});
+    id = add_request(RequestOutcome::Kind::kClearErrors, "clear_errors " + hex2(code)).id;
+    mail_->actions.push_back({RequestOutcome::Kind::kClearErrors, id, code, false});
   }
   wake();
   return id;
@@ -287,8 +307,10 @@ std::uint64_t Driver::set_ultrasonic(bool enable) {
   std::uint64_t id = 0;
   {
     std::lock_guard<std::mutex> lock(mail_mutex_);
-    id = add_request(std::string("ultrasonic ") + (enable ? "on" : "off")).id;
-    mail_->actions.push_back({Mail::Action::kUltrasonic, id, 0, enable});
+    id = add_request(RequestOutcome::Kind::kUltrasonic,
+                     std::string("ultrasonic ") + (enable ? "on" : "off"), enable)
+             .id;
+    mail_->actions.push_back({RequestOutcome::Kind::kUltrasonic, id, 0, enable});
   }
   wake();
   return id;
@@ -306,8 +328,8 @@ std::uint64_t Driver::resume() {
   std::uint64_t id = 0;
   {
     std::lock_guard<std::mutex> lock(mail_mutex_);
-    id = add_request("resume").id;
-    mail_->actions.push_back({Mail::Action::kResume, id, 0, false});
+    id = add_request(RequestOutcome::Kind::kResume, "resume").id;
+    mail_->actions.push_back({RequestOutcome::Kind::kResume, id, 0, false});
   }
   wake();
   return id;
@@ -320,7 +342,8 @@ Result<std::uint64_t> Driver::set_lights(const LightsRequest& lights) {
   std::uint64_t id = 0;
   {
     std::lock_guard<std::mutex> lock(mail_mutex_);
-    id = add_request("lights " + describe(lights.front, lights.front_brightness, lights.rear,
+    id = add_request(RequestOutcome::Kind::kLights,
+                     "lights " + describe(lights.front, lights.front_brightness, lights.rear,
                                           lights.rear_brightness))
              .id;
     mail_->vendor.push_back({DriverVendorAction::Kind::kLights, id, lights});
@@ -333,8 +356,9 @@ std::uint64_t Driver::set_park(bool on) {
   std::uint64_t id = 0;
   {
     std::lock_guard<std::mutex> lock(mail_mutex_);
-    id = add_request(std::string("park ") + (on ? "on" : "off")).id;
-    mail_->actions.push_back({Mail::Action::kPark, id, 0, on});
+    id =
+        add_request(RequestOutcome::Kind::kPark, std::string("park ") + (on ? "on" : "off"), on).id;
+    mail_->actions.push_back({RequestOutcome::Kind::kPark, id, 0, on});
   }
   wake();
   return id;
@@ -344,7 +368,7 @@ std::uint64_t Driver::request_firmware_version() {
   std::uint64_t id = 0;
   {
     std::lock_guard<std::mutex> lock(mail_mutex_);
-    id = add_request("firmware_version").id;
+    id = add_request(RequestOutcome::Kind::kFirmwareVersion, "firmware_version").id;
     mail_->vendor.push_back({DriverVendorAction::Kind::kVersion, id, {}});
   }
   wake();
@@ -408,7 +432,7 @@ void Driver::try_open(Timestamp now) {
     identifier_.emplace(config_.identification, config_.controller.geometry,
                         config_.identify_revision, source_->read_only());
     controller_->set_quiet(true);
-    controller_->set_identifying("identifying the chassis: listening");
+    controller_->set_identifying(IdentificationPhase::kListening);
   }
   std::lock_guard<std::mutex> lock(mail_mutex_);
   opened_once_ = true;
@@ -475,16 +499,16 @@ void Driver::apply_mail(Timestamp now) {
   for (const Mail::Action& a : mail.actions) {
     Status st = ok_status();
     switch (a.kind) {
-      case Mail::Action::kClearErrors:
+      case RequestOutcome::Kind::kClearErrors:
         st = controller_->clear_errors(a.code, now);
         break;
-      case Mail::Action::kUltrasonic:
+      case RequestOutcome::Kind::kUltrasonic:
         st = controller_->set_ultrasonic(a.enable, now);
         break;
-      case Mail::Action::kPark:
+      case RequestOutcome::Kind::kPark:
         st = controller_->request_park(a.enable, now);
         break;
-      case Mail::Action::kResume:
+      case RequestOutcome::Kind::kResume:
         // The operator takes a plausibility stop on: the monitors start over (and trip again
         // if the mismatch persists).
         if (!applied_stop_.empty()) {
@@ -494,6 +518,9 @@ void Driver::apply_mail(Timestamp now) {
         }
         st = controller_->resume(now);
         break;
+      case RequestOutcome::Kind::kLights:
+      case RequestOutcome::Kind::kFirmwareVersion:
+        break;  // vendor actions (Mail::vendor, apply_vendor_action)
     }
     std::lock_guard<std::mutex> lock(mail_mutex_);
     for (RequestOutcome& r : requests_) {
@@ -502,7 +529,7 @@ void Driver::apply_mail(Timestamp now) {
       if (!st) {
         r.state = RequestOutcome::State::kFailed;
         r.message = st.error().message;
-      } else if (a.kind == Mail::Action::kResume) {
+      } else if (a.kind == RequestOutcome::Kind::kResume) {
         r.state = RequestOutcome::State::kAnswered;
         r.message = "re-armed";
       } else {
@@ -611,7 +638,7 @@ void Driver::update_requests(Timestamp now) {
   std::lock_guard<std::mutex> lock(mail_mutex_);
   for (RequestOutcome& r : requests_) {
     if (r.state != RequestOutcome::State::kSent) continue;
-    if (r.what.rfind("clear_errors", 0) == 0) {
+    if (r.kind == RequestOutcome::Kind::kClearErrors) {
       if (status && status->received >= r.sent + kAnswerDelay) {
         r.state = RequestOutcome::State::kAnswered;
         r.error_word = c.error_bits;
@@ -623,7 +650,7 @@ void Driver::update_requests(Timestamp now) {
         r.message = "the chassis did not answer (no 0x211) within " +
                     std::to_string(seconds(config_.request_answer_timeout)) + " s";
       }
-    } else if (r.what.rfind("lights", 0) == 0) {
+    } else if (r.kind == RequestOutcome::Kind::kLights) {
       auto it = std::find_if(sent_lights_.begin(), sent_lights_.end(),
                              [&](const auto& p) { return p.first == r.id; });
       if (it == sent_lights_.end()) continue;
@@ -644,7 +671,7 @@ void Driver::update_requests(Timestamp now) {
                                 std::to_string(seconds(config_.request_answer_timeout)) + " s";
       }
       if (r.state != RequestOutcome::State::kSent) sent_lights_.erase(it);
-    } else if (r.what == "park on") {
+    } else if (r.kind == RequestOutcome::Kind::kPark && r.on) {
       const auto limit =
           config_.controller.mode_switch_timeout * config_.controller.mode_switch_max_attempts +
           config_.request_answer_timeout;
@@ -662,7 +689,7 @@ void Driver::update_requests(Timestamp now) {
                          ? std::string(" (") + std::string(to_string(c.refusal)) + ")"
                          : std::string());
       }
-    } else if (r.what == "park off") {
+    } else if (r.kind == RequestOutcome::Kind::kPark) {
       if (c.park_requested) {
         r.state = RequestOutcome::State::kFailed;
         r.message = "park was requested again";
@@ -677,7 +704,7 @@ void Driver::update_requests(Timestamp now) {
             "park released: motion allowed (the chassis still reports park; the next "
             "motion switches it out)";
       }
-    } else if (r.what == "firmware_version") {
+    } else if (r.kind == RequestOutcome::Kind::kFirmwareVersion) {
       if (firmware_.state == FirmwareVersion::State::kAnswered) {
         r.state = RequestOutcome::State::kAnswered;
         r.message = firmware_.text;
@@ -686,8 +713,8 @@ void Driver::update_requests(Timestamp now) {
         r.message = "the chassis did not answer the version request (0x4A1) within " +
                     std::to_string(seconds(config_.request_answer_timeout)) + " s";
       }
-    } else if (r.what.rfind("ultrasonic", 0) == 0) {
-      const bool want = r.what == "ultrasonic on";
+    } else if (r.kind == RequestOutcome::Kind::kUltrasonic) {
+      const bool want = r.on;
       if (c.ultrasonic_failed) {
         r.state = RequestOutcome::State::kFailed;
         r.message = "the chassis did not confirm the ultrasonic setting (0x45A)";
@@ -831,20 +858,20 @@ void Driver::run_identification(Timestamp now) {
     use_profile(with_configured_settings(st), /*reset_odometry=*/!odometry_fed_);
     controller_->set_probe(std::nullopt, std::nullopt);
     controller_->set_quiet(false);
-    controller_->set_identifying("");
+    controller_->set_identifying(std::nullopt);
     return;
   }
   if (st.phase == IdentificationPhase::kFailed) {
     // At rest, and saying why: the refusal stays, with the message naming what to set.
     controller_->set_probe(std::nullopt, std::nullopt);
-    controller_->set_identifying(st.message);
+    controller_->set_identifying(IdentificationPhase::kFailed);
     return;
   }
   const IdentificationRequest r = identifier_->request();
   if (r.profile) use_profile(*r.profile, /*reset_odometry=*/!odometry_fed_);
   controller_->set_quiet(r.quiet);
   controller_->set_probe(r.mode, r.probe);
-  controller_->set_identifying(st.message);
+  controller_->set_identifying(st.phase);
 }
 
 void Driver::run_standstill_probe() {
@@ -852,16 +879,12 @@ void Driver::run_standstill_probe() {
   if (probe_) {
     MotionCommand c;
     c.steering_angle = interpretation::manual_from_rep103_command_steering(probe_->steering);
-    char what[96];
-    std::snprintf(what, sizeof what, "standstill probe: %s, %.1f deg",
-                  std::string(protocol::to_string(probe_->mode)).c_str(),
-                  probe_->steering * 180.0 / M_PI);
-    controller_->set_identifying(what);
+    controller_->set_standstill_probe(true);
     controller_->set_probe(probe_->mode, c);
     probe_active_ = true;
   } else if (probe_active_) {
     controller_->set_probe(std::nullopt, std::nullopt);
-    controller_->set_identifying("");
+    controller_->set_standstill_probe(false);
     probe_active_ = false;
   }
 }

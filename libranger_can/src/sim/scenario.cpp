@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "ranger_can/clock.hpp"
+#include "ranger_can/control/parameters.hpp"
 #include "ranger_can/control/rearm.hpp"
 #include "ranger_can/parse.hpp"
 #include "ranger_can/sim/sim_bus_source.hpp"
@@ -559,9 +560,7 @@ Result<Scenario> parse_scenario(std::string_view text) {
 // ---- parameters ----
 
 const std::vector<std::string>& scenario_param_names() {
-  static const std::vector<std::string> names = {"steer_first_threshold", "cmd_timeout",
-                                                 "auto_reclaim_after_remote", "mode_switch_timeout",
-                                                 "low_battery_soc"};
+  static const std::vector<std::string> names = driver_parameter_names();
   return names;
 }
 
@@ -572,29 +571,7 @@ Status apply_scenario_param(DriverConfig& config, std::string_view assignment) {
                    "' (NAME: " + join(scenario_param_names()) + ")");
   }
   const auto& [name, value] = *kv;
-  ControllerConfig& c = config.controller;
-  if (name == "steer_first_threshold") {
-    auto v = parse_double_in(name, value, 0.0, M_PI / 2);
-    if (!v) return v.error();
-    c.steer_first_threshold = *v;
-  } else if (name == "cmd_timeout" || name == "mode_switch_timeout") {
-    auto v = parse_double_in(name, value, 0.001, 3600.0);
-    if (!v) return v.error();
-    (name == "cmd_timeout" ? c.cmd_timeout : c.mode_switch_timeout) = from_seconds(*v);
-  } else if (name == "auto_reclaim_after_remote") {
-    if (value != "true" && value != "false") {
-      return problem(name + ": expected true or false, got '" + value + "'");
-    }
-    c.auto_reclaim_after_remote = value == "true";
-  } else if (name == "low_battery_soc") {
-    auto v = parse_double_in(name, value, 0.0, 100.0);
-    if (!v) return v.error();
-    c.low_battery_soc = *v;
-  } else {
-    return problem("unknown parameter '" + name + "' (valid: " + join(scenario_param_names()) +
-                   ")");
-  }
-  return ok_status();
+  return set_driver_parameter(config, name, value);
 }
 
 Status validate(const ScenarioOptions& options) {

@@ -175,8 +175,10 @@ ProtocolProfile make_agx_v2() {
   p.steering_sign_111 = p.steering_sign_221 = p.steering_sign_271 = SteeringSign::kLeftPositive;
   p.steering_reference = SteeringReference::kInnerFront;
   p.spin_field = SpinField::kYawRate;
-  p.spin_sign = +1;                              // yaw rate, counter-clockwise positive
-  p.feedback_speed = FeedbackSpeed::kMeanWheel;  // assumed: the vendor's source does not say
+  p.spin_sign = +1;  // yaw rate, counter-clockwise positive
+  // The vendor's ROS 1 driver integrates 0x221's speed as the body centre's
+  // (docs/PROTOCOL_INTERPRETATIONS.md, point 8).
+  p.feedback_speed = FeedbackSpeed::kBodyCentre;
   p.error_word = ErrorWordLayout::kAgxV2_16;
   p.vehicle_status_1_is_estop = true;  // "0 normal, 1 e-stop, 2 exception"
   p.bms_voltage_scale = 0.1;

@@ -113,7 +113,8 @@ bool IdentifyRig::drive_until_stopped(const BodyTwist& twist, std::optional<Moti
 
 void IdentifyRig::expect_route(const std::string& label, double min_turns) {
   ASSERT_TRUE(wait_ready()) << to_string(snapshot()->controller.refusal) << ": "
-                            << snapshot()->controller.identifying;
+                            << (snapshot()->identification ? snapshot()->identification->message
+                                                           : std::string());
   const Pose2D start_truth = truth().pose;
   const Pose2D start_odo = snapshot()->odometry.pose;
   drive({0.8, 0.0, 0.3}, MotionMode::kAckermann, 10s);  // a left arc, r = 2.7 m

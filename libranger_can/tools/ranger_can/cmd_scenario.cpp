@@ -9,6 +9,7 @@
 #include "cli_input.hpp"
 #include "cli_options.hpp"
 #include "cli_profile.hpp"
+#include "ranger_can/control/parameters.hpp"
 #include "ranger_can/sim/scenario.hpp"
 #include "ranger_can/sim/sim_bus_source.hpp"
 #include "ranger_can/text.hpp"
@@ -24,6 +25,16 @@ Status check_every(const std::string& text) {
   if (!ms) return ms.error();
   if (ms->count() < 1) return Error{Errc::kInvalidArgument, "must be at least 0.001 s"};
   return ok_status();
+}
+
+// "steer_first_threshold=RAD [0, 1.5708], ..., auto_reclaim_after_remote=true|false".
+std::string param_help() {
+  std::string out;
+  for (const DriverParameter& p : driver_parameters()) {
+    out += (out.empty() ? "" : ", ") + std::string(p.name) + "=";
+    out += p.type == ParameterType::kBool ? std::string("true|false") : valid_text(p);
+  }
+  return out;
 }
 
 Status check_param(const std::string& text) {
@@ -135,9 +146,8 @@ const CommandSpec& scenario_command() {
           protocol_option(),
           set_option(),
           option("--param", "NAME=VALUE",
-                 "a driver setting: steer_first_threshold=RAD (0 disables steer-first), "
-                 "cmd_timeout=SEC, auto_reclaim_after_remote=true|false, "
-                 "mode_switch_timeout=SEC, low_battery_soc=PCT",
+                 "a driver setting, by the ROS node's parameter name (ranger_base/README.md): " +
+                     param_help(),
                  checked_by(check_param))
               .repeated(),
       },

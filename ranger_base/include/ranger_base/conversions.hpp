@@ -66,15 +66,16 @@ nav_msgs::Odometry to_ground_truth(const ranger::sim::ChassisSnapshot& sim,
 
 // ---- chassis state ----------------------------------------------------------------------------
 // The identification is listening: nothing is sent, and the controller hears nothing on purpose
-// (its link reads never-connected, its refusal link_lost) until the chassis has been heard.
+// (its link reads never-connected; the library refuses motion with `identifying`) until the
+// chassis has been heard.
 bool listening(const ranger::ControllerState& state);
 // Why motion is refused, by stable name (libranger_can's MotionRefusal: "estop", "identifying",
-// "implausible_feedback", ...; "" while driven), with the identification's listening reported as
-// "identifying" rather than "link_lost".
+// "implausible_feedback", ...; "" while driven).
 std::string refusal_name(const ranger::ControllerState& state);
 // Why motion is refused, and what to do about it, in words (system_state's
-// motion_inhibited_detail, diagnostics, the log); "" while the chassis is driven as asked.
-std::string describe_refusal(const ranger::ControllerState& state);
+// motion_inhibited_detail, diagnostics, the log); "" while the chassis is driven as asked. The
+// identification's words come from snapshot.identification.
+std::string describe_refusal(const ranger::DriverSnapshot& snapshot);
 // The stop causes of a set by name ("emergency_stop", "remote", ...), in the library's order.
 std::vector<std::string> cause_names(ranger::StopCauses causes);
 

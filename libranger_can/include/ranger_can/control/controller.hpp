@@ -46,6 +46,7 @@
 
 #include "ranger_can/control/feedback.hpp"
 #include "ranger_can/control/geometry.hpp"
+#include "ranger_can/control/identification.hpp"
 #include "ranger_can/control/kinematics.hpp"
 #include "ranger_can/control/mode_selector.hpp"
 #include "ranger_can/control/mode_switch.hpp"
@@ -84,10 +85,13 @@ enum class MotionRefusal {
   kSwitching,         // motion-mode switch in progress (ours or the remote's)
   kCmdTimeout,        // no set_command within cmd_timeout
   kBelowMinimum,      // the twist is below what the chassis can express (1 mm/s)
-  // The protocol settings are not decided yet (DriverConfig::identification: `auto`): no speed is
-  // commanded; only the identification's zero-speed steering probe goes out. Comes after the
-  // stop causes, standby and an unknown mode (the probe needs CAN mode and a known motion mode);
-  // ControllerState::identifying says what is going on.
+  // The driver holds motion for a purpose of its own: the protocol settings are not decided yet
+  // (DriverConfig::identification: `auto`; ControllerState::identifying gives the phase), or the
+  // commissioning's standstill probe runs (ControllerState::standstill_probe). No speed is
+  // commanded; only the zero-speed steering probe goes out. While the identification listens
+  // (quiet: the driver withholds every frame from the controller on purpose) it comes first, in
+  // place of kLinkLost; otherwise after the stop causes, standby and an unknown mode (the probe
+  // needs CAN mode and a known motion mode).
   kIdentifying,
   // The commander asked for park (request_park): the chassis is held in (or brought to) park
   // mode and motion is refused until park is released. After the stop causes and standby.
@@ -245,10 +249,12 @@ struct ControllerState {
   std::optional<bool> ultrasonic_requested;  // pending set_ultrasonic target
   bool ultrasonic_failed = false;            // not confirmed after the attempts
 
-  // Identification (set_identifying): why motion waits, e.g. "identifying the chassis: listening
-  // (0.4 s of 1.0 s)"; empty when the settings are decided. quiet: nothing is sent at all.
-  std::string identifying;
-  bool quiet = false;
+  // Identification (set_identifying): its phase while the settings are not decided (kFailed
+  // stays: the robot stays at rest), nullopt once decided or when they were given. The words for
+  // it are the identification's (DriverSnapshot::identification->message), written at the edge.
+  std::optional<IdentificationPhase> identifying;
+  bool standstill_probe = false;  // the commissioning's standstill probe (set_standstill_probe)
+  bool quiet = false;             // nothing is sent at all (set_quiet)
   std::optional<MotionCommand> probe;  // the zero-speed steering probe being commanded
   // Why the settings were found contradicted (set_implausible), naming the setting and the value
   // to try; empty otherwise.
@@ -348,9 +354,12 @@ class ChassisController {
   void set_implausible(std::string reason);
 
   // ---- identification (control/identification.hpp; the driver calls these) ----
-  // While `reason` is not empty, motion is refused with kIdentifying ("identifying the chassis:
-  // ..." in state().identifying); an empty reason ends it. Idempotent.
-  void set_identifying(std::string reason);
+  // While `phase` is set (the identification's phase until it decides; kFailed stays), motion is
+  // refused with kIdentifying; nullopt ends it. Idempotent.
+  void set_identifying(std::optional<IdentificationPhase> phase);
+  // While true, motion is refused with kIdentifying for the commissioning's standstill probe
+  // (set_probe gives the probe). Idempotent.
+  void set_standstill_probe(bool active);
   // quiet = true: nothing at all is sent (no 0x421, no keep-alive): the identification listens
   // before it speaks. The state machine goes on; quiet = false resumes at the next tick.
   void set_quiet(bool quiet);

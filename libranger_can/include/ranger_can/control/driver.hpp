@@ -88,15 +88,19 @@ struct DriverConfig {
 
 // What became of a request posted through the mailbox.
 struct RequestOutcome {
+  enum class Kind { kClearErrors, kUltrasonic, kResume, kLights, kPark, kFirmwareVersion };
   enum class State { kPending, kSent, kAnswered, kFailed };
   std::uint64_t id = 0;
-  std::string what;  // "clear_errors 0x00", "ultrasonic on", "resume"
+  Kind kind = Kind::kResume;
+  bool on = false;   // kUltrasonic, kPark: on (true) or off
+  std::string what;  // for people: "clear_errors 0x00", "ultrasonic on", "lights front on, ..."
   State state = State::kPending;
   std::string message;  // why it failed, or what the answer was
   // clear_errors: the 0x211 error word the chassis reported after it received the 0x441.
   std::optional<std::uint32_t> error_word;
   Timestamp sent{0};  // driver clock
 };
+std::string_view to_string(RequestOutcome::Kind k);   // "clear_errors", "ultrasonic", "resume", ...
 std::string_view to_string(RequestOutcome::State s);  // "pending", "sent", "answered", "failed"
 
 // Whether the chassis speaks the vendor's additions (0x231 light state, 0x241 remote state, 0x4A1
@@ -278,8 +282,8 @@ class Driver {
   std::uint64_t set_park(bool on);
   // Asks for the firmware version again (it is asked once by itself); answered with the text.
   std::uint64_t request_firmware_version();
-  // While set (after the identification, if any): speed is refused (kIdentifying, "standstill
-  // probe ...") and the probe is commanded; nullopt ends it.
+  // While set (after the identification, if any): speed is refused (kIdentifying, with
+  // ControllerState::standstill_probe) and the probe is commanded; nullopt ends it.
   void standstill_probe(std::optional<StandstillProbe> probe);
 
   // Blocks the calling thread until request `id` is answered or failed, or `timeout` passes
@@ -318,7 +322,8 @@ class Driver {
   bool apply_vendor_action(const DriverVendorAction& a, Timestamp now);
   void publish(Timestamp now);
   void deliver_events();
-  RequestOutcome& add_request(std::string what);  // mail lock held
+  // Records a request of `kind` (`what` says it for people); mail lock held.
+  RequestOutcome& add_request(RequestOutcome::Kind kind, std::string what, bool on = false);
 
   const DriverConfig config_;
   const std::shared_ptr<BusSource> source_;

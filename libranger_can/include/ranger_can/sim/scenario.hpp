@@ -120,9 +120,9 @@ Result<std::optional<ScenarioAction>> parse_scenario_line(std::string_view text,
 Result<Scenario> parse_scenario(std::istream& in);
 Result<Scenario> parse_scenario(std::string_view text);
 
-// The driver settings a scenario may change (`--param NAME=VALUE`), by the name of their
-// ControllerConfig field: steer_first_threshold (rad, 0 disables), cmd_timeout (s),
-// auto_reclaim_after_remote (true|false), mode_switch_timeout (s), low_battery_soc (%).
+// The driver settings a scenario may change (`--param NAME=VALUE`): every row of the parameter
+// table (control/parameters.hpp), by the ROS node's name, e.g. steer_first_threshold (rad, 0
+// disables), cmd_vel_timeout (s), auto_reclaim_after_remote (true|false).
 const std::vector<std::string>& scenario_param_names();
 // Applies "NAME=VALUE" to `config`; the error names the parameter and the problem.
 Status apply_scenario_param(DriverConfig& config, std::string_view assignment);

@@ -203,7 +203,7 @@ inline double ackermann_mean_wheel_speed_factor(double curvature, double wheelba
 // In oblique mode every wheel rolls at the body's speed, so only Ackermann can tell the readings
 // apart; oblique callers pass curvature 0, where every reading agrees. The curvature and the
 // geometry are unused under this reading: they are parameters so that another reading (e.g. the
-// mean wheel speed, as 0x221 reports) is a change here only.
+// mean wheel speed, as the manual's 0x221 reports) is a change here only.
 inline double body_speed_from_command_speed(double command_speed_mps,
                                             [[maybe_unused]] double curvature,
                                             [[maybe_unused]] double wheelbase_m,
@@ -217,8 +217,10 @@ inline double command_speed_from_body_speed(double body_speed_mps,
   return body_speed_mps;
 }
 
-// Point 8 — 0x221 speed in Ackermann mode is the mean of the four wheels' rolling speeds (what
-// the firmware measures), so the body centre moves with vx = speed / mean_i |(1 - k y_i, k x_i)|.
+// Point 8 — 0x221 speed in Ackermann mode is, in the manual's reading (feedback_speed
+// mean_wheel), the mean of the four wheels' rolling speeds (what the firmware measures), so the
+// body centre moves with vx = speed / mean_i |(1 - k y_i, k x_i)|; the vendor's revision reports
+// the body centre's speed itself (feedback_speed body_centre, the overload below).
 // At |k| = inf (a corrupt angle of 90 deg or more) the body-centre speed is 0.
 inline double ackermann_body_speed_from_feedback_speed(double feedback_speed_mps, double curvature,
                                                        double wheelbase_m, double track_m) {
