@@ -28,7 +28,7 @@ namespace proto = ranger::protocol;
 CanFrame sample_frame(std::uint32_t id) {
   CanFrame f;
   f.id = id;
-  f.dlc = static_cast<std::uint8_t>(proto::expected_dlc(id));
+  f.dlc = static_cast<std::uint8_t>(proto::layout_dlc(id));
   const std::uint8_t pattern[8] = {0x00, 0x96, 0x01, 0x2C, 0xFF, 0x6A, 0x03, 0xE8};
   for (int i = 0; i < f.dlc; ++i)
     f.data[static_cast<std::size_t>(i)] = pattern[i];

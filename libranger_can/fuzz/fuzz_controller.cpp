@@ -24,9 +24,9 @@
 #include <vector>
 
 #include "fuzz_input.hpp"
+#include "ranger_can/control/controller.hpp"
 #include "ranger_can/transport/bus.hpp"
 #include "ranger_can/wire/codec.hpp"
-#include "ranger_can/control/controller.hpp"
 #include "ranger_can/wire/protocol.hpp"
 
 namespace {
@@ -163,7 +163,7 @@ CanFrame make_frame(FuzzedDataProvider& in) {
     case 8: {  // any RANGER ID (0x45A, motors, ultrasonic, our own commands echoed), any bytes
       static const std::vector<std::uint32_t> kIds = protocol::all_ids();
       f.id = kIds[in.ConsumeIntegralInRange<std::size_t>(0, kIds.size() - 1)];
-      const int dlc = protocol::expected_dlc(f.id);
+      const int dlc = protocol::layout_dlc(f.id);
       f.dlc = static_cast<std::uint8_t>(dlc >= 0 ? dlc : 8);
       for (std::size_t i = 0; i < f.dlc; ++i)
         f.data[i] = in.ConsumeIntegral<std::uint8_t>();

@@ -8,7 +8,7 @@
 //    kBadDlc exactly for a DLC shorter than the ID's layout or above 8, kOutOfRange only for a
 //    0x221/0x271 steering angle beyond interpretation::kMaxPlausibleSteeringRad; every error has a
 //    message;
-//  * a longer frame decodes from its leading bytes (issue 14): no byte past the layout is read,
+//  * a longer frame decodes from its leading bytes: no byte past the layout is read,
 //    so the same frame with other bytes past its layout, or cut to its layout, decodes to the
 //    same message (compared through its encoding) or the same error; no byte past `dlc` either;
 //  * encode(decode(x)) under the same profile (with tx_dlc 0) reproduces x's layout bytes, up to

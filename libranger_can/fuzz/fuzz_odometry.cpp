@@ -44,7 +44,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         protocol::kMotionFeedbackId, protocol::kSteeringAnglesId, protocol::kWheelSpeedsId,
         protocol::kMotionModeFeedbackId, protocol::kSystemStatusId};
     f.id = kIds[in.ConsumeIntegralInRange<std::size_t>(0, 4)];
-    const int dlc = protocol::expected_dlc(f.id);
+    const int dlc = protocol::layout_dlc(f.id);
     f.dlc = in.ConsumeIntegralInRange<int>(0, 15) == 0
                 ? in.ConsumeIntegralInRange<std::uint8_t>(0, 8)
                 : static_cast<std::uint8_t>(dlc);

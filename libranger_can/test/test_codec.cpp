@@ -697,7 +697,7 @@ TEST(CodecDecodeErrors, DlcAboveEightIsRefused) {
 }
 
 TEST(CodecDecode, LongerFramesDecodeTheirLeadingBytes) {
-  // Issue 14: the vendor's software pads to 8 and never checks a length. Every ID, every longer
+  // The vendor's software pads to 8 and never checks a length. Every ID, every longer
   // DLC, random padding: the message is the one of the leading bytes.
   std::mt19937 rng(14);
   for (const ProtocolProfile& p : {manual_profile(), agx_v2()}) {

@@ -826,7 +826,7 @@ TEST(ControllerFeedback, SnapshotKeepsEveryKindOfFeedback) {
   EXPECT_FALSE(rig.state().last_error.empty());
 }
 
-// ---- re-arm, steer first, small twists, prompt sends (issue 13) ----------------------------
+// ---- re-arm, steer first, small twists, prompt sends ----------------------------
 
 TEST(ControllerRearm, ResumeIsRefusedWhileTheCauseIsActiveAndSendsNothing) {
   Rig rig;
@@ -983,7 +983,7 @@ TEST(ControllerConfig, Validation) {
 }  // namespace
 }  // namespace ranger
 
-// ---- the vendor's revision on the wire (issue 14) ----------------------------------------------
+// ---- the vendor's revision on the wire ----------------------------------------------
 
 namespace ranger {
 namespace {

@@ -318,7 +318,7 @@ TEST(ModeSelector, ClassificationTable) {
       {{0.03, 0, 0.5}, MotionMode::kAckermann, MotionMode::kAckermann},  // above linear_enter
       {{0.03, 0, 0.5}, MotionMode::kSpin, MotionMode::kSpin},            // below linear_exit
       {{0, 0, 0.03}, MotionMode::kSpin, MotionMode::kSpin},              // above rotation_exit
-      // no dead band (issue 13): a small twist drives in the mode a user expects
+      // no dead band: a small twist drives in the mode a user expects
       {{0, 0, 0.03}, MotionMode::kAckermann, MotionMode::kSpin},        // small pure rotation
       {{0, 0.03, 0}, MotionMode::kAckermann, MotionMode::kOblique},     // small pure lateral
       {{0.02, 0.03, 0}, MotionMode::kAckermann, MotionMode::kOblique},  // lateral dominates
@@ -473,7 +473,7 @@ TEST(ModeSelector, ObliqueSideIsForgottenOnResetAndInOtherModes) {
 }  // namespace
 }  // namespace ranger
 
-// ---- protocol profiles: the chassis's readings of 0x111 (issue 14) ---------------------------
+// ---- protocol profiles: the chassis's readings of 0x111 ---------------------------
 
 namespace ranger {
 namespace {

@@ -326,7 +326,7 @@ TEST(OdometryConfig, ValidationAndSourceNames) {
 }  // namespace
 }  // namespace ranger
 
-// ---- protocol profiles: the chassis's readings of 0x221 (issue 14) ---------------------------
+// ---- protocol profiles: the chassis's readings of 0x221 ---------------------------
 
 namespace ranger {
 namespace {

@@ -162,7 +162,6 @@ TEST(ProtocolIds, AllIdsAscendingWithTheirLayoutLength) {
   for (std::uint32_t id : ids) {
     EXPECT_TRUE(is_known_id(id));
     EXPECT_NE(frame_name(id), "unknown") << id;
-    EXPECT_EQ(expected_dlc(id), layout_dlc(id)) << "the deprecated name is an alias";
   }
   const std::pair<std::uint32_t, int> dlcs[] = {
       {0x111, 8}, {0x141, 1}, {0x421, 1}, {0x441, 1}, {0x451, 1}, {0x211, 8}, {0x221, 8},
@@ -302,15 +301,61 @@ TEST(ProtocolMotionModes, EachNumberingMapsItsWireValues) {
   EXPECT_FALSE(motion_mode_from_wire(3, ModeNumbering::kManual).has_value());
 }
 
+// ---- The frame table
+// ------------------------------------------------------------------------------
+
+TEST(ProtocolFrames, EveryIdentifierHasOneRowAndTheRowsAgreeWithTheLists) {
+  for (std::uint32_t id = 0; id < 0x800; ++id) {
+    int rows = 0;
+    for (const FrameInfo& f : kFrameTable)
+      rows += f.holds(id) ? 1 : 0;
+    EXPECT_LE(rows, 1) << std::hex << id;
+    EXPECT_EQ(rows == 1, is_known_id(id)) << std::hex << id;
+  }
+  for (const FrameInfo& f : kFrameTable) {
+    EXPECT_GT(f.length, 0) << f.name;
+    EXPECT_LE(f.length, 8) << f.name;
+    EXPECT_NE(f.revisions & kInAgxV2, 0) << f.name << ": the vendor's revision has every frame";
+    EXPECT_TRUE(f.period_ms == 0 || f.direction != Direction::kBoth) << f.name;
+  }
+  // Periods: the manual's feedback rates, 0x231/0x241 at the fast rate, the host's keep-alive.
+  EXPECT_EQ(frame_period_ms(kSystemStatusId), 20);
+  EXPECT_EQ(frame_period_ms(kUltrasonic5to8Id), 50);
+  EXPECT_EQ(frame_period_ms(kMotorLowSpeedBaseId + 8), 100);
+  EXPECT_EQ(frame_period_ms(kBmsBaseId + 9), 500);
+  EXPECT_EQ(frame_period_ms(kRemoteControlStateId), 20);
+  EXPECT_EQ(kKeepAlivePeriodMs, 20);
+  EXPECT_EQ(frame_period_ms(0x7FF), 0);
+  // Chassis frames: feedback and 0x4A1 answers, never the host's commands or its request.
+  CanFrame f;
+  f.id = kVersionId;
+  f.dlc = 1;
+  f.data[0] = kVersionRequestValue;
+  EXPECT_FALSE(is_chassis_frame(f));
+  f.data[0] = 'V';
+  EXPECT_TRUE(is_chassis_frame(f));
+  f.id = kMotionCommandId;
+  EXPECT_FALSE(is_chassis_frame(f));
+  f.id = kOdometerId;
+  EXPECT_TRUE(is_chassis_frame(f));
+}
+
 // ---- The agx_v2 16-bit error word --------------------------------------------------------------
 
+// The vendor's bits (PROTOCOL_AGX_V2.md) carry the name of their meaning, the manual layout's name
+// where the manual has the same fault.
 TEST(ProtocolErrorBits, Agx16BitsByName) {
   const std::pair<std::uint32_t, const char*> rows[] = {
-      {0x0001, "battery_fault"},        {0x0002, "battery_warning"},
-      {0x0004, "remote_signal_lost"},   {0x0008, "motor1_communication"},
-      {0x0010, "motor2_communication"}, {0x0020, "motor3_communication"},
-      {0x0040, "motor4_communication"}, {0x0080, "steering_encoder"},
-      {0x0100, "motor_driver"},         {0x0200, "host_communication_lost"},
+      {0x0001, "battery_under_voltage"},               // battery fault
+      {0x0002, "battery_warning"},                     // battery warning
+      {0x0004, "remote_control_lost"},                 // remote-control signal lost
+      {0x0008, "motor_driver_1_communication_fault"},  // motor 1 communication
+      {0x0010, "motor_driver_2_communication_fault"},
+      {0x0020, "motor_driver_3_communication_fault"},
+      {0x0040, "motor_driver_4_communication_fault"},
+      {0x0080, "steering_encoder_fault"},  // steering encoder
+      {0x0100, "driver_status_error"},     // motor driver fault
+      {0x0200, "host_communication_lost"},
   };
   const auto& table = system_error_bits(ErrorWordLayout::kAgxV2_16);
   ASSERT_EQ(table.size(), std::size(rows));
@@ -403,6 +448,29 @@ TEST(ProtocolFaults, EveryFaultHasANameAndEveryBitIsNamedInItsLayout) {
     }
   }
   EXPECT_EQ(to_string(static_cast<Fault>(kFaultCount)), "unknown");
+}
+
+TEST(ProtocolFaults, TheTableHasOneRowPerMeaningAndOneBitPerRowAndLayout) {
+  std::set<std::string_view> names;
+  for (const FaultInfo& f : kFaultTable) {
+    EXPECT_TRUE(names.insert(f.name).second) << f.name;
+    EXPECT_TRUE(f.manual_bit != kNoBit || f.agx16_bit != kNoBit) << f.name;
+    EXPECT_EQ(find_fault(f.name), &f);
+    EXPECT_EQ(find_fault(f.fault, f.motor), &f) << f.name;
+    for (const auto layout : {ErrorWordLayout::kManual32, ErrorWordLayout::kAgxV2_16}) {
+      if (f.bit(layout) == kNoBit) continue;
+      EXPECT_LT(f.bit(layout), error_word_bits(layout)) << f.name;
+      EXPECT_EQ(fault_at(layout, f.bit(layout)), &f) << f.name << ": two rows on one bit";
+      EXPECT_EQ(is_critical_error(1u << f.bit(layout), layout), f.critical) << f.name;
+    }
+  }
+  // Every fault of the enum has a row.
+  for (const Fault f : kAllFaults) {
+    bool found = false;
+    for (const FaultInfo& row : kFaultTable)
+      found = found || row.fault == f;
+    EXPECT_TRUE(found) << to_string(f);
+  }
 }
 
 TEST(ProtocolFaults, TheCriticalSetIsMadeOfFaults) {

@@ -12,7 +12,11 @@
 #include <vector>
 
 #include "cli_commands.hpp"
+#include "ranger_can/control/controller.hpp"
+#include "ranger_can/control/identification.hpp"
 #include "ranger_can/sim/scenario.hpp"
+#include "ranger_can/text.hpp"
+#include "ranger_can/wire/protocol.hpp"
 #include "support/cli_run.hpp"
 
 namespace ranger::sim {
@@ -105,6 +109,61 @@ TEST(ScenarioParse, EveryActionWithItsLineNumber) {
   EXPECT_EQ(s.expectations, 4u);
 }
 
+// The enumerators 0, 1, ... of a contiguous enum until to_string says "unknown" are exactly its
+// `all` list: an enumerator added without its name in the list fails here.
+template <typename Enum, std::size_t N>
+void expect_all_list_complete(const Enum (&all)[N], const char* what) {
+  std::vector<std::string> named;
+  for (int i = 0; i < 256; ++i) {
+    const std::string_view name = to_string(static_cast<Enum>(i));
+    if (name == "unknown") break;
+    named.emplace_back(name);
+  }
+  EXPECT_EQ(named, text::names_of(all)) << what;
+}
+
+TEST(EnumNames, EveryAllListHoldsEveryEnumerator) {
+  expect_all_list_complete(kAllMotionRefusals, "MotionRefusal");
+  expect_all_list_complete(kAllControllerFaults, "ControllerFault");
+  expect_all_list_complete(kAllLinkStates, "LinkState");
+  expect_all_list_complete(kAllIdentificationPhases, "IdentificationPhase");
+  expect_all_list_complete(protocol::kAllFaults, "Fault");
+  expect_all_list_complete(protocol::kAllMotionModes, "MotionMode");
+  expect_all_list_complete(protocol::kAllControlModes, "ControlMode");
+  expect_all_list_complete(protocol::kAllVehicleStatuses, "VehicleStatus");
+  expect_all_list_complete(protocol::kAllRemoteSwitches, "RemoteSwitch");
+  expect_all_list_complete(protocol::kAllLightModes, "LightMode");
+  expect_all_list_complete(protocol::kAllDirections, "Direction");
+}
+
+// Every name the driver can report, taken from the enums' `all` lists and the fault table (a new
+// enumerator or fault is covered without touching this test), is a valid `expect` value that
+// parses back to the same name.
+TEST(ScenarioParse, EveryNameOfTheEnumsAndTheFaultTableIsAccepted) {
+  std::vector<std::pair<std::string, std::string>> checks;  // field, name
+  for (const auto& n : text::names_of(kAllMotionRefusals))
+    checks.emplace_back("refusal", n);
+  for (const auto& n : text::names_of(protocol::kAllControlModes))
+    checks.emplace_back("control_mode", n);
+  for (const auto& n : text::names_of(protocol::kAllMotionModes))
+    checks.emplace_back("motion_mode", n);
+  for (const auto& n : text::names_of(kAllControllerFaults))
+    checks.emplace_back("fault", n);
+  for (const protocol::FaultInfo& f : protocol::kFaultTable)
+    checks.emplace_back("fault", std::string(f.name));
+  checks.emplace_back("fault", "reserved_bit_31");
+  for (const auto& [field, name] : checks) {
+    EXPECT_NE(name, "unknown") << field;
+    const Scenario s = parse_ok("expect " + field + " " + name + "\n");
+    ASSERT_EQ(s.actions.size(), 1u) << field << " " << name;
+    EXPECT_EQ(s.actions[0].expect.text, name) << field;
+  }
+  // `identifying` and `uart` among them, by name.
+  EXPECT_EQ(parse_ok("expect refusal identifying\n").actions.size(), 1u);
+  EXPECT_EQ(parse_ok("expect control_mode uart\n").actions.size(), 1u);
+  EXPECT_EQ(parse_ok("expect fault steering_encoder_fault\n").actions.size(), 1u);
+}
+
 TEST(ScenarioParse, BadLinesNameTheLineAndTheProblem) {
   struct Case {
     std::string line;
@@ -139,7 +198,7 @@ TEST(ScenarioParse, BadLinesNameTheLineAndTheProblem) {
       {"expect", "expect: give one of"},
       {"expect refusal stopped", "expect refusal: unknown 'stopped'"},
       {"expect refusal", "usage: expect refusal"},
-      {"expect control_mode manual", "unknown 'manual' (valid: standby, can, remote, null)"},
+      {"expect control_mode manual", "unknown 'manual' (valid: standby, can, uart, remote, null)"},
       {"expect motion_mode crab", "unknown 'crab'"},
       {"expect rearm_required yes", "unknown 'yes' (valid: true, false)"},
       {"expect fault estop", "unknown fault 'estop'"},

@@ -9,6 +9,7 @@
 #include <limits>
 
 #include <ranger_can/control/geometry.hpp>
+#include <ranger_can/text.hpp>
 
 namespace ranger_base {
 namespace {
@@ -201,6 +202,8 @@ const std::map<std::string_view, SystemErrorField>& system_error_fields() {
       RANGER_FIELD(SystemErrors, motor_driver_2_communication_fault),
       RANGER_FIELD(SystemErrors, motor_driver_3_communication_fault),
       RANGER_FIELD(SystemErrors, motor_driver_4_communication_fault),
+      RANGER_FIELD(SystemErrors, battery_warning),
+      RANGER_FIELD(SystemErrors, steering_encoder_fault),
   };
   return fields;
 }
@@ -242,7 +245,14 @@ void fill_bits(std::uint32_t word, const std::vector<protocol::NamedBit>& bits,
 
 void fill_system_errors(std::uint32_t error_word, ranger::ErrorWordLayout layout,
                         ranger_msgs::SystemErrors& out) {
-  fill_bits(error_word, protocol::system_error_bits(layout), system_error_fields(), out);
+  // By meaning: each fault-table row with a bit in this layout sets the field of its name.
+  const auto& fields = system_error_fields();
+  for (const protocol::FaultInfo& f : protocol::kFaultTable) {
+    const int bit = f.bit(layout);
+    const auto it = fields.find(f.name);
+    if (bit == protocol::kNoBit || it == fields.end()) continue;
+    out.*(it->second) = ((error_word >> bit) & 1u) != 0;
+  }
 }
 
 ranger_msgs::DriverStatus to_driver_status(std::uint8_t status) {
@@ -285,12 +295,7 @@ std::string refusal_name(const ranger::ControllerState& c) {
 std::string describe_refusal(const ranger::DriverSnapshot& snapshot) {
   const ranger::ControllerState& c = snapshot.controller;
   using R = ranger::MotionRefusal;
-  const auto join = [](const std::vector<std::string>& names) {
-    std::string out;
-    for (const auto& n : names)
-      out += (out.empty() ? "" : ", ") + n;
-    return out;
-  };
+  using ranger::text::join;
   switch (c.refusal) {
     case R::kNone:
       if (c.steer_first_factor < 1.0) {
@@ -499,7 +504,7 @@ ranger_msgs::BmsStateArray to_bms_state(const ranger::ChassisFeedback& feedback,
     ranger_msgs::BmsState s;
     s.battery = static_cast<std::uint8_t>(b);
     const auto& data = feedback.bms[i];
-    s.present = fresh(data, now, protocol::kBmsPeriodMs);
+    s.present = fresh(data, now, protocol::frame_period_ms(protocol::kBmsBaseId));
     if (data) {
       s.header.stamp = to_ros_time(data->stamp);
       s.soc = static_cast<float>(data->value.soc);
@@ -535,7 +540,7 @@ sensor_msgs::BatteryState to_battery_state(const ranger::ChassisFeedback& fb, Ti
   out.location = "pack";
 
   const auto& pack = fb.bms[0];
-  if (fresh(pack, now, protocol::kBmsPeriodMs)) {
+  if (fresh(pack, now, protocol::frame_period_ms(protocol::kBmsBaseId))) {
     out.header.stamp = to_ros_time(pack->stamp);
     out.present = true;
     out.voltage = static_cast<float>(pack->value.voltage);
@@ -570,7 +575,7 @@ sensor_msgs::BatteryState to_battery_state(const ranger::ChassisFeedback& fb, Ti
   }
   for (int b = 1; b <= protocol::kBatteryCount; ++b) {
     const auto& slot = fb.bms[static_cast<std::size_t>(b)];
-    const bool present = fresh(slot, now, protocol::kBmsPeriodMs);
+    const bool present = fresh(slot, now, protocol::frame_period_ms(protocol::kBmsBaseId));
     out.cell_voltage.push_back(present ? static_cast<float>(slot->value.voltage) : kNaN);
     out.cell_temperature.push_back(present ? static_cast<float>(slot->value.temperature) : kNaN);
   }

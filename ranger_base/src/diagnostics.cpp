@@ -2,6 +2,7 @@
 
 #include <diagnostic_msgs/DiagnosticStatus.h>
 
+#include <ranger_can/text.hpp>
 #include <ranger_can/transport/bus_source.hpp>
 
 #include <algorithm>
@@ -16,17 +17,10 @@ namespace {
 using diagnostic_msgs::DiagnosticStatus;
 namespace protocol = ranger::protocol;
 
-std::string hex(std::uint32_t v, int width) {
-  char buf[16];
-  std::snprintf(buf, sizeof buf, "0x%0*X", width, v);
-  return buf;
-}
+using ranger::text::hex;
 
 std::string join(const std::vector<std::string>& names) {
-  std::string out;
-  for (const auto& n : names)
-    out += (out.empty() ? "" : ", ") + n;
-  return out.empty() ? "none" : out;
+  return names.empty() ? "none" : ranger::text::join(names);
 }
 
 // A fault that stops the chassis is an ERROR; anything else it reports is a WARN.

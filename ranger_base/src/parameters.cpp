@@ -13,6 +13,7 @@
 #include <ranger_can/control/commissioning.hpp>
 #include <ranger_can/control/parameters.hpp>
 #include <ranger_can/sim/chassis_commands.hpp>
+#include <ranger_can/text.hpp>
 #include <ranger_can/transport/bus_source.hpp>
 
 namespace ranger_base {
@@ -69,12 +70,7 @@ std::string show(const XmlRpc::XmlRpcValue& v) {
   }
 }
 
-std::string join(const std::vector<std::string>& items, const char* separator = ", ") {
-  std::string out;
-  for (const auto& i : items)
-    out += (out.empty() ? "" : separator) + i;
-  return out;
-}
+using ranger::text::join;
 
 std::optional<double> as_number(const XmlRpc::XmlRpcValue& v) {
   XmlRpc::XmlRpcValue copy = v;
@@ -520,8 +516,15 @@ NodeParameters read_all(Reader& r) {
   const double ultrasonic_m =
       r.number("sim/ultrasonic_range", s.ultrasonic[0] / 1000.0, closed(0.0, 32.767), "m");
   s.ultrasonic.fill(static_cast<std::int16_t>(std::lround(ultrasonic_m * 1000.0)));
+  // Error bits by index or name, in the error-word layout of the port's variant.
+  ranger::ErrorWordLayout layout = s.profile.error_word;
+  if (const auto kind = ranger::bus_kind(p.port_name);
+      kind && *kind == ranger::BusKind::kSim && p.port_name.size() > 4) {
+    if (auto v = ranger::sim::apply_variant(p.port_name.substr(4), {}))
+      layout = v->profile.error_word;
+  }
   for (const auto& name : r.text_list("sim/errors")) {
-    if (auto bit = ranger::sim::parse_error_bit(name)) {
+    if (auto bit = ranger::sim::parse_error_bit(name, layout)) {
       p.sim.boot_error_bits |= 1u << *bit;
     } else {
       r.fail("sim/errors", "contains \"" + name + "\": " + bit.error().message);

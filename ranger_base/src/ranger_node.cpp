@@ -28,6 +28,7 @@
 #include <string>
 
 #include <ranger_can/sim/chassis_commands.hpp>
+#include <ranger_can/text.hpp>
 #include <ranger_can/transport/bus_source.hpp>
 
 #include "ranger_base/conversions.hpp"
@@ -61,12 +62,7 @@ double secs(nanoseconds d) {
   return ranger::seconds(d);
 }
 
-std::string join(const std::vector<std::string>& items, const char* separator = ", ") {
-  std::string out;
-  for (const auto& i : items)
-    out += (out.empty() ? "" : separator) + i;
-  return out;
-}
+using ranger::text::join;
 
 // "name<separator>value, ..." of (name, value) pairs, for the log.
 std::string join_pairs(const std::vector<std::pair<std::string, std::string>>& pairs,
@@ -83,9 +79,7 @@ bool is_socketcan(const std::string& port) {
 }
 
 std::string hex_word(std::uint32_t word) {
-  char buf[16];
-  std::snprintf(buf, sizeof buf, "0x%08" PRIX32, word);
-  return buf;
+  return ranger::text::hex(word, 8);
 }
 
 // Publishes a message as a shared pointer: a subscriber in the same process gets this very

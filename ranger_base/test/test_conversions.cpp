@@ -7,6 +7,9 @@
 #include <set>
 
 #include <ranger_can/control/geometry.hpp>
+#include <ranger_can/sim/sim_bus_source.hpp>
+#include <ranger_can/sim/virtual_chassis.hpp>
+#include <ranger_can/transport/loopback_bus.hpp>
 #include <ranger_can/wire/codec.hpp>
 #include <ranger_can/wire/protocol.hpp>
 
@@ -35,8 +38,17 @@ std::set<std::string> names(const std::vector<protocol::NamedBit>& bits) {
 
 // ---- named bits: the messages name every bit libranger_can defines, and nothing else ----------
 
-TEST(NamedBits, SystemErrorsHaveAFieldForEveryLibraryBit) {
-  EXPECT_EQ(keys(system_error_fields()), names(protocol::system_error_bits()));
+TEST(NamedBits, SystemErrorsHaveAFieldForEveryFaultOfTheTable) {
+  std::set<std::string> table;
+  for (const auto& f : protocol::kFaultTable)
+    table.emplace(f.name);
+  EXPECT_EQ(keys(system_error_fields()), table);
+  // Every name a layout's bits carry is a field of the message.
+  for (const auto layout :
+       {ranger::ErrorWordLayout::kManual32, ranger::ErrorWordLayout::kAgxV2_16}) {
+    for (const auto& n : names(protocol::system_error_bits(layout)))
+      EXPECT_EQ(table.count(n), 1u) << n;
+  }
 }
 
 TEST(NamedBits, DriverStatusHasAFieldForEveryLibraryBit) {
@@ -58,6 +70,65 @@ TEST(NamedBits, EachErrorBitSetsExactlyItsField) {
     for (const auto& [name, field] : fields) {
       EXPECT_EQ(msg.*field != 0, name == bit.name) << "bit " << bit.name << ", field " << name;
     }
+  }
+}
+
+// Every bit of every layout, raised on the virtual chassis of that layout and read from the 0x211
+// frame it sends, sets the message field of its meaning and no other; a reserved bit sets none.
+TEST(NamedBits, EveryErrorBitOfEveryLayoutOnTheVirtualChassisSetsTheFieldOfItsMeaning) {
+  const auto& fields = system_error_fields();
+  for (const char* variant : {"manual", "agx_v2"}) {
+    auto config = ranger::sim::apply_variant(variant, {});
+    ASSERT_TRUE(config.ok()) << variant;
+    const ranger::ErrorWordLayout layout = config->profile.error_word;
+    int defined = 0;
+    for (int bit = 0; bit < protocol::error_word_bits(layout); ++bit) {
+      ranger::LoopbackNetwork net;
+      auto chassis_bus = net.connect();
+      auto host_bus = net.connect();
+      ranger::sim::VirtualChassis chassis(*chassis_bus, *config, ranger::Timestamp{});
+      chassis.set_error_bit(bit, true);
+      chassis.step(ranger::Timestamp{} + 100ms);
+      std::optional<ranger::SystemStatus> status;
+      while (auto f = host_bus->receive(std::chrono::nanoseconds(0))) {
+        if (f->id != protocol::kSystemStatusId) continue;
+        if (auto m = ranger::decode(*f, config->profile)) {
+          if (auto* s = std::get_if<ranger::SystemStatus>(&*m)) status = *s;
+        }
+      }
+      ASSERT_TRUE(status.has_value()) << variant << " bit " << bit;
+      ASSERT_EQ(status->error_bits & (1u << bit), 1u << bit) << variant << " bit " << bit;
+      ranger_msgs::SystemErrors msg;
+      fill_system_errors(1u << bit, layout, msg);
+      const protocol::FaultInfo* meaning = protocol::fault_at(layout, bit);
+      if (meaning != nullptr) ++defined;
+      for (const auto& [name, field] : fields) {
+        EXPECT_EQ(msg.*field != 0, meaning != nullptr && name == meaning->name)
+            << variant << " bit " << bit << ", field " << name;
+      }
+      // The same word through the whole state message.
+      ranger::DriverSnapshot snap;
+      snap.profile = config->profile;
+      snap.controller.error_bits = status->error_bits;
+      const auto state = to_system_state(snap, ros::Time(1.0));
+      if (meaning != nullptr) {
+        EXPECT_TRUE(state.errors.*(fields.at(meaning->name))) << variant << " bit " << bit;
+      }
+    }
+    EXPECT_EQ(defined, static_cast<int>(protocol::system_error_bits(layout).size())) << variant;
+  }
+}
+
+// The faults both layouts have set the same field on either.
+TEST(NamedBits, AFaultOfBothLayoutsSetsTheSameFieldOnEither) {
+  for (const auto& f : protocol::kFaultTable) {
+    if (f.manual_bit == protocol::kNoBit || f.agx16_bit == protocol::kNoBit) continue;
+    ranger_msgs::SystemErrors manual;
+    ranger_msgs::SystemErrors agx;
+    fill_system_errors(1u << f.manual_bit, ranger::ErrorWordLayout::kManual32, manual);
+    fill_system_errors(1u << f.agx16_bit, ranger::ErrorWordLayout::kAgxV2_16, agx);
+    EXPECT_EQ(manual, agx) << f.name;
+    EXPECT_TRUE(agx.*(system_error_fields().at(f.name))) << f.name;
   }
 }
 

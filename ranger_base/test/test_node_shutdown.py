@@ -23,7 +23,7 @@ import rostest
 from geometry_msgs.msg import Twist, TwistStamped
 from ranger_msgs.msg import SystemState
 
-EXIT_BOUND_S = 0.3  # issue 16: exit within 0.3 s of Ctrl-C or rosnode kill
+EXIT_BOUND_S = 0.3  # exit within 0.3 s of Ctrl-C or rosnode kill
 STOP_LOG = "stop sent to the chassis"
 
 

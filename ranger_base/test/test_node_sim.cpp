@@ -36,9 +36,14 @@
 #include <std_srvs/Trigger.h>
 #include <tf2/utils.h>
 
+#include <ranger_base/conversions.hpp>
+#include <ranger_base/diagnostics.hpp>
+#include <ranger_can/wire/protocol.hpp>
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <deque>
 #include <functional>
 #include <limits>
@@ -784,7 +789,7 @@ TEST_F(MiniV1, SideSlipThroughSetMotionModeMovesSidewaysWithOdometry) {
       << p.response.message;
 }
 
-// ---- safety through ROS (issue 13): the re-arm latch, resume, sim/inject ------------------------
+// ---- safety through ROS: the re-arm latch, resume, sim/inject ------------------------
 
 class Safety : public NodeSim {
  protected:
@@ -1005,6 +1010,63 @@ TEST_F(Faults, ClearErrorsAnswersThenTheLatchHoldsUntilResume) {
       drive_until(twist(0.4, 0, 0), [] { return truth_.get()->twist.twist.linear.x > 0.3; }));
   EXPECT_FALSE(state_.get()->rearm_required);
   stop_and_settle();
+}
+
+// ---- node_sim_fault_bits*.test: every error bit of the chassis's layout, by meaning ------------
+
+class FaultBits : public Faults {
+ protected:
+  // The error-word layout of the chassis (the test's private parameter): "manual" or "agx_v2".
+  static ranger::ErrorWordLayout layout() {
+    std::string name = "manual";
+    ros::param::get("~layout", name);
+    return name == "agx_v2" ? ranger::ErrorWordLayout::kAgxV2_16
+                            : ranger::ErrorWordLayout::kManual32;
+  }
+
+  // The value /diagnostics' error status gives `key` (empty when absent).
+  static std::string diagnostic_value(const std::string& key) {
+    std::lock_guard<std::mutex> lock(commands_mutex_);
+    for (const auto& [name, status] : diagnostics_) {
+      if (name.size() < std::strlen(ranger_base::kDiagErrors) ||
+          name.compare(name.size() - std::strlen(ranger_base::kDiagErrors), std::string::npos,
+                       ranger_base::kDiagErrors) != 0) {
+        continue;
+      }
+      for (const auto& kv : status.values) {
+        if (kv.key == key) return kv.value;
+      }
+    }
+    return "";
+  }
+};
+
+// Each bit the layout defines, raised on the virtual chassis through sim/inject, shows the
+// SystemErrors field of its meaning (and no other) true in system_state, and its name active in
+// /diagnostics; dropped, it clears.
+TEST_F(FaultBits, EveryBitOfTheLayoutShowsTheFieldOfItsMeaning) {
+  const auto& fields = ranger_base::system_error_fields();
+  const auto& bits = ranger::protocol::system_error_bits(layout());
+  ASSERT_FALSE(bits.empty());
+  for (const auto& bit : bits) {
+    const std::string name(bit.name);
+    const auto field = fields.at(bit.name);
+    // The chassis's own watchdog: the node's next 0x111 clears it at once (the conversion test
+    // covers its field).
+    if (name == "host_communication_lost") continue;
+    inject("error " + std::to_string(bit.index));
+    ASSERT_TRUE(wait_for([&] { return state_.get()->errors.*field != 0; })) << name;
+    const auto s = *state_.get();
+    EXPECT_EQ(s.error_word, 1u << bit.index) << name;
+    for (const auto& [other, other_field] : fields) {
+      EXPECT_EQ(s.errors.*other_field != 0, other == bit.name) << name << ": field " << other;
+    }
+    EXPECT_TRUE(contains(s.active_errors, name)) << name;
+    EXPECT_TRUE(wait_for([&] { return diagnostic_value(name) == "active"; })) << name;
+    inject("error " + std::to_string(bit.index) + " off");
+    ASSERT_TRUE(wait_for([] { return state_.get()->error_word == 0; })) << name;
+    EXPECT_FALSE(state_.get()->errors.*field) << name;
+  }
 }
 
 // ---- node_sim_identify*.test: protocol auto (the default) -------------------------------------

@@ -5,7 +5,9 @@ Payloads for every message in the DBC (edge patterns, random bytes, and random v
 each signal's range) are written to a candump log, decoded by `ranger_can decode --json
 --protocol REVISION` and by cantools (installed from PyPI into a virtual environment this script
 creates, or reuses), and every signal is compared with the C++ field it describes. Also checked:
-the DBC and the codec know the same IDs with the same lengths (a DBC length longer than the
+the DBC's messages are the frame table's of the revision (protocol.hpp's kFrameTable, parsed
+here: identifiers, lengths, sender, GenMsgCycleTime = the nominal period); the DBC and the codec
+know the same IDs with the same lengths (a DBC length longer than the
 codec's layout shows as extra bytes, a shorter one as an error); every JSON field the codec prints
 for a frame is covered by some DBC signal (or is one the revision leaves reserved); a steering
 angle outside the DBC's stated range is refused by the codec as impossible content, one inside it
@@ -42,6 +44,9 @@ def parse_args(argv):
     p.add_argument("--venv", required=True, help="virtual environment for cantools (created if absent)")
     p.add_argument("--work", required=True, help="directory for the generated log")
     p.add_argument("--frames", type=int, default=400, help="random payloads per message")
+    p.add_argument("--frame-table", default=os.path.join(
+        os.path.dirname(os.path.abspath(__file__)), "..", "..", "libranger_can", "include",
+        "ranger_can", "wire", "protocol.hpp"), help="the header holding the frame table")
     p.add_argument("--seed", type=int, default=20240611)
     p.add_argument(IN_VENV_FLAG, action="store_true", help=argparse.SUPPRESS)
     return p.parse_args(argv)
@@ -391,6 +396,61 @@ PLANTED = [("BMS voltage scale of the other revision", plant_scale),
 
 # ---- main -------------------------------------------------------------------------------------
 
+# ---- the frame table ----------------------------------------------------------------------------
+
+def frame_table(header):
+    """kFrameTable of protocol.hpp, one entry per identifier: {id: row}."""
+    with open(header) as f:
+        text = f.read()
+    consts = {m.group(1): int(m.group(2), 0) for m in re.finditer(
+        r"inline constexpr (?:std::uint32_t|std::uint8_t|int) (k\w+) = (0x[0-9A-Fa-f]+|\d+);", text)}
+    start = text.index("kFrameTable[] = {")
+    body = text[start:text.index("};", start)]
+    row_re = re.compile(r'\{([^{}",]+),\s*([^,]+),\s*(\d+),\s*"(\w+)",\s*Direction::k(\w+),'
+                        r'\s*(\d+),\s*(\d+),\s*([\w| ]+)\}')
+    table = {}
+    for m in row_re.finditer(body):
+        first = eval(m.group(1), {}, dict(consts))  # our own source: constants and + only
+        count = eval(m.group(2), {}, dict(consts))
+        stride = int(m.group(3))
+        row = {"name": m.group(4), "direction": m.group(5), "length": int(m.group(6)),
+               "period": int(m.group(7)),
+               "revisions": {w.strip() for w in m.group(8).split("|")}}
+        for i in range(count):
+            table[first + i * stride] = row
+    if not table:
+        die(f"no frame table found in {header}")
+    return table
+
+
+def check_frame_table(messages, table, protocol):
+    """The DBC's messages against the frame table's frames of `protocol`."""
+    revision = "kInManual" if protocol == "manual" else "kInAgxV2"
+    expected = {i: r for i, r in table.items() if revision in r["revisions"]}
+    senders = {"ToChassis": "Host", "FromChassis": "Chassis"}
+    problems = []
+    for m in messages:
+        r = expected.get(m.frame_id)
+        where = f"ID 0x{m.frame_id:03X} {m.name}"
+        if r is None:
+            problems.append(f"{where}: in the DBC, not a {protocol} frame of the frame table")
+            continue
+        sender = m.senders[0] if m.senders else ""
+        if r["direction"] in senders and sender != senders[r["direction"]]:
+            problems.append(f"{where}: sent by {sender} in the DBC, {r['direction']} in the table")
+        if r["direction"] != "Both" and m.length != r["length"]:
+            problems.append(f"{where}: length {m.length} in the DBC, {r['length']} in the table")
+        if (m.cycle_time or 0) != r["period"]:
+            problems.append(f"{where}: GenMsgCycleTime {m.cycle_time or 0} in the DBC, period "
+                            f"{r['period']} ms in the table")
+    dbc_ids = {m.frame_id for m in messages}
+    for i, r in sorted(expected.items()):
+        if i not in dbc_ids:
+            problems.append(f"ID 0x{i:03X} ({r['name']}): a {protocol} frame of the table, not in "
+                            f"the DBC")
+    return problems
+
+
 def main():
     args = parse_args(sys.argv[1:])
     if not args.in_venv:
@@ -405,6 +465,14 @@ def main():
     other_ids = set()
     if args.other_dbc:
         other_ids = {m.frame_id for m in cantools.database.load_file(args.other_dbc).messages}
+
+    table_problems = check_frame_table(messages, frame_table(args.frame_table), args.protocol)
+    if table_problems:
+        print(f"check_dbc: {len(table_problems)} disagreement(s) between {args.dbc} and the frame "
+              f"table ({args.frame_table}):")
+        for p in table_problems:
+            print("  " + p)
+        sys.exit(1)
 
     frames = []  # (id, payload)
     for m in messages:

@@ -82,6 +82,28 @@ std::string_view to_string(MotionRefusal r) {
   return "unknown";
 }
 
+std::string_view to_string(ControllerFault f) {
+  switch (f) {
+    case ControllerFault::kLinkLost:
+      return "link_lost";
+    case ControllerFault::kEmergencyStop:
+      return "emergency_stop";
+    case ControllerFault::kVehicleAbnormal:
+      return "vehicle_abnormal";
+    case ControllerFault::kVehicleStatusUnknown:
+      return "vehicle_status_unknown";
+    case ControllerFault::kLowBattery:
+      return "low_battery";
+    case ControllerFault::kModeSwitchFailed:
+      return "motion_mode_switch_failed";
+    case ControllerFault::kImplausibleFeedback:
+      return "implausible_feedback";
+    case ControllerFault::kUltrasonicUnconfirmed:
+      return "ultrasonic_setting_unconfirmed";
+  }
+  return "unknown";
+}
+
 std::string_view to_string(LinkState s) {
   switch (s) {
     case LinkState::kNeverConnected:
@@ -823,23 +845,24 @@ void ChassisController::update_faults() {
   faults_valid_ = true;
   faults_signature_ = signature;
   std::vector<std::string> faults;
+  const auto add = [&faults](ControllerFault f) { faults.emplace_back(to_string(f)); };
   const StopCauses active = state_.active_causes;
-  if (has(active, StopCause::kLinkLost)) faults.emplace_back("link_lost");
-  if (has(active, StopCause::kEstop)) faults.emplace_back("emergency_stop");
+  if (has(active, StopCause::kLinkLost)) add(ControllerFault::kLinkLost);
+  if (has(active, StopCause::kEstop)) add(ControllerFault::kEmergencyStop);
   if (state_.vehicle_status == protocol::VehicleStatus::kAbnormal) {
-    faults.emplace_back("vehicle_abnormal");
+    add(ControllerFault::kVehicleAbnormal);
   }
   if (feedback_.system_status && !state_.vehicle_status) {
-    faults.emplace_back("vehicle_status_unknown");
+    add(ControllerFault::kVehicleStatusUnknown);
   }
   for (std::string& name :
        protocol::error_bit_names(state_.error_bits, config_.profile.error_word)) {
     faults.push_back(std::move(name));
   }
-  if (has(active, StopCause::kLowBattery)) faults.emplace_back("low_battery");
-  if (has(active, StopCause::kModeSwitchFailed)) faults.emplace_back("motion_mode_switch_failed");
-  if (has(active, StopCause::kImplausible)) faults.emplace_back("implausible_feedback");
-  if (state_.ultrasonic_failed) faults.emplace_back("ultrasonic_setting_unconfirmed");
+  if (has(active, StopCause::kLowBattery)) add(ControllerFault::kLowBattery);
+  if (has(active, StopCause::kModeSwitchFailed)) add(ControllerFault::kModeSwitchFailed);
+  if (has(active, StopCause::kImplausible)) add(ControllerFault::kImplausibleFeedback);
+  if (state_.ultrasonic_failed) add(ControllerFault::kUltrasonicUnconfirmed);
   state_.faults = std::move(faults);
 }
 

@@ -13,6 +13,7 @@
 
 #include <cstdio>
 
+#include "ranger_can/text.hpp"
 #include "ranger_can/wire/codec.hpp"
 #include "ranger_can/wire/interpretation.hpp"
 #include "ranger_can/wire/protocol.hpp"
@@ -27,7 +28,7 @@ constexpr std::size_t kMaxRequests = 16;
 // A 0x211 that arrives this soon after a request was sent may have left the chassis before the
 // request reached it: the answer is the first one after this.
 constexpr std::chrono::nanoseconds kAnswerDelay =
-    std::chrono::milliseconds(protocol::kFastPeriodMs);
+    std::chrono::milliseconds(protocol::frame_period_ms(protocol::kSystemStatusId));
 
 bool finite(const BodyTwist& t) {
   return std::isfinite(t.vx) && std::isfinite(t.vy) && std::isfinite(t.wz);
@@ -45,15 +46,11 @@ OdometryConfig odometry_config(const DriverConfig& config) {
 }
 
 std::string join_names(const std::vector<std::string>& names) {
-  std::string out;
-  for (const auto& n : names)
-    out += (out.empty() ? "" : ", ") + n;
-  return out;
+  return text::join(names);
 }
 
 std::string hex2(std::uint8_t v) {
-  static const char* digits = "0123456789ABCDEF";
-  return std::string("0x") + digits[v >> 4] + digits[v & 0xF];
+  return text::hex(v, 2);
 }
 
 double axis(std::int8_t raw) {

@@ -9,6 +9,7 @@
 
 #include "ranger_can/control/kinematics.hpp"
 #include "ranger_can/control/odometry.hpp"
+#include "ranger_can/text.hpp"
 #include "ranger_can/wire/interpretation.hpp"
 
 namespace ranger {
@@ -42,9 +43,7 @@ std::string secs(std::chrono::nanoseconds d) {
   return fmt("%.2f", seconds(d)) + " s";
 }
 std::string hex_id(std::uint32_t id) {
-  char buf[16];
-  std::snprintf(buf, sizeof buf, "0x%03X", static_cast<unsigned>(id));
-  return buf;
+  return text::hex(id);
 }
 
 const std::array<AngleUnit, 2> kUnits = {AngleUnit::kCentidegree, AngleUnit::kMilliradian};
@@ -384,22 +383,17 @@ void ChassisIdentifier::on_frame(const CanFrame& frame, Timestamp now) {
 
 void ChassisIdentifier::observe_passive(const CanFrame& frame) {
   const std::uint32_t id = frame.id;
-  // IDs only the vendor's revision sends.
-  if (id == protocol::kLightStateId || id == protocol::kRemoteControlStateId ||
-      id == protocol::kOdometerId ||
-      (id == protocol::kVersionId && !protocol::is_version_request(frame))) {
+  // Frames only the vendor's revision defines, sent by the chassis (the frame table).
+  const protocol::FrameInfo* info = protocol::find_frame(id);
+  const bool chassis_frame = protocol::is_chassis_frame(frame);
+  if (chassis_frame && (info->revisions & protocol::kInManual) == 0) {
     const std::string what = hex_id(id) + " (" + std::string(protocol::frame_name(id)) + ")";
     if (std::find(agx_signatures_.begin(), agx_signatures_.end(), what) == agx_signatures_.end()) {
       agx_signatures_.push_back(what);
     }
   }
   // Padding: a chassis frame longer than its layout (the host's own commands do not count).
-  const bool host_frame = id == protocol::kMotionCommandId || id == protocol::kLightCommandId ||
-                          id == protocol::kMotionModeCommandId ||
-                          id == protocol::kControlModeCommandId ||
-                          id == protocol::kErrorClearCommandId ||
-                          id == protocol::kUltrasonicSettingId || id == protocol::kVersionId;
-  if (!host_frame && protocol::extra_bytes(frame) > 0 &&
+  if (chassis_frame && protocol::extra_bytes(frame) > 0 &&
       std::find(padded_ids_.begin(), padded_ids_.end(), id) == padded_ids_.end()) {
     padded_ids_.push_back(id);
   }

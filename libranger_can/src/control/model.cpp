@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "ranger_can/parse.hpp"
+#include "ranger_can/text.hpp"
 
 namespace ranger {
 
@@ -29,12 +30,7 @@ std::string_view trim(std::string_view s) {
   return s.substr(first, last - first + 1);
 }
 
-std::string join(const std::vector<std::string>& names) {
-  std::string out;
-  for (const auto& n : names)
-    out += (out.empty() ? "" : ", ") + n;
-  return out;
-}
+using text::join;
 
 bool valid_key(std::string_view key) {
   return !key.empty() && std::all_of(key.begin(), key.end(), [](char c) {

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "ranger_can/parse.hpp"
+#include "ranger_can/text.hpp"
 #include "ranger_can/wire/protocol.hpp"
 
 namespace ranger::sim {
@@ -67,22 +68,32 @@ std::string fixed(double v, int decimals) {
 
 }  // namespace
 
-Result<int> parse_error_bit(const std::string& text) {
+Result<int> parse_error_bit(const std::string& text, ErrorWordLayout layout) {
+  const int width = protocol::error_word_bits(layout);
   if (!text.empty() && (std::isdigit(static_cast<unsigned char>(text[0])) != 0)) {
-    auto n = parse_integer("error bit", text, 0, 31);
+    auto n = parse_integer("error bit", text, 0, width - 1);
     if (!n) return n.error();
     return static_cast<int>(*n);
   }
-  std::string names;
-  for (const auto& b : protocol::system_error_bits()) {
-    if (b.name == text) return b.index;
-    names += (names.empty() ? "" : ", ") + std::string(b.name);
+  if (const protocol::FaultInfo* f = protocol::find_fault(text)) {
+    if (f->bit(layout) != protocol::kNoBit) return f->bit(layout);
   }
-  return Error{Errc::kInvalidArgument,
-               "unknown error bit '" + text + "' (give 0-31 or one of: " + names + ")"};
+  std::vector<std::string> names;
+  for (const auto& b : protocol::system_error_bits(layout))
+    names.emplace_back(b.name);
+  return Error{Errc::kInvalidArgument, "unknown error bit '" + text + "' (give 0-" +
+                                           std::to_string(width - 1) +
+                                           " or one of: " + text::join(names, ", ") + ")"};
 }
 
-std::string describe_chassis(const sim::ChassisSnapshot& s) {
+Result<int> check_error_bit(const std::string& text) {
+  auto manual = parse_error_bit(text, ErrorWordLayout::kManual32);
+  if (manual) return manual;
+  auto agx16 = parse_error_bit(text, ErrorWordLayout::kAgxV2_16);
+  return agx16 ? agx16 : manual;
+}
+
+std::string describe_chassis(const sim::ChassisSnapshot& s, ErrorWordLayout layout) {
   std::string out;
   out += "control " + std::string(protocol::to_string(s.control_mode));
   out += ", motion " + std::string(protocol::to_string(s.motion_mode));
@@ -97,10 +108,8 @@ std::string describe_chassis(const sim::ChassisSnapshot& s) {
          fixed(s.pose.yaw * 180 / M_PI, 1) + " deg)";
   out += ", battery " + fixed(s.battery.soc, 1) + "% " + fixed(s.battery.voltage, 1) + " V";
   out += ", errors ";
-  const auto names = protocol::error_bit_names(s.error_bits);
-  if (names.empty()) out += "none";
-  for (std::size_t i = 0; i < names.size(); ++i)
-    out += (i ? "," : "") + names[i];
+  const auto names = protocol::error_bit_names(s.error_bits, layout);
+  out += names.empty() ? "none" : text::join(names, ",");
   out += s.motion_allowed ? ", motion allowed" : ", motion refused: " + s.motion_refused_reason;
   auto position = [](protocol::RemoteSwitch p) {
     return p == protocol::RemoteSwitch::kUp     ? "top"
@@ -174,15 +183,20 @@ Result<ChassisAction> parse_chassis_command(std::string_view line) {
   }
   if (cmd == "error") {
     if (w.size() != 2 && w.size() != 3) return usage("usage: error BIT|NAME [on|off]");
-    auto bit = parse_error_bit(w[1]);
-    if (!bit) return bit.error();
+    if (auto bit = check_error_bit(w[1]); !bit) return bit.error();
     bool on = true;
     if (w.size() == 3) {
       auto v = parse_on_off(cmd, w[2]);
       if (!v) return v.error();
       on = *v;
     }
-    return act([bit = *bit, on](VirtualChassis& c) { c.set_error_bit(bit, on); });
+    // The bit of the name in the chassis's own layout.
+    return ChassisAction([name = w[1], on](VirtualChassis& c) -> std::string {
+      const auto bit = parse_error_bit(name, c.profile().error_word);
+      if (!bit) return bit.error().message;
+      c.set_error_bit(*bit, on);
+      return "";
+    });
   }
   if (cmd == "clear") {
     if (w.size() > 2) return usage("usage: clear [CODE]");
@@ -268,7 +282,8 @@ Result<ChassisAction> parse_chassis_command(std::string_view line) {
   }
   if (cmd == "status") {
     if (auto s = need(1, "status"); !s) return s.error();
-    return ChassisAction([](VirtualChassis& c) { return describe_chassis(c.snapshot()); });
+    return ChassisAction(
+        [](VirtualChassis& c) { return describe_chassis(c.snapshot(), c.profile().error_word); });
   }
   std::string names;
   for (const auto& n : chassis_command_names())

@@ -14,6 +14,7 @@
 #include "ranger_can/control/rearm.hpp"
 #include "ranger_can/parse.hpp"
 #include "ranger_can/sim/sim_bus_source.hpp"
+#include "ranger_can/text.hpp"
 #include "ranger_can/wire/protocol.hpp"
 
 namespace ranger::sim {
@@ -36,36 +37,9 @@ const char* const kActionsHelp =
     "\n"
     "chassis side, applied to the virtual chassis at once (what `status` prints goes to stderr):\n";
 
-const char* const kExpectHelp =
-    "\n"
-    "checks:\n"
-    "  expect refusal NAME      why motion is refused: none, link_lost, remote, estop,\n"
-    "                           critical_error, low_battery, mode_switch_failed,\n"
-    "                           implausible_feedback, rearm_required, standby, mode_unknown,\n"
-    "                           switching, cmd_timeout, below_minimum, parked\n"
-    "  expect control_mode standby|can|remote|null\n"
-    "  expect motion_mode ackermann|oblique|spin|park|side_slip|null   (the chassis's 0x291)\n"
-    "  expect rearm_required true|false\n"
-    "  expect identification listening|awaiting_control|spin_check|steer_probe|returning|\n"
-    "                           decided|failed|none   the identification's phase (none: the\n"
-    "                           protocol was given)\n"
-    "  expect moving | still    ground truth: the fastest point of the chassis (body centre or a\n"
-    "                           wheel) is faster than 1 mm/s | not faster\n"
-    "  expect fault NAME | no-fault NAME | no-faults\n"
-    "                           NAME as in the output's faults (emergency_stop, link_lost,\n"
-    "                           low_battery, over_current, ...)\n"
-    "  expect FIELD OP NUMBER   FIELD: t, truth.x|y|yaw|vx|vy|wz|speed, odom.x|y|yaw|vx|vy|wz,\n"
-    "                           steer_first_factor; OP: > < >= <= ==; the value as printed\n";
+// The checks, with the names each accepts (from the enums' `all` lists).
+std::string expect_help();
 }  // namespace
-
-const std::string& scenario_language_help() {
-  static const std::string text = [] {
-    std::string chassis = kChassisCommandHelp;
-    chassis.erase(0, chassis.find('\n') + 1);  // its own "commands (one per line):" heading
-    return std::string(kActionsHelp) + chassis + kExpectHelp;
-  }();
-  return text;
-}
 
 namespace {
 
@@ -84,12 +58,7 @@ Error problem(const std::string& what) {
   return Error{Errc::kParseError, what};
 }
 
-std::string join(const std::vector<std::string>& names, const char* sep = ", ") {
-  std::string out;
-  for (const auto& n : names)
-    out += (out.empty() ? "" : sep) + n;
-  return out;
-}
+using text::join;
 
 std::vector<std::string> split(std::string_view text) {
   std::vector<std::string> words;
@@ -137,39 +106,27 @@ std::string printable(const std::string& text) {
 // ---- names the checks accept ----
 
 const std::vector<std::string>& refusal_names() {
-  static const std::vector<std::string> names = [] {
-    std::vector<std::string> n;
-    for (MotionRefusal r :
-         {MotionRefusal::kNone, MotionRefusal::kLinkLost, MotionRefusal::kRemote,
-          MotionRefusal::kEstop, MotionRefusal::kCriticalError, MotionRefusal::kLowBattery,
-          MotionRefusal::kModeSwitchFailed, MotionRefusal::kImplausible,
-          MotionRefusal::kRearmRequired, MotionRefusal::kStandby, MotionRefusal::kModeUnknown,
-          MotionRefusal::kSwitching, MotionRefusal::kCmdTimeout, MotionRefusal::kBelowMinimum,
-          MotionRefusal::kParked}) {
-      n.emplace_back(to_string(r));
-    }
-    return n;
-  }();
+  static const std::vector<std::string> names = text::names_of(kAllMotionRefusals);
+  return names;
+}
+
+// An `all` list's names and "null" (the field has no value yet).
+template <typename Enum, std::size_t N>
+std::vector<std::string> names_or_null(const Enum (&all)[N]) {
+  std::vector<std::string> names = text::names_of(all);
+  names.emplace_back("null");
   return names;
 }
 
 const std::vector<std::string>& control_mode_names() {
-  static const std::vector<std::string> names = {
-      std::string(protocol::to_string(ControlMode::kStandby)),
-      std::string(protocol::to_string(ControlMode::kCan)),
-      std::string(protocol::to_string(ControlMode::kRemote)), "null"};
+  static const std::vector<std::string> names = names_or_null(protocol::kAllControlModes);
   return names;
 }
 
 // The identification's phases (protocol auto), and "none" for a protocol that was given.
 const std::vector<std::string>& identification_names() {
   static const std::vector<std::string> names = [] {
-    std::vector<std::string> out;
-    for (auto p : {IdentificationPhase::kListening, IdentificationPhase::kAwaitingControl,
-                   IdentificationPhase::kSpinCheck, IdentificationPhase::kSteerProbe,
-                   IdentificationPhase::kReturning, IdentificationPhase::kDecided,
-                   IdentificationPhase::kFailed})
-      out.emplace_back(to_string(p));
+    std::vector<std::string> out = text::names_of(kAllIdentificationPhases);
     out.emplace_back("none");
     return out;
   }();
@@ -177,32 +134,27 @@ const std::vector<std::string>& identification_names() {
 }
 
 const std::vector<std::string>& motion_mode_names() {
-  static const std::vector<std::string> names = {
-      std::string(protocol::to_string(MotionMode::kAckermann)),
-      std::string(protocol::to_string(MotionMode::kOblique)),
-      std::string(protocol::to_string(MotionMode::kSpin)),
-      std::string(protocol::to_string(MotionMode::kPark)),
-      std::string(protocol::to_string(MotionMode::kSideSlip)),
-      "null"};
+  static const std::vector<std::string> names = names_or_null(protocol::kAllMotionModes);
   return names;
 }
 
-// Every name ControllerState::faults can hold: the 0x211 error bits (reserved ones as
-// "reserved_bit_N") and the controller's own (controller.cpp, update_faults).
+// The fault table's names (protocol::kFaultTable), in its order.
+std::vector<std::string> fault_table_names() {
+  std::vector<std::string> n;
+  for (const protocol::FaultInfo& f : protocol::kFaultTable)
+    n.emplace_back(f.name);
+  return n;
+}
+
+// Every name ControllerState::faults can hold: the controller's own, the fault table's (either
+// layout) and a reserved bit's "reserved_bit_N".
 const std::vector<std::string>& fault_names() {
   static const std::vector<std::string> names = [] {
-    std::vector<std::string> n = {"link_lost",
-                                  "emergency_stop",
-                                  "vehicle_abnormal",
-                                  "vehicle_status_unknown",
-                                  "low_battery",
-                                  "motion_mode_switch_failed",
-                                  "implausible_feedback",
-                                  "ultrasonic_setting_unconfirmed"};
-    for (int bit = 0; bit < 32; ++bit) {
-      for (auto& name : protocol::error_bit_names(1u << bit))
-        n.push_back(std::move(name));
-    }
+    std::vector<std::string> n = text::names_of(kAllControllerFaults);
+    for (auto& name : fault_table_names())
+      n.push_back(std::move(name));
+    for (int bit = 0; bit < 32; ++bit)
+      n.push_back("reserved_bit_" + std::to_string(bit));
     return n;
   }();
   return names;
@@ -211,6 +163,54 @@ const std::vector<std::string>& fault_names() {
 const std::vector<std::string>& bool_names() {
   static const std::vector<std::string> names = {"true", "false"};
   return names;
+}
+
+// One help entry: `head` in the first 27 columns, then `text` wrapped at 100 columns, its
+// continuation lines indented to column 27.
+std::string help_entry(const std::string& head, const std::string& text) {
+  constexpr std::size_t kIndent = 27;
+  std::string out;
+  std::string line =
+      head.size() < kIndent ? head + std::string(kIndent - head.size(), ' ') : head + " ";
+  const std::size_t start = line.size();
+  std::istringstream words(text);
+  std::string w;
+  while (words >> w) {
+    if (line.size() > start && line.size() + 1 + w.size() > 100) {
+      out += line + "\n";
+      line = std::string(kIndent, ' ');
+    } else if (line.size() > start || line.size() > kIndent) {
+      if (line.back() != ' ') line += ' ';
+    }
+    line += w;
+  }
+  while (!line.empty() && line.back() == ' ')
+    line.pop_back();
+  return out + line + "\n";
+}
+
+std::string expect_help() {
+  return "\n"
+         "checks:\n" +
+         help_entry("  expect refusal NAME", "why motion is refused: " + join(refusal_names())) +
+         help_entry("  expect control_mode " + join(control_mode_names(), "|"), "") +
+         help_entry("  expect motion_mode " + join(motion_mode_names(), "|"),
+                    "(the chassis's 0x291)") +
+         help_entry("  expect rearm_required true|false", "") +
+         help_entry("  expect identification NAME",
+                    "the identification's phase: " + join(identification_names()) +
+                        " (none: the protocol was given)") +
+         help_entry("  expect moving | still",
+                    "ground truth: the fastest point of the chassis (body centre or a wheel) is "
+                    "faster than 1 mm/s | not faster") +
+         help_entry("  expect fault NAME | no-fault NAME | no-faults", "") +
+         help_entry("", "NAME as in the output's faults: the driver's (" +
+                            join(text::names_of(kAllControllerFaults)) +
+                            "), a 0x211 fault of either error-word layout (" +
+                            join(fault_table_names()) + ") or reserved_bit_N") +
+         help_entry("  expect FIELD OP NUMBER",
+                    "FIELD: t, truth.x|y|yaw|vx|vy|wz|speed, odom.x|y|yaw|vx|vy|wz, "
+                    "steer_first_factor; OP: > < >= <= ==; the value as printed");
 }
 
 bool contains(const std::vector<std::string>& names, const std::string& name) {
@@ -246,19 +246,7 @@ std::string seconds_text(std::chrono::milliseconds t) {
 
 void append_string(std::string& out, std::string_view s) {
   out += '"';
-  for (char c : s) {
-    const auto u = static_cast<unsigned char>(c);
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (u < 0x20 || u >= 0x7F) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", u);
-      out += buf;
-    } else {
-      out += c;
-    }
-  }
+  out += text::json_escape(s);
   out += '"';
 }
 
@@ -976,6 +964,15 @@ Result<ScenarioResult> run_scenario(const Scenario& scenario, const ScenarioOpti
         << " more failed expectation(s) not shown\n";
   }
   return result;
+}
+
+const std::string& scenario_language_help() {
+  static const std::string text = [] {
+    std::string chassis = kChassisCommandHelp;
+    chassis.erase(0, chassis.find('\n') + 1);  // its own "commands (one per line):" heading
+    return std::string(kActionsHelp) + chassis + expect_help();
+  }();
+  return text;
 }
 
 }  // namespace ranger::sim

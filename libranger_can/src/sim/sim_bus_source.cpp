@@ -1,4 +1,5 @@
 #include "ranger_can/sim/sim_bus_source.hpp"
+#include "ranger_can/text.hpp"
 
 #include <algorithm>
 #include <utility>
@@ -8,12 +9,7 @@ namespace {
 
 constexpr std::string_view kSim = "sim";
 
-std::string join(const std::vector<std::string>& names) {
-  std::string out;
-  for (const auto& n : names)
-    out += (out.empty() ? "" : ", ") + n;
-  return out;
-}
+using text::join;
 
 }  // namespace
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <initializer_list>
 #include <type_traits>
 #include <utility>
 
@@ -43,6 +44,25 @@ std::string names_of(std::uint32_t bits, ErrorWordLayout layout) {
   return out;
 }
 
+// The nominal period of a frame (the frame table).
+constexpr std::chrono::milliseconds period_of(std::uint32_t id) {
+  return std::chrono::milliseconds(protocol::frame_period_ms(id));
+}
+// The frames each schedule sends share its period.
+constexpr bool same_period(std::initializer_list<std::uint32_t> ids) {
+  for (const std::uint32_t id : ids) {
+    if (protocol::frame_period_ms(id) != protocol::frame_period_ms(*ids.begin())) return false;
+  }
+  return protocol::frame_period_ms(*ids.begin()) > 0;
+}
+static_assert(same_period({protocol::kSystemStatusId, protocol::kMotionFeedbackId,
+                           protocol::kMotorHighSpeedBaseId + 1, protocol::kSteeringAnglesId,
+                           protocol::kWheelSpeedsId, protocol::kMotionModeFeedbackId,
+                           protocol::kLightStateId, protocol::kRemoteControlStateId}));
+static_assert(same_period({protocol::kUltrasonic1to4Id, protocol::kUltrasonic5to8Id}));
+static_assert(same_period({protocol::kMotorLowSpeedBaseId + 1}));
+static_assert(same_period({protocol::kBmsBaseId, protocol::kBmsBaseId + 1}));
+
 // The 0x221 / 0x111 Ackermann angle of the profile's reading, from the mean front angle the model
 // keeps (REP-103 signs).
 double front_angle_from_mean(double mean, const VehicleGeometry& g, SteeringReference reference) {
@@ -68,10 +88,11 @@ VirtualChassis::VirtualChassis(Bus& bus, const VirtualChassisConfig& config, Tim
       ultrasonic_enabled_(config.ultrasonic_enabled),
       ultrasonic_(config.ultrasonic),
       garbage_rng_(config.garbage_seed) {
-  schedules_[kFast] = {std::chrono::milliseconds(protocol::kFastPeriodMs), boot_time};
-  schedules_[kUltrasonic] = {std::chrono::milliseconds(protocol::kUltrasonicPeriodMs), boot_time};
-  schedules_[kSlow] = {std::chrono::milliseconds(protocol::kSlowPeriodMs), boot_time};
-  schedules_[kBms] = {std::chrono::milliseconds(protocol::kBmsPeriodMs), boot_time};
+  // Each schedule sends the frames of one period of the frame table (send_due).
+  schedules_[kFast] = {period_of(protocol::kSystemStatusId), boot_time};
+  schedules_[kUltrasonic] = {period_of(protocol::kUltrasonic1to4Id), boot_time};
+  schedules_[kSlow] = {period_of(protocol::kMotorLowSpeedBaseId + 1), boot_time};
+  schedules_[kBms] = {period_of(protocol::kBmsBaseId), boot_time};
   control_mode_ = config.boot_in_remote_mode ? ControlMode::kRemote : ControlMode::kStandby;
   event(std::string("power on in ") + std::string(protocol::to_string(control_mode_)) +
         " mode, motion mode " + std::string(protocol::to_string(motion_.mode())) + ", battery " +
@@ -813,8 +834,7 @@ void VirtualChassis::send_due(ScheduleId which, Timestamp t) {
       mm.switching = motion_.switching();
       send(mm, t);
       if (config_.vendor_frames) {
-        // 0x231 and 0x241 at 20 ms, the period the vendor's manuals of the same family give
-        // (assumed for the RANGER), each with its counter.
+        // 0x231 and 0x241, each with its counter.
         LightState light = lights_.report();
         light.counter = vendor_counter_;
         send(light, t);

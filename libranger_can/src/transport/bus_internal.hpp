@@ -14,11 +14,12 @@
 #include <utility>
 #include <vector>
 
-#include "ranger_can/transport/bus.hpp"
 #include "ranger_can/clock.hpp"
+#include "ranger_can/result.hpp"
+#include "ranger_can/text.hpp"
+#include "ranger_can/transport/bus.hpp"
 #include "ranger_can/transport/error_frame.hpp"
 #include "ranger_can/wire/frame.hpp"
-#include "ranger_can/result.hpp"
 
 namespace ranger::bus_internal {
 
@@ -126,9 +127,7 @@ class ReopenSchedule {
 inline constexpr std::uint32_t kMaxStandardId = 0x7FF;
 
 inline std::string hex_id(std::uint32_t id) {
-  char b[16];
-  std::snprintf(b, sizeof b, "0x%03X", static_cast<unsigned>(id));
-  return b;
+  return text::hex(id);
 }
 
 // The checks every send() applies before a frame goes anywhere.

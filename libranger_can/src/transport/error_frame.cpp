@@ -1,4 +1,5 @@
 #include "ranger_can/transport/error_frame.hpp"
+#include "ranger_can/text.hpp"
 
 #include <cstdio>
 #include <vector>
@@ -20,14 +21,7 @@ CanFrame make(std::uint32_t classes, std::uint8_t controller_status) {
 
 namespace {
 
-std::string join(const std::vector<std::string>& parts, const char* sep) {
-  std::string out;
-  for (const auto& p : parts) {
-    if (!out.empty()) out += sep;
-    out += p;
-  }
-  return out;
-}
+using text::join;
 
 }  // namespace
 

@@ -15,6 +15,7 @@
 #include <limits>
 #include <type_traits>
 
+#include "ranger_can/text.hpp"
 #include "ranger_can/wire/interpretation.hpp"
 
 namespace ranger {
@@ -162,11 +163,7 @@ VehicleStatus vehicle_status_from_wire(std::uint8_t raw, const ProtocolProfile& 
 constexpr auto kNoMotionMode = static_cast<MotionMode>(0xFF);
 
 // ---- Error messages (only built on failure paths) ---------------------------------------------
-std::string hex(std::uint32_t v, int width = 3) {
-  char buf[16];
-  std::snprintf(buf, sizeof buf, "0x%0*X", width, v);
-  return buf;
-}
+using text::hex;
 
 std::string id_text(std::uint32_t id) {
   return hex(id) + " (" + std::string(protocol::frame_name(id)) + ")";

@@ -1,5 +1,6 @@
 #include "ranger_can/wire/interpretation.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -48,18 +49,14 @@ double ackermann_curvature_from_inner_angle(double inner_angle, double wheelbase
 }
 
 const std::vector<protocol::Fault>& critical_faults() {
-  using protocol::Fault;
-  static const std::vector<Fault> kFaults = {
-      Fault::kBatteryUnderVoltage,
-      Fault::kDriverStatusError,
-      Fault::kOverTemperature,
-      Fault::kOverCurrent,
-      Fault::kMotorCommunication,
-      Fault::kSteeringCalibration,
-      Fault::kSteeringCalibrationTimeout,
-      Fault::kSafetyEdge,
-      Fault::kSteeringEncoder,
-  };
+  static const std::vector<protocol::Fault> kFaults = [] {
+    std::vector<protocol::Fault> faults;
+    for (const protocol::FaultInfo& f : protocol::kFaultTable) {
+      if (f.critical && std::find(faults.begin(), faults.end(), f.fault) == faults.end())
+        faults.push_back(f.fault);
+    }
+    return faults;
+  }();
   return kFaults;
 }
 
@@ -67,10 +64,8 @@ std::uint32_t critical_error_mask(ErrorWordLayout layout) {
   // Built once per layout: the controller asks for every 0x211 (50 times a second).
   auto build = [](ErrorWordLayout l) {
     std::uint32_t mask = 0;
-    for (const protocol::Fault f : critical_faults()) {
-      mask |= protocol::fault_bit(f, l);
-      for (int motor = 1; motor <= protocol::kMotorCount; ++motor)
-        mask |= protocol::fault_bit(f, l, motor);
+    for (const protocol::FaultInfo& f : protocol::kFaultTable) {
+      if (f.critical && f.bit(l) != protocol::kNoBit) mask |= 1u << f.bit(l);
     }
     return mask;
   };

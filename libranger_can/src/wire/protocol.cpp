@@ -12,76 +12,46 @@ namespace ranger::protocol {
 
 namespace {
 
-constexpr bool is_motor_id(std::uint32_t id, std::uint32_t base) {
-  return id > base && id <= base + static_cast<std::uint32_t>(kMotorCount);
-}
-constexpr bool is_bms_id(std::uint32_t id) {
-  return id >= kBmsBaseId && id < kBmsBaseId + 10;
-}
-
-}  // namespace
-
-std::vector<std::uint32_t> manual_ids() {
-  std::vector<std::uint32_t> ids = {kMotionCommandId, kMotionModeCommandId, kSystemStatusId,
-                                    kMotionFeedbackId};
-  for (std::uint32_t m = 1; m <= kMotorCount; ++m)
-    ids.push_back(kMotorHighSpeedBaseId + m);
-  for (std::uint32_t m = 1; m <= kMotorCount; ++m)
-    ids.push_back(kMotorLowSpeedBaseId + m);
-  ids.insert(ids.end(), {kSteeringAnglesId, kWheelSpeedsId, kMotionModeFeedbackId,
-                         kUltrasonic1to4Id, kUltrasonic5to8Id});
-  for (std::uint32_t k = 0; k < 10; ++k)
-    ids.push_back(kBmsBaseId + k);
-  ids.insert(ids.end(), {kControlModeCommandId, kErrorClearCommandId, kUltrasonicSettingId,
-                         kUltrasonicSettingFeedbackId});
-  return ids;  // ascending: 0x111 ... 0x36A, 0x421, 0x441, 0x451, 0x45A
-}
-
-std::vector<std::uint32_t> all_ids() {
-  std::vector<std::uint32_t> ids = manual_ids();
-  ids.insert(ids.end(),
-             {kLightCommandId, kLightStateId, kRemoteControlStateId, kOdometerId, kVersionId});
+std::vector<std::uint32_t> ids_of(std::uint8_t revisions) {
+  std::vector<std::uint32_t> ids;
+  for (const FrameInfo& f : kFrameTable) {
+    if ((f.revisions & revisions) == 0) continue;
+    for (int i = 0; i < f.count; ++i)
+      ids.push_back(f.id + static_cast<std::uint32_t>(i * f.stride));
+  }
   std::sort(ids.begin(), ids.end());
   return ids;
 }
 
+}  // namespace
+
+std::string_view to_string(Direction d) {
+  switch (d) {
+    case Direction::kToChassis:
+      return "to_chassis";
+    case Direction::kFromChassis:
+      return "from_chassis";
+    case Direction::kBoth:
+      return "both";
+  }
+  return "unknown";
+}
+
+std::vector<std::uint32_t> manual_ids() {
+  return ids_of(kInManual);
+}
+
+std::vector<std::uint32_t> all_ids() {
+  return ids_of(kInManual | kInAgxV2);
+}
+
 bool is_known_id(std::uint32_t id) {
-  return layout_dlc(id) >= 0;
+  return find_frame(id) != nullptr;
 }
 
 int layout_dlc(std::uint32_t id) {
-  switch (id) {
-    case kMotionCommandId:
-    case kLightCommandId:
-    case kSystemStatusId:
-    case kMotionFeedbackId:
-    case kLightStateId:
-    case kRemoteControlStateId:
-    case kSteeringAnglesId:
-    case kWheelSpeedsId:
-    case kOdometerId:
-    case kUltrasonic1to4Id:
-    case kUltrasonic5to8Id:
-      return 8;
-    case kMotionModeCommandId:
-    case kControlModeCommandId:
-    case kErrorClearCommandId:
-    case kUltrasonicSettingId:
-    case kUltrasonicSettingFeedbackId:
-    case kVersionId:
-      return 1;
-    case kMotionModeFeedbackId:
-      return 2;
-    default:
-      break;
-  }
-  if (is_motor_id(id, kMotorHighSpeedBaseId) || is_motor_id(id, kMotorLowSpeedBaseId)) return 8;
-  if (is_bms_id(id)) return ((id - kBmsBaseId) % 2 == 0) ? 8 : 4;
-  return -1;
-}
-
-int expected_dlc(std::uint32_t id) {
-  return layout_dlc(id);
+  const FrameInfo* f = find_frame(id);
+  return f != nullptr ? f->length : -1;
 }
 
 bool is_version_request(const CanFrame& f) {
@@ -91,6 +61,13 @@ bool is_version_request(const CanFrame& f) {
     if (f.data[i] != 0) return false;
   }
   return true;
+}
+
+bool is_chassis_frame(const CanFrame& frame) {
+  const FrameInfo* f = find_frame(frame.id);
+  if (f == nullptr || frame.is_error) return false;
+  return f->direction == Direction::kFromChassis ||
+         (f->direction == Direction::kBoth && !is_version_request(frame));
 }
 
 int extra_bytes(const CanFrame& frame) {
@@ -103,49 +80,8 @@ int extra_bytes(const CanFrame& frame) {
 }
 
 std::string_view frame_name(std::uint32_t id) {
-  switch (id) {
-    case kMotionCommandId:
-      return "motion_command";
-    case kLightCommandId:
-      return "light_command";
-    case kMotionModeCommandId:
-      return "motion_mode_command";
-    case kControlModeCommandId:
-      return "control_mode_command";
-    case kErrorClearCommandId:
-      return "error_clear_command";
-    case kUltrasonicSettingId:
-      return "ultrasonic_setting";
-    case kVersionId:
-      return "version";
-    case kSystemStatusId:
-      return "system_status";
-    case kMotionFeedbackId:
-      return "motion_feedback";
-    case kLightStateId:
-      return "light_state";
-    case kRemoteControlStateId:
-      return "remote_control";
-    case kSteeringAnglesId:
-      return "steering_angles";
-    case kWheelSpeedsId:
-      return "wheel_speeds";
-    case kMotionModeFeedbackId:
-      return "motion_mode";
-    case kOdometerId:
-      return "odometer";
-    case kUltrasonic1to4Id:
-    case kUltrasonic5to8Id:
-      return "ultrasonic";
-    case kUltrasonicSettingFeedbackId:
-      return "ultrasonic_setting_feedback";
-    default:
-      break;
-  }
-  if (is_motor_id(id, kMotorHighSpeedBaseId)) return "motor_high_speed";
-  if (is_motor_id(id, kMotorLowSpeedBaseId)) return "motor_low_speed";
-  if (is_bms_id(id)) return ((id - kBmsBaseId) % 2 == 0) ? "bms" : "bms_alarm";
-  return "unknown";
+  const FrameInfo* f = find_frame(id);
+  return f != nullptr ? f->name : "unknown";
 }
 
 // ---- Motion modes -------------------------------------------------------------------------------
@@ -292,74 +228,14 @@ int error_word_bits(ErrorWordLayout layout) {
 
 namespace {
 
-const std::vector<NamedBit>& manual_error_bits() {
-  // Wheel order of the manual (RF, RR, LR, LF), named as in geometry.hpp's joint names.
-  static const std::vector<NamedBit> bits = {
-      // byte 7 (least significant)
-      {error_bit_index(7, 0), "battery_under_voltage", "battery under-voltage"},
-      {error_bit_index(7, 1), "ultrasonic_obstacle_triggered",
-       "ultrasonic obstacle avoidance triggered"},
-      {error_bit_index(7, 2), "remote_control_lost", "remote control lost-connection protection"},
-      {error_bit_index(7, 3), "motor_driver_1_communication_fault",
-       "communication fault of motor driver 1 (front-right wheel)"},
-      {error_bit_index(7, 4), "motor_driver_2_communication_fault",
-       "communication fault of motor driver 2 (rear-right wheel)"},
-      {error_bit_index(7, 5), "motor_driver_3_communication_fault",
-       "communication fault of motor driver 3 (rear-left wheel)"},
-      {error_bit_index(7, 6), "motor_driver_4_communication_fault",
-       "communication fault of motor driver 4 (front-left wheel)"},
-      // byte 6
-      {error_bit_index(6, 0), "driver_status_error", "motor driver status error"},
-      {error_bit_index(6, 1), "host_communication_lost",
-       "communication with the upper layer (host) lost"},
-      {error_bit_index(6, 2), "motor_driver_5_communication_fault",
-       "communication fault of motor driver 5 (front-right steering)"},
-      {error_bit_index(6, 3), "motor_driver_6_communication_fault",
-       "communication fault of motor driver 6 (rear-right steering)"},
-      {error_bit_index(6, 4), "motor_driver_7_communication_fault",
-       "communication fault of motor driver 7 (rear-left steering)"},
-      {error_bit_index(6, 5), "motor_driver_8_communication_fault",
-       "communication fault of motor driver 8 (front-left steering)"},
-      {error_bit_index(6, 6), "over_temperature", "over-temperature protection"},
-      {error_bit_index(6, 7), "over_current", "over-current protection"},
-      // byte 5
-      {error_bit_index(5, 0), "steering_calibration_fault_front_right",
-       "steering zero-point calibration fault, front-right"},
-      {error_bit_index(5, 1), "steering_calibration_fault_rear_right",
-       "steering zero-point calibration fault, rear-right"},
-      {error_bit_index(5, 2), "steering_calibration_fault_rear_left",
-       "steering zero-point calibration fault, rear-left"},
-      {error_bit_index(5, 3), "steering_calibration_fault_front_left",
-       "steering zero-point calibration fault, front-left"},
-      {error_bit_index(5, 4), "steering_calibration_timeout", "steering calibration timeout"},
-      {error_bit_index(5, 5), "safety_edge_collision", "safety edge (bumper) collision"},
-      // byte 4 (most significant)
-      {error_bit_index(4, 0), "steering_servo_warning_front_right",
-       "steering servo warning, front-right"},
-      {error_bit_index(4, 1), "steering_servo_warning_rear_right",
-       "steering servo warning, rear-right"},
-      {error_bit_index(4, 2), "steering_servo_warning_rear_left",
-       "steering servo warning, rear-left"},
-      {error_bit_index(4, 3), "steering_servo_warning_front_left",
-       "steering servo warning, front-left"},
-  };
-  return bits;
-}
-
-const std::vector<NamedBit>& agx16_error_bits() {
-  // PROTOCOL_AGX_V2.md: generic to the vendor's chassis family.
-  static const std::vector<NamedBit> bits = {
-      {0, "battery_fault", "battery fault"},
-      {1, "battery_warning", "battery warning"},
-      {2, "remote_signal_lost", "remote-control signal lost"},
-      {3, "motor1_communication", "communication fault of motor 1 (front-right wheel)"},
-      {4, "motor2_communication", "communication fault of motor 2 (rear-right wheel)"},
-      {5, "motor3_communication", "communication fault of motor 3 (rear-left wheel)"},
-      {6, "motor4_communication", "communication fault of motor 4 (front-left wheel)"},
-      {7, "steering_encoder", "steering encoder fault"},
-      {8, "motor_driver", "motor driver fault"},
-      {9, "host_communication_lost", "communication with the host lost"},
-  };
+// A layout's rows of the fault table as named bits, in ascending bit order.
+std::vector<NamedBit> layout_bits(ErrorWordLayout layout) {
+  std::vector<NamedBit> bits;
+  for (const FaultInfo& f : kFaultTable) {
+    if (f.bit(layout) != kNoBit) bits.push_back({f.bit(layout), f.name, f.description});
+  }
+  std::sort(bits.begin(), bits.end(),
+            [](const NamedBit& x, const NamedBit& y) { return x.index < y.index; });
   return bits;
 }
 
@@ -381,18 +257,16 @@ std::vector<std::string> names_of_set_bits(std::uint32_t word, int width,
   return names;
 }
 
-std::uint32_t manual_bit(int byte, int bit) {
-  return 1u << error_bit_index(byte, bit);
-}
-
 }  // namespace
 
 const std::vector<NamedBit>& system_error_bits(ErrorWordLayout layout) {
-  return layout == ErrorWordLayout::kAgxV2_16 ? agx16_error_bits() : manual_error_bits();
+  static const std::vector<NamedBit> manual = layout_bits(ErrorWordLayout::kManual32);
+  static const std::vector<NamedBit> agx16 = layout_bits(ErrorWordLayout::kAgxV2_16);
+  return layout == ErrorWordLayout::kAgxV2_16 ? agx16 : manual;
 }
 
 const std::vector<NamedBit>& system_error_bits() {
-  return manual_error_bits();
+  return system_error_bits(ErrorWordLayout::kManual32);
 }
 
 std::vector<std::string> error_bit_names(std::uint32_t error_word, ErrorWordLayout layout) {
@@ -445,59 +319,30 @@ std::string_view to_string(Fault f) {
   return "unknown";
 }
 
+const FaultInfo* find_fault(Fault fault, int motor) {
+  for (const FaultInfo& f : kFaultTable) {
+    if (f.fault == fault && (f.motor == 0 || f.motor == motor)) return &f;
+  }
+  return nullptr;
+}
+
+const FaultInfo* find_fault(std::string_view name) {
+  for (const FaultInfo& f : kFaultTable) {
+    if (f.name == name) return &f;
+  }
+  return nullptr;
+}
+
+const FaultInfo* fault_at(ErrorWordLayout layout, int index) {
+  for (const FaultInfo& f : kFaultTable) {
+    if (index != kNoBit && f.bit(layout) == index) return &f;
+  }
+  return nullptr;
+}
+
 std::uint32_t fault_bit(Fault fault, ErrorWordLayout layout, int motor) {
-  const bool steering_motor = motor >= 5 && motor <= kMotorCount;
-  if (layout == ErrorWordLayout::kAgxV2_16) {
-    switch (fault) {
-      case Fault::kBatteryUnderVoltage:
-        return 0x0001;
-      case Fault::kBatteryWarning:
-        return 0x0002;
-      case Fault::kRemoteSignalLost:
-        return 0x0004;
-      case Fault::kMotorCommunication:
-        return motor >= 1 && motor <= 4 ? 0x0008u << (motor - 1) : 0;
-      case Fault::kSteeringEncoder:
-        return 0x0080;
-      case Fault::kDriverStatusError:
-        return 0x0100;
-      case Fault::kHostCommunicationLost:
-        return 0x0200;
-      default:
-        return 0;
-    }
-  }
-  switch (fault) {
-    case Fault::kBatteryUnderVoltage:
-      return manual_bit(7, 0);
-    case Fault::kUltrasonicTriggered:
-      return manual_bit(7, 1);
-    case Fault::kRemoteSignalLost:
-      return manual_bit(7, 2);
-    case Fault::kMotorCommunication:
-      if (motor >= 1 && motor <= 4) return manual_bit(7, 2 + motor);
-      return steering_motor ? manual_bit(6, motor - 3) : 0;
-    case Fault::kDriverStatusError:
-      return manual_bit(6, 0);
-    case Fault::kHostCommunicationLost:
-      return manual_bit(6, 1);
-    case Fault::kOverTemperature:
-      return manual_bit(6, 6);
-    case Fault::kOverCurrent:
-      return manual_bit(6, 7);
-    case Fault::kSteeringCalibration:
-      return steering_motor ? manual_bit(5, motor - 5) : 0;
-    case Fault::kSteeringCalibrationTimeout:
-      return manual_bit(5, 4);
-    case Fault::kSafetyEdge:
-      return manual_bit(5, 5);
-    case Fault::kSteeringServoWarning:
-      return steering_motor ? manual_bit(4, motor - 5) : 0;
-    case Fault::kBatteryWarning:
-    case Fault::kSteeringEncoder:
-      return 0;
-  }
-  return 0;
+  const FaultInfo* f = find_fault(fault, motor);
+  return f != nullptr && f->bit(layout) != kNoBit ? 1u << f->bit(layout) : 0u;
 }
 
 // ---- 0x261-0x268 driver status bits -----------------------------------------------------------

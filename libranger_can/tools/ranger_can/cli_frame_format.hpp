@@ -1,9 +1,9 @@
 // How the ranger_can tool shows a RANGER frame: one JSON object or one human-readable line.
 // `decode` prints these for every log line; `monitor` and others may reuse them.
 //
-// JSON line contract (issue 2): every line has `t` (s; 0 when the log line had no timestamp),
+// JSON line contract: every line has `t` (s; 0 when the log line had no timestamp),
 // `iface`, `id` (integer), `name` (protocol::frame_name), `dlc`, `data` (hex), `extra_bytes` when
-// the frame is longer than its layout (issue 14: those bytes were ignored); then the decoded
+// the frame is longer than its layout (those bytes are ignored); then the decoded
 // message's fields in SI units and the manual's signs (rad, m/s, V, A, degC, %), or `error` for a
 // frame that did not decode (short DLC, unknown ID, impossible content, error frame). Frames are
 // decoded under a protocol profile (cli_profile.hpp: --protocol, --set), which also names the

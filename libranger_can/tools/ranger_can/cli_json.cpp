@@ -1,4 +1,5 @@
 #include "cli_json.hpp"
+#include "ranger_can/text.hpp"
 
 #include <charconv>
 #include <cmath>
@@ -24,36 +25,8 @@ void append_json_number(std::string& out, double v) {
 }
 
 void append_json_string(std::string& out, std::string_view v) {
-  static constexpr char kHex[] = "0123456789abcdef";
   out += '"';
-  for (const char ch : v) {
-    const auto c = static_cast<unsigned char>(ch);
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\r':
-        out += "\\r";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      default:
-        if (c < 0x20 || c >= 0x7F) {  // control bytes and anything non-ASCII (may be bad UTF-8)
-          out += "\\u00";
-          out += kHex[c >> 4];
-          out += kHex[c & 0x0F];
-        } else {
-          out += ch;
-        }
-    }
-  }
+  out += text::json_escape(v);
   out += '"';
 }
 

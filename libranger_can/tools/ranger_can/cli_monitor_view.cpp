@@ -8,6 +8,7 @@
 
 #include "cli_json.hpp"
 #include "ranger_can/control/geometry.hpp"
+#include "ranger_can/text.hpp"
 #include "ranger_can/wire/interpretation.hpp"
 #include "ranger_can/wire/protocol.hpp"
 
@@ -57,29 +58,17 @@ std::string age_text(Timestamp received, Timestamp now) {
 }
 
 std::string hex_id(std::uint32_t id) {
-  char buf[16];
-  std::snprintf(buf, sizeof buf, "0x%03X", id);
-  return buf;
+  return text::hex(id);
 }
 
-// Nominal frames per second of a feedback ID (0 for commands and on-change frames).
+// Nominal frames per second of a feedback ID (0 for commands and on-change frames): the frame
+// table's period.
 double nominal_rate(std::uint32_t id) {
-  if (id == protocol::kSystemStatusId || id == protocol::kMotionFeedbackId ||
-      id == protocol::kSteeringAnglesId || id == protocol::kWheelSpeedsId ||
-      id == protocol::kMotionModeFeedbackId ||
-      (id > protocol::kMotorHighSpeedBaseId && id <= protocol::kMotorHighSpeedBaseId + 8)) {
-    return 1000.0 / protocol::kFastPeriodMs;
+  const protocol::FrameInfo* f = protocol::find_frame(id);
+  if (f == nullptr || f->direction != protocol::Direction::kFromChassis || f->period_ms == 0) {
+    return 0.0;
   }
-  if (id == protocol::kUltrasonic1to4Id || id == protocol::kUltrasonic5to8Id) {
-    return 1000.0 / protocol::kUltrasonicPeriodMs;
-  }
-  if (id > protocol::kMotorLowSpeedBaseId && id <= protocol::kMotorLowSpeedBaseId + 8) {
-    return 1000.0 / protocol::kSlowPeriodMs;
-  }
-  if (id >= protocol::kBmsBaseId && id < protocol::kBmsBaseId + 10) {
-    return 1000.0 / protocol::kBmsPeriodMs;
-  }
-  return 0.0;
+  return 1000.0 / f->period_ms;
 }
 
 std::string ultrasonic_text(std::int16_t raw) {
@@ -95,7 +84,7 @@ void ChassisMonitor::on_frame(const CanFrame& frame, Timestamp now) {
     return;
   }
   auto decoded = decode(frame, profile_);
-  stats_.record(frame.id, now, decoded.ok(), frame.dlc - protocol::expected_dlc(frame.id));
+  stats_.record(frame.id, now, decoded.ok(), protocol::extra_bytes(frame));
   if (!decoded) {
     ++decode_errors_;
     return;

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "ranger_can/parse.hpp"
+#include "ranger_can/text.hpp"
 
 namespace ranger::cli {
 
@@ -144,10 +145,7 @@ Error usage(std::string message) {
 }
 
 std::string join(const std::vector<std::string>& words, const char* separator) {
-  std::string out;
-  for (const auto& w : words)
-    out += (out.empty() ? "" : separator) + w;
-  return out;
+  return text::join(words, separator);
 }
 
 Status check_value(const std::string& what, const ValueRule& rule, const std::string& value) {

@@ -12,6 +12,7 @@
 #include "ranger_can/control/parameters.hpp"
 #include "ranger_can/sim/scenario.hpp"
 #include "ranger_can/sim/sim_bus_source.hpp"
+#include "ranger_can/text.hpp"
 
 namespace ranger::cli {
 
@@ -97,10 +98,7 @@ int scenario_main(const ParsedArgs& args, Io io) {
 }
 
 std::string join(const std::vector<std::string>& names, const char* sep) {
-  std::string out;
-  for (const auto& n : names)
-    out += (out.empty() ? "" : sep) + n;
-  return out;
+  return text::join(names, sep);
 }
 
 }  // namespace

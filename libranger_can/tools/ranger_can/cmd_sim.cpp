@@ -59,7 +59,7 @@ struct SimOptions {
   std::string variant = "manual";
   bool estop = false;
   bool stuck = false;
-  std::vector<int> errors;
+  std::vector<std::string> errors;  // error bits by index or name, of the variant's layout
   std::string pose_out;
   double pose_rate = 50.0;
   std::string control_fifo;
@@ -117,8 +117,7 @@ Result<SimOptions> options_from(const ParsedArgs& args) {
   o.config.boot_in_remote_mode = args.has("--remote");
   if (auto v = args.get("--firmware")) o.config.version = *v;
   o.estop = args.has("--estop");
-  for (const auto& e : args.all("--error"))
-    o.errors.push_back(*parse_error_bit(e));
+  o.errors = args.all("--error");
   o.stuck = args.has("--stuck-mode-switch");
   o.config.limits.acceleration = args.number("--accel", o.config.limits.acceleration);
   if (args.has("--steering-rate")) {
@@ -134,6 +133,9 @@ Result<SimOptions> options_from(const ParsedArgs& args) {
   auto config = sim::apply_variant(o.variant, o.config);
   if (!config) return config.error();
   o.config = *config;
+  for (const auto& e : o.errors) {
+    if (auto b = parse_error_bit(e, o.config.profile.error_word); !b) return b.error();
+  }
   return o;
 }
 
@@ -269,8 +271,9 @@ int sim_main(const ParsedArgs& args, Io io) {
   runner.with_chassis([&](sim::VirtualChassis& c) {
     if (o.estop) c.set_emergency_stop(true);
     if (o.stuck) c.set_mode_switch_stuck(true);
-    for (int b : o.errors)
-      c.set_error_bit(b, true);
+    for (const auto& e : o.errors) {
+      if (auto b = parse_error_bit(e, c.profile().error_word)) c.set_error_bit(*b, true);
+    }
   });
   if (!o.quiet) {
     io.out << "ranger_can sim: virtual RANGER on " << (*bus)->name() << " (variant " << o.variant
@@ -488,8 +491,9 @@ const CommandSpec& sim_command() {
                  "the firmware version the chassis answers 0x4A1 with (agx_v2 variants; "
                  "default 'ranger_sim 0.1.0'; the control command 'version TEXT' changes it)"),
           flag("--estop", "boot with the emergency stop pressed"),
-          option("--error", "BIT|NAME", "boot with this 0x211 error bit raised",
-                 checked_by([](const std::string& t) { return check_with(parse_error_bit, t); }))
+          option(
+              "--error", "BIT|NAME", "boot with this 0x211 error bit raised",
+              checked_by([](const std::string& t) { return check_with(sim::check_error_bit, t); }))
               .repeated(),
           flag("--stuck-mode-switch", "motion-mode switches never complete"),
           option("--accel", "M/S2",

@@ -90,8 +90,8 @@ ranger::Result<ranger::LightsRequest> to_lights_request(const ranger_msgs::SetLi
 void fill_lights_response(const std::optional<ranger::LightsState>& lights,
                           ranger_msgs::SetLights::Response& out);
 
-// Sets every SystemErrors field from the chassis's error word, through libranger_can's bit names
-// for the word's layout (the protocol profile's).
+// Sets the SystemErrors fields by meaning: each row of the fault table (protocol::kFaultTable)
+// with a bit in `layout` sets the field of its name from that bit; the others stay as they are.
 void fill_system_errors(std::uint32_t error_word, ranger::ErrorWordLayout layout,
                         ranger_msgs::SystemErrors& out);
 ranger_msgs::DriverStatus to_driver_status(std::uint8_t status);

@@ -98,9 +98,53 @@ enum class MotionRefusal {
   kParked,
 };
 std::string_view to_string(MotionRefusal r);  // "none", "link_lost", "remote", ...
+inline constexpr MotionRefusal kAllMotionRefusals[] = {
+    MotionRefusal::kNone,
+    MotionRefusal::kLinkLost,
+    MotionRefusal::kRemote,
+    MotionRefusal::kEstop,
+    MotionRefusal::kCriticalError,
+    MotionRefusal::kLowBattery,
+    MotionRefusal::kModeSwitchFailed,
+    MotionRefusal::kImplausible,
+    MotionRefusal::kRearmRequired,
+    MotionRefusal::kStandby,
+    MotionRefusal::kModeUnknown,
+    MotionRefusal::kSwitching,
+    MotionRefusal::kCmdTimeout,
+    MotionRefusal::kBelowMinimum,
+    MotionRefusal::kIdentifying,
+    MotionRefusal::kParked,
+};
 
 enum class LinkState { kNeverConnected, kConnected, kStale };
 std::string_view to_string(LinkState s);  // "never_connected", "connected", "stale"
+inline constexpr LinkState kAllLinkStates[] = {LinkState::kNeverConnected, LinkState::kConnected,
+                                               LinkState::kStale};
+
+// The faults the controller names itself in ControllerState::faults, beside the chassis's 0x211
+// faults (the fault table's names, protocol::kFaultTable, and "reserved_bit_N").
+enum class ControllerFault {
+  kLinkLost,               // no 0x211 within link_timeout
+  kEmergencyStop,          // 0x211 vehicle status emergency stop
+  kVehicleAbnormal,        // 0x211 vehicle status abnormal
+  kVehicleStatusUnknown,   // a 0x211 vehicle status outside the table
+  kLowBattery,             // BMS SOC below low_battery_soc
+  kModeSwitchFailed,       // a motion-mode switch was never confirmed
+  kImplausibleFeedback,    // the feedback contradicts the protocol settings
+  kUltrasonicUnconfirmed,  // the ultrasonic setting was not confirmed by 0x45A
+};
+std::string_view to_string(ControllerFault f);  // "link_lost", "emergency_stop", ...
+inline constexpr ControllerFault kAllControllerFaults[] = {
+    ControllerFault::kLinkLost,
+    ControllerFault::kEmergencyStop,
+    ControllerFault::kVehicleAbnormal,
+    ControllerFault::kVehicleStatusUnknown,
+    ControllerFault::kLowBattery,
+    ControllerFault::kModeSwitchFailed,
+    ControllerFault::kImplausibleFeedback,
+    ControllerFault::kUltrasonicUnconfirmed,
+};
 
 struct ControllerConfig {
   VehicleGeometry geometry;
@@ -183,9 +227,8 @@ struct ControllerState {
   std::optional<double> battery_soc;  // % from BMS 0x361 (whole pack)
   StopCauses active_causes = 0;       // involuntary stop causes active now
   StopCauses latched_causes = 0;      // causes since the last re-arm (motion needs a re-arm)
-  // Every active fault by stable snake_case name: 0x211 error bit names, "emergency_stop",
-  // "vehicle_abnormal", "low_battery", "link_lost", "motion_mode_switch_failed",
-  // "ultrasonic_setting_unconfirmed".
+  // Every active fault by stable snake_case name: the controller's own (ControllerFault) and the
+  // 0x211 error bits' (protocol::error_bit_names of the profile's layout).
   std::vector<std::string> faults;
 
   // Commanding

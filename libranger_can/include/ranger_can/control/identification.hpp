@@ -100,6 +100,11 @@ enum class IdentificationPhase {
   kFailed,
 };
 std::string_view to_string(IdentificationPhase p);  // "listening", ..., "decided", "failed"
+inline constexpr IdentificationPhase kAllIdentificationPhases[] = {
+    IdentificationPhase::kListening, IdentificationPhase::kAwaitingControl,
+    IdentificationPhase::kSpinCheck, IdentificationPhase::kSteerProbe,
+    IdentificationPhase::kReturning, IdentificationPhase::kDecided,
+    IdentificationPhase::kFailed};
 
 // One decided (or kept) setting and why.
 struct IdentifiedSetting {

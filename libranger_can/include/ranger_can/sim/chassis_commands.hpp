@@ -30,11 +30,14 @@ Result<ChassisAction> parse_chassis_command(std::string_view line);
 // parse_chassis_command, then the action.
 Result<std::string> apply_chassis_command(std::string_view line, VirtualChassis& chassis);
 
-// Looks up a 0x211 error bit by index ("9") or name ("host_communication_lost"); the error says
-// which names exist.
-Result<int> parse_error_bit(const std::string& text);
+// Looks up a 0x211 error bit of `layout` by index ("9") or by its fault-table name
+// ("host_communication_lost"); the error says which names the layout has.
+Result<int> parse_error_bit(const std::string& text, ErrorWordLayout layout);
+// parse_error_bit in the first layout that accepts `text` (a check before the layout is known).
+Result<int> check_error_bit(const std::string& text);
 
-// A one-paragraph description of the chassis's state (the `status` command).
-std::string describe_chassis(const ChassisSnapshot& s);
+// A one-paragraph description of the chassis's state (the `status` command); error names of
+// `layout`.
+std::string describe_chassis(const ChassisSnapshot& s, ErrorWordLayout layout);
 
 }  // namespace ranger::sim

@@ -81,9 +81,9 @@ inline constexpr bool kVehicleStatus1IsEmergencyStop = true;
 // faults, protections, calibration faults, battery under-voltage. Warnings (steering servo,
 // battery warning), host-link loss (cured by commanding again), ultrasonic triggering and
 // remote-control loss are transient conditions and do not count. Motor-numbered faults count for
-// every motor.
+// every motor. The fault table (protocol::kFaultTable, column `critical`) holds this reading.
 const std::vector<protocol::Fault>& critical_faults();
-// The bits of critical_faults() in a layout's error word.
+// The bits of the critical rows of the fault table in a layout's error word.
 std::uint32_t critical_error_mask(ErrorWordLayout layout);
 
 // ---- Ultrasonic (0x342, 0x343) ----------------------------------------------------------------

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <iterator>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -49,8 +50,86 @@ inline constexpr int kMotorCount = 8;
 inline constexpr int kUltrasonicCount = 8;
 inline constexpr int kBatteryCount = 4;  // slots 1..4; index 0 is the whole pack
 
-// Every identifier of either revision, in ascending order (receive filters, the DBC cross-check,
-// frame-rate statistics). The decoder knows all of them whatever the profile.
+// ---- The frame table ----------------------------------------------------------------------------
+// Every frame of either revision, once: its identifier(s), name, direction, the length of its
+// layout, its nominal period and the revisions that define it. The ID lists, DLC checks, names,
+// the identification's vendor-only set, the monitor's expected rates, the virtual chassis's send
+// schedule and the DBC cross-check (tests/dbc/check_dbc.py parses this table) all read it.
+enum class Direction : std::uint8_t {
+  kToChassis,    // the host's commands
+  kFromChassis,  // the chassis's feedback
+  kBoth,         // 0x4A1: the host's request and the chassis's answers
+};
+std::string_view to_string(Direction d);  // "to_chassis", "from_chassis", "both"
+inline constexpr Direction kAllDirections[] = {Direction::kToChassis, Direction::kFromChassis,
+                                               Direction::kBoth};
+
+// The revisions that define a frame (a bit set).
+inline constexpr std::uint8_t kInManual = 1u << 0;  // the manual, section 3.2 (PROTOCOL.md)
+inline constexpr std::uint8_t kInAgxV2 = 1u << 1;   // the vendor's revision (PROTOCOL_AGX_V2.md)
+
+struct FrameInfo {
+  std::uint32_t id;  // the first identifier of the row
+  int count;         // identifiers in the row: id, id + stride, ... (motors, batteries)
+  int stride;
+  std::string_view name;  // snake_case, stable
+  Direction direction;
+  int length;     // the layout's length in bytes, the same in every revision that defines the frame
+                  // (a received frame may be longer, never shorter); 0x4A1: the request's
+  int period_ms;  // nominal period; 0: sent on request or on change
+  std::uint8_t revisions;
+
+  constexpr bool holds(std::uint32_t x) const {
+    if (x < id) return false;
+    const std::uint32_t offset = x - id;
+    return offset % static_cast<std::uint32_t>(stride) == 0 &&
+           offset / static_cast<std::uint32_t>(stride) < static_cast<std::uint32_t>(count);
+  }
+};
+
+// clang-format off
+inline constexpr FrameInfo kFrameTable[] = {
+  // id                          count stride name                     direction               length period  revisions
+  {kMotionCommandId,               1, 1, "motion_command",              Direction::kToChassis,   8,  20, kInManual | kInAgxV2},
+  {kLightCommandId,                1, 1, "light_command",               Direction::kToChassis,   8,   0, kInAgxV2},
+  {kMotionModeCommandId,           1, 1, "motion_mode_command",         Direction::kToChassis,   1,   0, kInManual | kInAgxV2},
+  {kSystemStatusId,                1, 1, "system_status",               Direction::kFromChassis, 8,  20, kInManual | kInAgxV2},
+  {kMotionFeedbackId,              1, 1, "motion_feedback",             Direction::kFromChassis, 8,  20, kInManual | kInAgxV2},
+  // 0x231 and 0x241: the period the vendor's manuals of the same family give (assumed here)
+  {kLightStateId,                  1, 1, "light_state",                 Direction::kFromChassis, 8,  20, kInAgxV2},
+  {kRemoteControlStateId,          1, 1, "remote_control",              Direction::kFromChassis, 8,  20, kInAgxV2},
+  {kMotorHighSpeedBaseId + 1, kMotorCount, 1, "motor_high_speed",       Direction::kFromChassis, 8,  20, kInManual | kInAgxV2},
+  {kMotorLowSpeedBaseId + 1,  kMotorCount, 1, "motor_low_speed",        Direction::kFromChassis, 8, 100, kInManual | kInAgxV2},
+  {kSteeringAnglesId,              1, 1, "steering_angles",             Direction::kFromChassis, 8,  20, kInManual | kInAgxV2},
+  {kWheelSpeedsId,                 1, 1, "wheel_speeds",                Direction::kFromChassis, 8,  20, kInManual | kInAgxV2},
+  {kMotionModeFeedbackId,          1, 1, "motion_mode",                 Direction::kFromChassis, 2,  20, kInManual | kInAgxV2},
+  {kOdometerId,                    1, 1, "odometer",                    Direction::kFromChassis, 8,   0, kInAgxV2},
+  {kUltrasonic1to4Id,              2, 1, "ultrasonic",                  Direction::kFromChassis, 8,  50, kInManual | kInAgxV2},
+  {kBmsBaseId,         kBatteryCount + 1, 2, "bms",                     Direction::kFromChassis, 8, 500, kInManual | kInAgxV2},
+  {kBmsBaseId + 1,     kBatteryCount + 1, 2, "bms_alarm",               Direction::kFromChassis, 4, 500, kInManual | kInAgxV2},
+  {kControlModeCommandId,          1, 1, "control_mode_command",        Direction::kToChassis,   1,   0, kInManual | kInAgxV2},
+  {kErrorClearCommandId,           1, 1, "error_clear_command",         Direction::kToChassis,   1,   0, kInManual | kInAgxV2},
+  {kUltrasonicSettingId,           1, 1, "ultrasonic_setting",          Direction::kToChassis,   1,   0, kInManual | kInAgxV2},
+  {kUltrasonicSettingFeedbackId,   1, 1, "ultrasonic_setting_feedback", Direction::kFromChassis, 1,   0, kInManual | kInAgxV2},
+  {kVersionId,                     1, 1, "version",                     Direction::kBoth,        1,   0, kInAgxV2},
+};
+// clang-format on
+
+// The row of `id`; nullptr for an identifier of neither revision.
+constexpr const FrameInfo* find_frame(std::uint32_t id) {
+  for (const FrameInfo& f : kFrameTable) {
+    if (f.holds(id)) return &f;
+  }
+  return nullptr;
+}
+// The nominal period of `id`'s frame in milliseconds (0: on request or on change, or unknown).
+constexpr int frame_period_ms(std::uint32_t id) {
+  const FrameInfo* f = find_frame(id);
+  return f != nullptr ? f->period_ms : 0;
+}
+
+// Every identifier of either revision, in ascending order (receive filters, frame-rate
+// statistics). The decoder knows all of them whatever the profile.
 std::vector<std::uint32_t> all_ids();
 // The identifiers of the manual (section 3.2), in ascending order.
 std::vector<std::uint32_t> manual_ids();
@@ -59,25 +138,20 @@ bool is_known_id(std::uint32_t id);
 // frame may be longer (its extra bytes are ignored), never shorter. 0x4A1: 1 (the request; an
 // answer's text is as long as the frame).
 int layout_dlc(std::uint32_t id);
-// Deprecated: the old name of layout_dlc (the DLC used to be the only one accepted).
-int expected_dlc(std::uint32_t id);
 // Bytes of `frame` past its layout that a decoder ignores (0 for an unknown ID, an error frame, a
 // frame not longer than its layout, or a 0x4A1 answer, whose text is the whole frame).
 int extra_bytes(const CanFrame& frame);
 // A 0x4A1 frame is the host's version request when byte 0 is 0x01 and every further byte is zero
 // (a request padded to 8 bytes); anything else on 0x4A1 is an answer (text).
 bool is_version_request(const CanFrame& frame);
+// True when the chassis sent `frame` (feedback, or a 0x4A1 answer), false for the host's.
+bool is_chassis_frame(const CanFrame& frame);
 // A short snake_case name for `id` ("motion_command", "bms", ...), "unknown" otherwise.
 std::string_view frame_name(std::uint32_t id);
 
-// Nominal feedback periods from the manual, for rate checks and the simulator.
-inline constexpr int kFastPeriodMs = 20;        // 0x211 0x221 0x251-8 0x271 0x281 0x291
-inline constexpr int kUltrasonicPeriodMs = 50;  // 0x342 0x343
-inline constexpr int kSlowPeriodMs = 100;       // 0x261-8
-inline constexpr int kBmsPeriodMs = 500;        // 0x361-0x36A
-// The chassis stops if no 0x111 arrives for this long; the host keeps it alive at 20 ms.
+// The chassis stops if no 0x111 arrives for this long; the host keeps it alive at 0x111's period.
 inline constexpr int kChassisCommandTimeoutMs = 500;
-inline constexpr int kKeepAlivePeriodMs = 20;
+inline constexpr int kKeepAlivePeriodMs = frame_period_ms(kMotionCommandId);
 
 // ---- Enumerations ------------------------------------------------------------------------------
 // Motion modes. The values are agx_v2's wire numbering; the wire value of a mode depends on the
@@ -132,11 +206,24 @@ enum class ErrorClearCode : std::uint8_t {
 };
 inline constexpr std::uint8_t kMaxErrorClearCode = 0x10;
 
+// Names (snake_case, stable) and every enumerator of each, in wire order: what the scenario
+// language, the CLI and the ROS node accept and print.
 std::string_view to_string(MotionMode m);
 std::string_view to_string(ControlMode m);
 std::string_view to_string(VehicleStatus s);
 std::string_view to_string(RemoteSwitch s);
 std::string_view to_string(LightMode m);
+inline constexpr MotionMode kAllMotionModes[] = {MotionMode::kAckermann, MotionMode::kOblique,
+                                                 MotionMode::kSpin, MotionMode::kPark,
+                                                 MotionMode::kSideSlip};
+inline constexpr ControlMode kAllControlModes[] = {ControlMode::kStandby, ControlMode::kCan,
+                                                   ControlMode::kUart, ControlMode::kRemote};
+inline constexpr VehicleStatus kAllVehicleStatuses[] = {
+    VehicleStatus::kNormal, VehicleStatus::kEmergencyStop, VehicleStatus::kAbnormal};
+inline constexpr RemoteSwitch kAllRemoteSwitches[] = {
+    RemoteSwitch::kUndefined, RemoteSwitch::kMiddle, RemoteSwitch::kUp, RemoteSwitch::kDown};
+inline constexpr LightMode kAllLightModes[] = {LightMode::kOff, LightMode::kOn,
+                                               LightMode::kBreathing, LightMode::kCustom};
 // Describes what a 0x441 code clears ("all non-critical faults", "motor driver 3 communication
 // fault").
 std::string error_clear_description(std::uint8_t code);
@@ -159,7 +246,8 @@ struct NamedBit {
   std::string_view description;
 };
 
-// Every defined error bit of a layout, in ascending bit order (reserved bits are absent).
+// Every defined error bit of a layout: the rows of the fault table (below) with a bit in it, in
+// ascending bit order (reserved bits are absent). A fault's name is the same in either layout.
 const std::vector<NamedBit>& system_error_bits(ErrorWordLayout layout);
 const std::vector<NamedBit>& system_error_bits();  // the manual's (kManual32)
 // Names of the bits set in `error_word`; reserved bits that are set appear as "reserved_bit_N".
@@ -171,28 +259,105 @@ std::vector<std::string> error_bit_names(std::uint32_t error_word);  // kManual3
 bool is_critical_error(std::uint32_t error_word, ErrorWordLayout layout);
 bool is_critical_error(std::uint32_t error_word);  // kManual32
 
-// Faults by meaning, so that the controller and the virtual chassis never write a bit position:
-// fault_bit() gives a fault's bit in a layout's word, 0 when the layout has no such bit. `motor`
-// numbers the motor for the faults marked so (protocol numbering, 1..8); 0 otherwise.
+// Faults by meaning, so that the controller, the virtual chassis and the ROS node never write a
+// bit position. `motor` numbers the motor of a motor-numbered fault (protocol numbering, 1..8: the
+// wheels 1-4 and steering motors 5-8 in the manual's wheel order RF, RR, LR, LF); 0 otherwise.
 enum class Fault {
-  kBatteryUnderVoltage,         // manual: byte 7 bit 0; agx16: 0x0001 battery fault
-  kBatteryWarning,              // agx16: 0x0002; manual: none
-  kUltrasonicTriggered,         // manual: byte 7 bit 1; agx16: none
-  kRemoteSignalLost,            // manual: byte 7 bit 2; agx16: 0x0004
-  kHostCommunicationLost,       // manual: byte 6 bit 1; agx16: 0x0200
-  kDriverStatusError,           // manual: byte 6 bit 0; agx16: 0x0100 motor driver
-  kOverTemperature,             // manual: byte 6 bit 6; agx16: none
-  kOverCurrent,                 // manual: byte 6 bit 7; agx16: none
-  kMotorCommunication,          // motor 1..8; manual: byte 7 bits 3-6, byte 6 bits 2-5;
-                                // agx16: motors 1..4 only, 0x0008..0x0040
-  kSteeringCalibration,         // steering motor 5..8; manual: byte 5 bits 0-3; agx16: none
-  kSteeringCalibrationTimeout,  // manual: byte 5 bit 4; agx16: none
-  kSafetyEdge,                  // manual: byte 5 bit 5; agx16: none
-  kSteeringServoWarning,        // steering motor 5..8; manual: byte 4 bits 0-3; agx16: none
-  kSteeringEncoder,             // agx16: 0x0080; manual: none
+  kBatteryUnderVoltage,
+  kBatteryWarning,
+  kUltrasonicTriggered,
+  kRemoteSignalLost,
+  kHostCommunicationLost,
+  kDriverStatusError,
+  kOverTemperature,
+  kOverCurrent,
+  kMotorCommunication,   // motor-numbered
+  kSteeringCalibration,  // motor-numbered (steering motors 5..8)
+  kSteeringCalibrationTimeout,
+  kSafetyEdge,
+  kSteeringServoWarning,  // motor-numbered (steering motors 5..8)
+  kSteeringEncoder,
 };
-inline constexpr int kFaultCount = 14;
+inline constexpr Fault kAllFaults[] = {
+    Fault::kBatteryUnderVoltage,
+    Fault::kBatteryWarning,
+    Fault::kUltrasonicTriggered,
+    Fault::kRemoteSignalLost,
+    Fault::kHostCommunicationLost,
+    Fault::kDriverStatusError,
+    Fault::kOverTemperature,
+    Fault::kOverCurrent,
+    Fault::kMotorCommunication,
+    Fault::kSteeringCalibration,
+    Fault::kSteeringCalibrationTimeout,
+    Fault::kSafetyEdge,
+    Fault::kSteeringServoWarning,
+    Fault::kSteeringEncoder,
+};
+inline constexpr int kFaultCount = static_cast<int>(std::size(kAllFaults));
 std::string_view to_string(Fault f);  // "battery_under_voltage", ...
+
+// ---- The fault table
+// ----------------------------------------------------------------------------- One row per fault
+// the chassis reports in 0x211, by meaning: its bit in each error-word layout (kNoBit when the
+// layout has none), its stable snake_case name (ControllerState::faults, the ROS message's
+// SystemErrors field, diagnostics, the scenario language: the same name on both revisions), whether
+// it is critical (the chassis does not drive until it is cleared: our reading, interpretation.hpp)
+// and a description. Every bit position of either layout is written here and nowhere else.
+inline constexpr int kNoBit = -1;
+struct FaultInfo {
+  Fault fault;
+  int motor;       // 1..8 for a motor-numbered fault, 0 otherwise
+  int manual_bit;  // position in the kManual32 word (error_bit_index(byte, bit)) or kNoBit
+  int agx16_bit;   // position in the kAgxV2_16 word or kNoBit
+  bool critical;
+  std::string_view name;
+  std::string_view description;
+
+  constexpr int bit(ErrorWordLayout layout) const {
+    return layout == ErrorWordLayout::kAgxV2_16 ? agx16_bit : manual_bit;
+  }
+};
+// clang-format off
+inline constexpr FaultInfo kFaultTable[] = {
+  // fault                             motor manual bit              agx16  critical
+  {Fault::kBatteryUnderVoltage,         0, error_bit_index(7, 0),     0, true,  "battery_under_voltage", "battery under-voltage (agx_v2: battery fault)"},
+  {Fault::kBatteryWarning,              0, kNoBit,                    1, false, "battery_warning", "battery warning"},
+  {Fault::kUltrasonicTriggered,         0, error_bit_index(7, 1), kNoBit, false, "ultrasonic_obstacle_triggered", "ultrasonic obstacle avoidance triggered"},
+  {Fault::kRemoteSignalLost,            0, error_bit_index(7, 2),     2, false, "remote_control_lost", "remote control lost-connection protection"},
+  {Fault::kMotorCommunication,          1, error_bit_index(7, 3),     3, true,  "motor_driver_1_communication_fault", "communication fault of motor driver 1 (front-right wheel)"},
+  {Fault::kMotorCommunication,          2, error_bit_index(7, 4),     4, true,  "motor_driver_2_communication_fault", "communication fault of motor driver 2 (rear-right wheel)"},
+  {Fault::kMotorCommunication,          3, error_bit_index(7, 5),     5, true,  "motor_driver_3_communication_fault", "communication fault of motor driver 3 (rear-left wheel)"},
+  {Fault::kMotorCommunication,          4, error_bit_index(7, 6),     6, true,  "motor_driver_4_communication_fault", "communication fault of motor driver 4 (front-left wheel)"},
+  {Fault::kDriverStatusError,           0, error_bit_index(6, 0),     8, true,  "driver_status_error", "motor driver status error (agx_v2: motor driver fault)"},
+  {Fault::kHostCommunicationLost,       0, error_bit_index(6, 1),     9, false, "host_communication_lost", "communication with the upper layer (host) lost"},
+  {Fault::kMotorCommunication,          5, error_bit_index(6, 2), kNoBit, true,  "motor_driver_5_communication_fault", "communication fault of motor driver 5 (front-right steering)"},
+  {Fault::kMotorCommunication,          6, error_bit_index(6, 3), kNoBit, true,  "motor_driver_6_communication_fault", "communication fault of motor driver 6 (rear-right steering)"},
+  {Fault::kMotorCommunication,          7, error_bit_index(6, 4), kNoBit, true,  "motor_driver_7_communication_fault", "communication fault of motor driver 7 (rear-left steering)"},
+  {Fault::kMotorCommunication,          8, error_bit_index(6, 5), kNoBit, true,  "motor_driver_8_communication_fault", "communication fault of motor driver 8 (front-left steering)"},
+  {Fault::kOverTemperature,             0, error_bit_index(6, 6), kNoBit, true,  "over_temperature", "over-temperature protection"},
+  {Fault::kOverCurrent,                 0, error_bit_index(6, 7), kNoBit, true,  "over_current", "over-current protection"},
+  {Fault::kSteeringCalibration,         5, error_bit_index(5, 0), kNoBit, true,  "steering_calibration_fault_front_right", "steering zero-point calibration fault, front-right"},
+  {Fault::kSteeringCalibration,         6, error_bit_index(5, 1), kNoBit, true,  "steering_calibration_fault_rear_right", "steering zero-point calibration fault, rear-right"},
+  {Fault::kSteeringCalibration,         7, error_bit_index(5, 2), kNoBit, true,  "steering_calibration_fault_rear_left", "steering zero-point calibration fault, rear-left"},
+  {Fault::kSteeringCalibration,         8, error_bit_index(5, 3), kNoBit, true,  "steering_calibration_fault_front_left", "steering zero-point calibration fault, front-left"},
+  {Fault::kSteeringCalibrationTimeout,  0, error_bit_index(5, 4), kNoBit, true,  "steering_calibration_timeout", "steering calibration timeout"},
+  {Fault::kSafetyEdge,                  0, error_bit_index(5, 5), kNoBit, true,  "safety_edge_collision", "safety edge (bumper) collision"},
+  {Fault::kSteeringServoWarning,        5, error_bit_index(4, 0), kNoBit, false, "steering_servo_warning_front_right", "steering servo warning, front-right"},
+  {Fault::kSteeringServoWarning,        6, error_bit_index(4, 1), kNoBit, false, "steering_servo_warning_rear_right", "steering servo warning, rear-right"},
+  {Fault::kSteeringServoWarning,        7, error_bit_index(4, 2), kNoBit, false, "steering_servo_warning_rear_left", "steering servo warning, rear-left"},
+  {Fault::kSteeringServoWarning,        8, error_bit_index(4, 3), kNoBit, false, "steering_servo_warning_front_left", "steering servo warning, front-left"},
+  {Fault::kSteeringEncoder,             0, kNoBit,                    7, true,  "steering_encoder_fault", "steering encoder fault"},
+};
+// clang-format on
+
+// The row of `fault` (and `motor`, for a motor-numbered fault); nullptr when the table has none.
+const FaultInfo* find_fault(Fault fault, int motor = 0);
+// The row named `name`; nullptr when no row has that name.
+const FaultInfo* find_fault(std::string_view name);
+// The row whose bit in `layout`'s word is `index`; nullptr for a reserved bit.
+const FaultInfo* fault_at(ErrorWordLayout layout, int index);
+// The fault's bit (a one-bit mask) in a layout's word, 0 when the layout has no such bit.
 std::uint32_t fault_bit(Fault fault, ErrorWordLayout layout, int motor = 0);
 
 // ---- 0x261-0x268 driver status bits -----------------------------------------------------------
