@@ -36,6 +36,21 @@ void drive(ranger::Driver& driver, const ranger::BodyTwist& twist, double second
   }
 }
 
+// Publishes `twist` until the odometry has moved `metres` from where it was (each side as long
+// as the chassis itself says, however busy the machine), or until `limit_s` has passed.
+bool drive_distance(ranger::Driver& driver, const ranger::BodyTwist& twist, double metres,
+                    double limit_s) {
+  const auto start = driver.snapshot()->odometry.pose;
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(limit_s);
+  while (std::chrono::steady_clock::now() < end) {
+    const auto pose = driver.snapshot()->odometry.pose;
+    if (std::hypot(pose.x - start.x, pose.y - start.y) >= metres) return true;
+    driver.command(ranger::MotionRequest{twist, ranger::protocol::MotionMode::kOblique});
+    std::this_thread::sleep_for(20ms);
+  }
+  return false;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -55,12 +70,13 @@ int main(int argc, char** argv) {
   ranger::Driver driver(config, *source, clock);
   driver.start();
 
-  // Wait until the chassis is in CAN command mode (the driver asks for it by itself).
-  const auto deadline = std::chrono::steady_clock::now() + 5s;
+  // Wait until the chassis is in CAN command mode (the driver asks for it by itself; a generous
+  // limit, so that a busy machine is not mistaken for a silent chassis).
+  const auto deadline = std::chrono::steady_clock::now() + 30s;
   while (driver.snapshot()->controller.control_mode != ranger::protocol::ControlMode::kCan) {
     if (std::chrono::steady_clock::now() > deadline) {
       const auto s = driver.snapshot();
-      std::fprintf(stderr, "drive_square: no CAN command mode on %s within 5 s (%s)\n",
+      std::fprintf(stderr, "drive_square: no CAN command mode on %s within 30 s (%s)\n",
                    bus.c_str(), s->bus_open ? std::string(ranger::to_string(s->controller.link)).c_str()
                                             : s->bus_error.c_str());
       return 1;
@@ -80,7 +96,11 @@ int main(int argc, char** argv) {
            driver.snapshot()->controller.steer_first_factor < 1.0) {
       drive(driver, sides[i], 0.05);
     }
-    drive(driver, sides[i], side / speed);
+    if (!drive_distance(driver, sides[i], side, 3.0 * side / speed + 10.0)) {
+      std::fprintf(stderr, "drive_square: the %s side did not reach %.3f m\n", names[i], side);
+      driver.stop();
+      return 1;
+    }
     print_pose(*driver.snapshot(), names[i]);
   }
   drive(driver, {}, 1.0);  // stop and let the chassis settle
