@@ -15,6 +15,7 @@
 #include "cli_profile.hpp"
 #include "ranger_can/clock.hpp"
 #include "ranger_can/parse.hpp"
+#include "ranger_can/text.hpp"
 #include "ranger_can/wire/candump_log.hpp"
 #include "ranger_can/wire/codec.hpp"
 #include "ranger_can/wire/interpretation.hpp"
@@ -30,12 +31,19 @@ Error bad(const std::string& what) {
   return Error{Errc::kInvalidArgument, what};
 }
 
+// The modes `send mode` takes: every motion mode but park, which has a command of its own.
+std::vector<std::string> mode_names() {
+  std::vector<std::string> names;
+  for (const protocol::MotionMode m : protocol::kAllMotionModes)
+    if (m != protocol::MotionMode::kPark) names.emplace_back(protocol::to_string(m));
+  return names;
+}
+
 Result<Message> parse_mode(const Words& w) {
-  if (w[0] == "ackermann") return Message{MotionModeCommand{protocol::MotionMode::kAckermann}};
-  if (w[0] == "oblique") return Message{MotionModeCommand{protocol::MotionMode::kOblique}};
-  if (w[0] == "spin") return Message{MotionModeCommand{protocol::MotionMode::kSpin}};
-  if (w[0] == "side_slip") return Message{MotionModeCommand{protocol::MotionMode::kSideSlip}};
-  return bad("mode: unknown motion mode '" + w[0] + "' (ackermann, oblique, spin or side_slip)");
+  for (const protocol::MotionMode m : protocol::kAllMotionModes)
+    if (m != protocol::MotionMode::kPark && w[0] == protocol::to_string(m))
+      return Message{MotionModeCommand{m}};
+  return bad("mode: unknown motion mode '" + w[0] + "' (" + text::join(mode_names()) + ")");
 }
 
 Result<Message> parse_park(const Words& w) {
@@ -134,7 +142,7 @@ struct SendCommand {
 
 const std::vector<SendCommand>& send_commands() {
   static const std::vector<SendCommand> commands = {
-      {"mode", "ackermann|oblique|spin|side_slip", 1, 1,
+      {"mode", text::join(mode_names(), "|"), 1, 1,
        "0x141 motion mode (side_slip: MINI V1 and agx_v2 numbering only)", parse_mode},
       {"park", "on|off", 1, 1,
        "0x141 park (on) or dual Ackermann (off); agx_v2 numbering only (the manual and the MINI "
