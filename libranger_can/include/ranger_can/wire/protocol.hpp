@@ -6,6 +6,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <iterator>
 #include <optional>
@@ -115,17 +116,24 @@ inline constexpr FrameInfo kFrameTable[] = {
 };
 // clang-format on
 
+// The index of `id`'s row in kFrameTable; std::size(kFrameTable) for an identifier of neither
+// revision. (An index, not a pointer: constant evaluation under -fsanitize=undefined refuses to
+// compare a pointer into the table with nullptr.)
+constexpr std::size_t frame_index(std::uint32_t id) {
+  for (std::size_t i = 0; i < std::size(kFrameTable); ++i) {
+    if (kFrameTable[i].holds(id)) return i;
+  }
+  return std::size(kFrameTable);
+}
 // The row of `id`; nullptr for an identifier of neither revision.
 constexpr const FrameInfo* find_frame(std::uint32_t id) {
-  for (const FrameInfo& f : kFrameTable) {
-    if (f.holds(id)) return &f;
-  }
-  return nullptr;
+  const std::size_t i = frame_index(id);
+  return i < std::size(kFrameTable) ? &kFrameTable[i] : nullptr;
 }
 // The nominal period of `id`'s frame in milliseconds (0: on request or on change, or unknown).
 constexpr int frame_period_ms(std::uint32_t id) {
-  const FrameInfo* f = find_frame(id);
-  return f != nullptr ? f->period_ms : 0;
+  const std::size_t i = frame_index(id);
+  return i < std::size(kFrameTable) ? kFrameTable[i].period_ms : 0;
 }
 
 // Every identifier of either revision, in ascending order (receive filters, frame-rate
