@@ -122,9 +122,13 @@ run_ros_build() {
     export ROS_HOME=$root/build/asan-ws/ros_home ROS_HOSTNAME=localhost
     export ROS_MASTER_URI=http://localhost:11311
     set_sanitizer_env "$reports"
+    # Every rostest but the nodelet's: that one loads the plugin into the system's nodelet
+    # manager, which is not instrumented (the ASan runtime must come first in a process), and
+    # uses ranger_bringup's launch file, which this workspace does not build. The nodelet and the
+    # node are one class, which the other rostests run under ASan.
     colcon --log-base build/log-asan test --base-paths . --packages-select ranger_base \
       --build-base "$ws" --install-base "$install" --event-handlers console_cohesion- \
-      --executor sequential --return-code-on-test-failure
+      --executor sequential --return-code-on-test-failure --ctest-args -E node_nodelet
     test_rc=$?
     colcon test-result --test-result-base "$ws" --verbose
     rm -rf "$results/asan-ros" && mkdir -p "$results/asan-ros"
