@@ -113,6 +113,42 @@ TEST(Driver, ConnectsDrivesAndPublishesWhatItKnows) {
   EXPECT_GT(s->odometry.stamp, s->now - 40ms);
 }
 
+// Snapshots are refilled once no reader holds them: one a reader holds never changes under it,
+// and a refilled one carries nothing of its earlier publication.
+TEST(Driver, AHeldSnapshotNeverChangesAndARefilledOneKeepsNothingStale) {
+  DriverRig rig;
+  rig.step();
+  const auto early = rig.snapshot();  // connected, nothing driven yet
+  const std::uint64_t early_sequence = early->sequence;
+  const Timestamp early_now = early->now;
+  ASSERT_TRUE(rig.run_until([&] { return ready(*rig.snapshot()); }, 2s));
+  rig.drive({0.5, 0, 0}, 1s);
+  EXPECT_EQ(early->sequence, early_sequence);
+  EXPECT_EQ(early->now, early_now);
+  EXPECT_FALSE(early->motion_known);
+  EXPECT_EQ(early->odometry.pose.x, 0.0);
+
+  // Every step publishes a new one; consecutive ones differ by one in sequence and are current.
+  for (int i = 0; i < 5; ++i) {
+    rig.step();
+    const auto a = rig.snapshot();
+    rig.step();
+    const auto b = rig.snapshot();
+    EXPECT_NE(a.get(), b.get()) << "a held snapshot is not refilled";
+    EXPECT_EQ(b->sequence, a->sequence + 1);
+    EXPECT_EQ(b->now, rig.clock().now());
+    EXPECT_GE(b->odometry.pose.x, a->odometry.pose.x);
+  }
+  // A request made now shows in the next snapshot, and in none published before it.
+  const auto before = rig.snapshot();
+  const auto id = rig.driver().clear_errors(0);
+  ASSERT_TRUE(id.ok()) << id.error().message;
+  EXPECT_EQ(before->request(*id), nullptr);
+  rig.step();
+  EXPECT_NE(rig.snapshot()->request(*id), nullptr);
+  EXPECT_EQ(before->request(*id), nullptr);
+}
+
 TEST(Driver, ACommandGoesOutAtTheNextStepAndEverySendIsAnEvent) {
   DriverRig rig;
   ASSERT_TRUE(rig.run_until([&] { return ready(*rig.snapshot()); }, 2s));

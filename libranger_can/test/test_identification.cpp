@@ -35,6 +35,11 @@ ProtocolProfile preset(const char* name) {
   return *protocol_preset(name);
 }
 
+// The identification has ended (the first snapshot, before the bus opens, has none yet).
+bool identification_done(const DriverSnapshot& s) {
+  return s.identification && s.identification->done();
+}
+
 bool has_line(const std::vector<std::string>& lines, const std::string& needle) {
   for (const auto& l : lines)
     if (l.find(needle) != std::string::npos) return true;
@@ -224,7 +229,7 @@ TEST(DriverAuto, IdentifiesTheManualChassisThenDrivesTheRoute) {
   ASSERT_TRUE(rig.snapshot()->identification);
   // Until decided: a named refusal, and nothing moves.
   rig.command({0.5, 0.0, 0.0});
-  ASSERT_TRUE(rig.run_until([&] { return rig.snapshot()->identification->done(); }, 12s));
+  ASSERT_TRUE(rig.run_until([&] { return identification_done(*rig.snapshot()); }, 12s));
   const auto s = rig.snapshot();
   ASSERT_TRUE(s->identification->decided_ok()) << s->identification->message;
   EXPECT_EQ(s->profile, preset("manual")) << describe(s->profile);
@@ -250,7 +255,7 @@ TEST(DriverAuto, ListeningIsRefusedAsIdentifyingNotAsALostLink) {
   EXPECT_EQ(s->controller.identifying, IdentificationPhase::kListening);
   EXPECT_TRUE(s->controller.quiet);
   EXPECT_FALSE(rig.saw_refusal(MotionRefusal::kLinkLost));
-  ASSERT_TRUE(rig.run_until([&] { return rig.snapshot()->identification->done(); }, 12s));
+  ASSERT_TRUE(rig.run_until([&] { return identification_done(*rig.snapshot()); }, 12s));
   EXPECT_FALSE(rig.snapshot()->controller.identifying.has_value());
 }
 
@@ -276,7 +281,7 @@ TEST(DriverAuto, SpinCheckCanBeSkipped) {
   DriverConfig c = test::auto_config();
   c.identification.spin_check = false;
   IdentifyRig rig("sim", c);
-  ASSERT_TRUE(rig.run_until([&] { return rig.snapshot()->identification->done(); }, 12s));
+  ASSERT_TRUE(rig.run_until([&] { return identification_done(*rig.snapshot()); }, 12s));
   const auto s = rig.snapshot();
   ASSERT_TRUE(s->identification->decided_ok()) << s->identification->message;
   EXPECT_EQ(s->profile, preset("manual"));
@@ -511,7 +516,7 @@ TEST_P(EveryVariant, AutoIdentifiesItAndDrivesTheRoute) {
   IdentifyRig rig("sim:" + v, c);
   rig.set_rearm(true);
   rig.command({0.5, 0.0, 0.0});
-  ASSERT_TRUE(rig.run_until([&] { return rig.snapshot()->identification->done(); }, 15s));
+  ASSERT_TRUE(rig.run_until([&] { return identification_done(*rig.snapshot()); }, 15s));
   const auto s = rig.snapshot();
   const IdentificationStatus& id = *s->identification;
   std::printf("[identify] variant=%s %s time=%.2f s confidence=%.3f profile=%s\n", v.c_str(),

@@ -182,7 +182,9 @@ RangerNode::RangerNode(const ros::NodeHandle& nh, const ros::NodeHandle& private
   // Both observers run on the driver thread: they queue, or wake the publication thread, and
   // return (publication never runs on the thread that owns the 0x111 keep-alive).
   publication_wake_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
-  driver_->set_sent_observer([this](const ranger::SentEvent& e) { on_sent(e); });
+  // The send's wall time is read only for cmd_vel_out.
+  driver_->set_sent_observer([this](const ranger::SentEvent& e) { on_sent(e); },
+                             params_.publish_cmd);
   driver_->set_step_observer(
       [this](const std::shared_ptr<const ranger::DriverSnapshot>&) { on_step(); });
 }
@@ -213,9 +215,7 @@ void RangerNode::start() {
   set_lights_srv_ = service_nh_.advertiseService("set_lights", &RangerNode::on_set_lights, this);
   park_srv_ = service_nh_.advertiseService("park", &RangerNode::on_park, this);
 
-  cmd_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &cmd_queue_);
   service_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &service_queue_);
-  cmd_spinner_->start();
   service_spinner_->start();
   ROS_INFO("ranger_base_node on %s (%s), publishing odom at %.1f Hz (%s -> %s%s)",
            params_.port_name.c_str(),
@@ -277,10 +277,9 @@ void RangerNode::shutdown() {
                           : (s->read_only ? "a replayed log is read-only"
                                           : "the driver had nothing to stop"));
   }
-  // Disabled queues wake their spinner threads at once instead of after their poll timeout.
+  // A disabled queue wakes its spinner thread at once instead of after its poll timeout.
   cmd_queue_.disable();
   service_queue_.disable();
-  if (cmd_spinner_) cmd_spinner_->stop();
   if (service_spinner_) service_spinner_->stop();
 }
 

@@ -241,8 +241,9 @@ TEST(SystemState, IdentifyingAndImplausibleAreSaidWithTheirReasons) {
   c.quiet = true;
   c.identifying = ranger::IdentificationPhase::kListening;
   snap.protocol = ranger::ProtocolChoice::kAuto;
-  snap.identification = ranger::IdentificationStatus{};
-  snap.identification->message = "identifying the chassis: listening (0.4 s of 1.2 s)";
+  auto id = std::make_shared<ranger::IdentificationStatus>();
+  id->message = "identifying the chassis: listening (0.4 s of 1.2 s)";
+  snap.identification = id;
   auto state = to_system_state(snap, ros::Time(1.0));
   EXPECT_EQ(state.motion_inhibited_reason, "identifying");
   EXPECT_NE(state.motion_inhibited_detail.find("listening (0.4 s of 1.2 s)"), std::string::npos)
@@ -255,7 +256,7 @@ TEST(SystemState, IdentifyingAndImplausibleAreSaidWithTheirReasons) {
   c.link = ranger::LinkState::kConnected;
   c.refusal = ranger::MotionRefusal::kIdentifying;
   c.identifying = ranger::IdentificationPhase::kSteerProbe;
-  snap.identification->message = "identifying the chassis: steering probe";
+  id->message = "identifying the chassis: steering probe";
   state = to_system_state(snap, ros::Time(1.0));
   EXPECT_EQ(state.motion_inhibited_reason, "identifying");
   EXPECT_EQ(state.motion_inhibited_detail, "identifying the chassis: steering probe");

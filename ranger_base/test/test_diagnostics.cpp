@@ -180,12 +180,12 @@ TEST(Diagnostics, FrameRatesPerIdFromTheSnapshotAndRejectsWarn) {
 
 // ---- Protocol: the settings, the identification, the plausibility monitors -----------------
 
-ranger::IdentificationStatus identification(ranger::IdentificationPhase phase) {
+std::shared_ptr<ranger::IdentificationStatus> identification(ranger::IdentificationPhase phase) {
   ranger::IdentificationStatus id;
   id.phase = phase;
   id.revision = "manual";
   id.message = "steering probe";
-  return id;
+  return std::make_shared<ranger::IdentificationStatus>(std::move(id));
 }
 
 TEST(ProtocolDiagnostics, ForcedSettingsAreOkAndListed) {
@@ -204,14 +204,15 @@ TEST(ProtocolDiagnostics, ForcedSettingsAreOkAndListed) {
 TEST(ProtocolDiagnostics, IdentifyingIsOkAndDecidedShowsTheEvidence) {
   auto s = healthy();
   s.protocol = ranger::ProtocolChoice::kAuto;
-  s.identification = identification(ranger::IdentificationPhase::kSteerProbe);
+  const auto status = identification(ranger::IdentificationPhase::kSteerProbe);
+  s.identification = status;
   DiagnosticStatusWrapper probing;
   diagnose_protocol(s, {"auto: identified from the chassis, model ranger", "can0"}, probing);
   EXPECT_EQ(probing.level, DiagnosticStatus::OK) << probing.message;
   EXPECT_NE(probing.message.find("identifying the chassis (steer_probe)"), std::string::npos)
       << probing.message;
 
-  auto& id = *s.identification;
+  auto& id = *status;
   id.phase = ranger::IdentificationPhase::kDecided;
   id.evidence = {"no frame only the vendor's revision sends: preset manual",
                  "spin position at standstill: the unit is centideg"};
@@ -232,8 +233,9 @@ TEST(ProtocolDiagnostics, IdentifyingIsOkAndDecidedShowsTheEvidence) {
 TEST(ProtocolDiagnostics, AFailedIdentificationIsAnErrorNamingWhatToSetAndTheCommissioning) {
   auto s = healthy();
   s.protocol = ranger::ProtocolChoice::kAuto;
-  s.identification = identification(ranger::IdentificationPhase::kFailed);
-  s.identification->message = ranger::unidentified_message("no 0x271 answer", 10s);
+  const auto failed = identification(ranger::IdentificationPhase::kFailed);
+  failed->message = ranger::unidentified_message("no 0x271 answer", 10s);
+  s.identification = failed;
   DiagnosticStatusWrapper d;
   diagnose_protocol(s, {"auto", "can1"}, d);
   EXPECT_EQ(d.level, DiagnosticStatus::ERROR);

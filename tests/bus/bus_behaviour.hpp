@@ -30,8 +30,8 @@
 #include <thread>
 #include <vector>
 
-#include "ranger_can/transport/bus.hpp"
 #include "ranger_can/clock.hpp"
+#include "ranger_can/transport/bus.hpp"
 #include "ranger_can/transport/error_frame.hpp"
 #include "ranger_can/wire/frame.hpp"
 #include "ranger_can/wire/protocol.hpp"
@@ -415,6 +415,69 @@ TYPED_TEST_P(BusBehaviour, FdIsReadableExactlyWhileAFrameWaits) {
   EXPECT_FALSE(readable(0));
 }
 
+TYPED_TEST_P(BusBehaviour, ReceiveQueuedHandsOutWhatArrivedInOrderWithoutWaiting) {
+  auto a = this->endpoint();
+  auto b = this->endpoint();
+  ASSERT_TRUE(a && b);
+  std::vector<Result<CanFrame>> got;
+  EXPECT_EQ(b->receive_queued(got, 100), 0u) << "nothing queued: nothing, at once";
+  EXPECT_TRUE(got.empty());
+
+  // More than one kernel batch (32), with frames the filter refuses in between.
+  constexpr std::uint32_t kCount = 100;
+  for (std::uint32_t i = 0; i < kCount; ++i) {
+    ASSERT_TRUE(a->send(numbered(kDataId, i)).ok());
+    if (i % 10 == 0) {
+      ASSERT_TRUE(a->send(numbered(kForeignId, i)).ok());
+    }
+  }
+  // The last frame is known to have arrived once receive() returns it: send a marker and wait.
+  ASSERT_TRUE(a->send(numbered(kDataId, kCount)).ok());
+  const int timeout_ms = static_cast<int>(
+      std::chrono::duration_cast<std::chrono::milliseconds>(this->env.delivery_timeout()).count());
+  struct pollfd p = {b->fd(), POLLIN, 0};
+  ASSERT_EQ(::poll(&p, 1, timeout_ms), 1);
+
+  // `max` bounds each call; the rest stays for the next one.
+  EXPECT_EQ(b->receive_queued(got, 10), 10u);
+  ASSERT_EQ(got.size(), 10u);
+  std::uint32_t expected = 0;
+  for (const auto& r : got) {
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_EQ(r->id, kDataId);
+    EXPECT_EQ(sequence_of(*r), expected++);
+    EXPECT_GT(r->stamp.count(), 0);
+  }
+  for (int calls = 0; expected <= kCount && calls < 1000; ++calls) {
+    got.clear();
+    b->receive_queued(got, 1000);
+    for (const auto& r : got) {
+      ASSERT_TRUE(r.ok()) << r.error().message;
+      EXPECT_EQ(r->id, kDataId) << "the filter applies";
+      EXPECT_EQ(sequence_of(*r), expected++) << "in order, none twice, none lost";
+    }
+    if (expected <= kCount && got.empty()) {
+      ASSERT_EQ(::poll(&p, 1, timeout_ms), 1);
+    }
+  }
+  EXPECT_EQ(expected, kCount + 1);
+  got.clear();
+  EXPECT_EQ(b->receive_queued(got, 100), 0u);
+  EXPECT_EQ(b->status().stats.rx_frames, kCount + 1);
+  // receive() and receive_queued() share one queue.
+  ASSERT_TRUE(a->send(numbered(kDataId, 500)).ok());
+  ASSERT_TRUE(a->send(numbered(kDataId, 501)).ok());
+  EXPECT_EQ(sequence_of(this->expect_frame(*b)), 500u);
+  for (int calls = 0; got.empty() && calls < 1000; ++calls) {
+    if (b->receive_queued(got, 100) == 0) {
+      ASSERT_EQ(::poll(&p, 1, timeout_ms), 1);
+    }
+  }
+  ASSERT_EQ(got.size(), 1u);
+  ASSERT_TRUE(got[0].ok());
+  EXPECT_EQ(sequence_of(*got[0]), 501u);
+}
+
 REGISTER_TYPED_TEST_SUITE_P(BusBehaviour,
                             DeliversToOtherEndpointsNotToTheSenderWithReceiveTimestamps,
                             DefaultFilterDeliversOnlyRangerIdsAndSetFilterReplacesIt,
@@ -424,6 +487,7 @@ REGISTER_TYPED_TEST_SUITE_P(BusBehaviour,
                             FullTransmitQueueReturnsWouldBlockAndCountsTheDrop,
                             OpeningAMissingInterfaceFailsNamingIt,
                             OpeningADownInterfaceFailsNamingIt, RefusesFramesThatCannotBeSent,
-                            FdIsReadableExactlyWhileAFrameWaits);
+                            FdIsReadableExactlyWhileAFrameWaits,
+                            ReceiveQueuedHandsOutWhatArrivedInOrderWithoutWaiting);
 
 }  // namespace ranger::bus_test

@@ -14,6 +14,9 @@ class Clock {
  public:
   virtual ~Clock() = default;
   virtual Timestamp now() const = 0;
+  // True when now() reads CLOCK_MONOTONIC: a thread may then wait for one of its instants with
+  // an absolute kernel timer (no clock read to turn it into a timeout).
+  virtual bool monotonic() const { return false; }
 };
 
 // Monotonic time for control loops (timeouts, keep-alive).
@@ -23,6 +26,7 @@ class SteadyClock final : public Clock {
     return std::chrono::duration_cast<Timestamp>(
         std::chrono::steady_clock::now().time_since_epoch());
   }
+  bool monotonic() const override { return true; }  // libstdc++'s steady_clock on Linux
 };
 
 // Same epoch as SocketCAN's SO_TIMESTAMP (CLOCK_REALTIME), for stamping frames that must be

@@ -3,10 +3,12 @@
 #include <poll.h>
 #include <pthread.h>
 #include <sys/eventfd.h>
+#include <sys/timerfd.h>
 #include <time.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <exception>
 #include <utility>
@@ -24,6 +26,20 @@ namespace {
 using namespace std::chrono_literals;
 
 constexpr std::size_t kMaxFramesPerIteration = 512;
+
+// ThreadSanitizer does not model the acquire fence publish() relies on to reuse a snapshot: under
+// it every snapshot is a new one.
+#if defined(__SANITIZE_THREAD__)
+constexpr bool kReuseSnapshots = false;
+#elif defined(__has_feature)
+#if __has_feature(thread_sanitizer)
+constexpr bool kReuseSnapshots = false;
+#else
+constexpr bool kReuseSnapshots = true;
+#endif
+#else
+constexpr bool kReuseSnapshots = true;
+#endif
 constexpr std::size_t kMaxRequests = 16;
 // A 0x211 that arrives this soon after a request was sent may have left the chassis before the
 // request reached it: the answer is the first one after this.
@@ -211,6 +227,7 @@ Driver::Driver(DriverConfig config, std::shared_ptr<BusSource> source, const Clo
       mail_(std::make_unique<Mail>()),
       snapshot_(std::make_shared<DriverSnapshot>()) {
   wake_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
+  if (clock_.monotonic()) timer_fd_ = ::timerfd_create(CLOCK_MONOTONIC, TFD_NONBLOCK | TFD_CLOEXEC);
   auto first = std::make_shared<DriverSnapshot>();
   first->bus_name = source_ ? source_->name() : "";
   first->profile = config_.controller.profile;
@@ -221,6 +238,7 @@ Driver::Driver(DriverConfig config, std::shared_ptr<BusSource> source, const Clo
 Driver::~Driver() {
   stop();
   if (wake_fd_ >= 0) ::close(wake_fd_);
+  if (timer_fd_ >= 0) ::close(timer_fd_);
 }
 
 void Driver::start() {
@@ -424,11 +442,13 @@ void Driver::try_open(Timestamp now) {
   if (source_->read_only()) controller_config.listen_only = true;
   controller_ = std::make_unique<ChassisController>(*bus_, controller_config);
   controller_->set_send_observer([this](const SentFrame& sent) {
-    events_.push_back(SentEvent{sent, std::chrono::system_clock::now()});
+    events_.push_back(SentEvent{sent, sent_wall_time_ ? std::chrono::system_clock::now()
+                                                      : std::chrono::system_clock::time_point{}});
   });
   if (config_.protocol == ProtocolChoice::kAuto) {
     // Listen before speaking: the controller hears nothing and says nothing until the
     // identification has proposed the settings.
+    identification_changed_ = true;
     identifier_.emplace(config_.identification, config_.controller.geometry,
                         config_.identify_revision, source_->read_only());
     controller_->set_quiet(true);
@@ -728,24 +748,36 @@ void Driver::update_requests(Timestamp now) {
 }
 
 void Driver::publish(Timestamp now) {
-  auto s = std::make_shared<DriverSnapshot>();
+  std::shared_ptr<DriverSnapshot> s;
+  if (kReuseSnapshots && spare_ && spare_.use_count() == 1) {
+    // No reader holds it: the last one's reads happened before its release of the count.
+    std::atomic_thread_fence(std::memory_order_acquire);
+    s = std::move(spare_);
+  } else {
+    s = std::make_shared<DriverSnapshot>();
+  }
+  // Every field is assigned (a reused snapshot keeps nothing of its last publication).
   s->now = now;
   s->bus_name = source_ ? source_->name() : "";
   s->bus_open = bus_ != nullptr;
   s->read_only = source_ && source_->read_only();
   s->bus_error = bus_error_;
-  if (bus_) s->bus = bus_->status();
-  if (controller_) {
-    s->controller = controller_->state();
-    s->feedback = controller_->feedback();
-  }
+  s->bus = bus_ ? bus_->status() : BusStatus{};
+  s->controller = controller_ ? controller_->state() : ControllerState{};
+  s->feedback = controller_ ? controller_->feedback() : ChassisFeedback{};
   s->motion_known = controller_ && s->controller.link == LinkState::kConnected;
   s->odometry = odometry_.state();
   s->joints = joints_.joints();
   s->frames = frames_;
   s->profile = profile_;
   s->protocol = config_.protocol;
-  if (identifier_) s->identification = identifier_->status();
+  if (!identifier_) {
+    identification_.reset();
+  } else if (!identification_ || !identification_->done() || identification_changed_) {
+    identification_ = std::make_shared<const IdentificationStatus>(identifier_->status());
+    identification_changed_ = false;
+  }
+  s->identification = identification_;
   s->plausibility = monitor_.status();
   s->loop_iterations = loop_iterations_;
   s->vendor_frames = vendor_frames_;
@@ -759,8 +791,10 @@ void Driver::publish(Timestamp now) {
   {
     std::lock_guard<std::mutex> lock(snapshot_mutex_);
     s->sequence = snapshot_->sequence + 1;
-    snapshot_ = std::move(s);
+    snapshot_ = s;
   }
+  spare_ = std::move(published_);
+  published_ = std::move(s);
   snapshot_changed_.notify_all();
 }
 
@@ -777,10 +811,12 @@ void Driver::step(Timestamp now) {
   ++loop_iterations_;
   if (!bus_) try_open(now);
   if (bus_) {
-    for (std::size_t i = 0; i < kMaxFramesPerIteration; ++i) {
-      auto frame = bus_->receive(0ns);
-      if (!frame) break;  // kTimeout: nothing more; other errors: the bus reports and reopens
-      handle_frame(*frame, now);
+    // What has arrived (one system call per batch, no clock read); an error ends the list: the
+    // bus reports it and reopens.
+    received_.clear();
+    bus_->receive_queued(received_, kMaxFramesPerIteration);
+    for (const Result<CanFrame>& frame : received_) {
+      if (frame) handle_frame(*frame, now);
     }
     apply_mail(now);
     run_identification(now);
@@ -898,6 +934,7 @@ void Driver::run_plausibility(Timestamp now) {
   controller_->set_implausible(applied_stop_);  // the stop, latched
   // Auto: a setting the identification could not decide at rest is learned here. The stop stays
   // latched (a zero twist or resume re-arms); the cause itself is gone with the setting.
+  if (identifier_) identification_changed_ = true;  // adopt() records the stop either way
   if (identifier_ && identifier_->adopt(stop->setting, stop->try_value, stop->detail)) {
     use_profile(with_configured_settings(identifier_->status()), /*reset_odometry=*/false);
     controller_->set_implausible("");
@@ -929,6 +966,30 @@ void Driver::wait(std::chrono::nanoseconds timeout) {
   }
 }
 
+void Driver::wait_until(Timestamp due) {
+  if (due != timer_armed_) {
+    itimerspec spec{};
+    const auto ns = std::max<Timestamp::rep>(due.count(), 1);  // 0 would disarm it
+    spec.it_value = {static_cast<time_t>(ns / 1'000'000'000),
+                     static_cast<long>(ns % 1'000'000'000)};
+    if (::timerfd_settime(timer_fd_, TFD_TIMER_ABSTIME, &spec, nullptr) != 0) {
+      wait(due - clock_.now());
+      return;
+    }
+    timer_armed_ = due;
+  }
+  // No timeout: the kernel reads no clock for this wait (under emulation a clock read can cost
+  // more than the rest of an iteration).
+  pollfd fds[2] = {{wake_fd_, POLLIN, 0}, {timer_fd_, POLLIN, 0}};
+  if (::ppoll(fds, 2, nullptr, nullptr) <= 0) return;
+  if (fds[0].revents & POLLIN) {
+    std::uint64_t value;
+    [[maybe_unused]] const auto n = ::read(wake_fd_, &value, sizeof value);
+  }
+  // An expired timer is not read: arming it again (the next instant is a later one) clears it.
+  if (fds[1].revents & POLLIN) timer_armed_ = Timestamp{-1};
+}
+
 void Driver::loop() {
   ::pthread_setname_np(::pthread_self(), config_.thread_name.substr(0, 15).c_str());
   try {
@@ -937,8 +998,14 @@ void Driver::loop() {
         std::lock_guard<std::mutex> lock(mail_mutex_);
         if (stop_requested_) break;
       }
-      step(clock_.now());
-      wait(next_due() - clock_.now());
+      const Timestamp now = clock_.now();
+      step(now);
+      // Woken by the next due instant (at least once a second), or by wake().
+      if (timer_fd_ >= 0 && wake_fd_ >= 0) {
+        wait_until(std::min(next_due(), now + std::chrono::seconds(1)));
+      } else {
+        wait(next_due() - clock_.now());
+      }
     }
   } catch (const std::exception& e) {  // never let an exception escape the thread
     bus_error_ = std::string("driver thread failed: ") + e.what();

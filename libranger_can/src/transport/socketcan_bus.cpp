@@ -18,6 +18,7 @@
 #include <cerrno>
 #include <cstring>
 #include <deque>
+#include <optional>
 #include <system_error>
 #include <thread>
 
@@ -163,6 +164,9 @@ struct SocketCanBus::State {
   ReopenSchedule schedule;
   IdFilter filter;
   std::shared_ptr<Socket> socket;  // null while the interface is down
+  // Since the last status(): frames were read, one recvmmsg filled its whole batch.
+  bool read_since_status = false;
+  bool full_batch_since_status = false;
 
   // Accounts for the kernel's cumulative drop counter of `s` having reached `count`.
   void account_drops(Socket& s, std::uint32_t count) {
@@ -423,6 +427,8 @@ int SocketCanBus::read_batch(const std::shared_ptr<Socket>& socket, int& err) {
   std::lock_guard<std::mutex> lock(mutex_);  // once for the whole batch
   State& s = *state_;
   if (b.ready.empty()) b.filter_generation = filter_generation_.load();
+  if (n > 0) s.read_since_status = true;
+  if (n == static_cast<int>(kReceiveBatch)) s.full_batch_since_status = true;
   for (std::size_t i = 0; i < static_cast<std::size_t>(n); ++i) {
     struct msghdr& msg = b.msgs[i].msg_hdr;
     Timestamp stamp{0};
@@ -465,9 +471,22 @@ int SocketCanBus::read_batch(const std::shared_ptr<Socket>& socket, int& err) {
   return n;
 }
 
+void SocketCanBus::refilter_ready() {
+  std::deque<Result<CanFrame>>& ready = rx_->ready;
+  if (ready.empty() || rx_->filter_generation == filter_generation_.load()) return;
+  // The filter changed since these were read: they must pass the new one.
+  std::lock_guard<std::mutex> lock(mutex_);
+  rx_->filter_generation = filter_generation_.load();
+  const IdFilter& filter = state_->filter;
+  ready.erase(std::remove_if(ready.begin(), ready.end(),
+                             [&filter](const Result<CanFrame>& f) {
+                               return f && !f->is_error && !filter.accepts(f->id);
+                             }),
+              ready.end());
+}
+
 Result<CanFrame> SocketCanBus::receive(std::chrono::nanoseconds timeout) {
   using std::chrono::steady_clock;
-  const auto deadline = steady_clock::now() + timeout;
   std::lock_guard<std::mutex> receive_lock(receive_mutex_);
   std::deque<Result<CanFrame>>& ready = rx_->ready;
   auto next_ready = [&ready] {
@@ -475,24 +494,17 @@ Result<CanFrame> SocketCanBus::receive(std::chrono::nanoseconds timeout) {
     ready.pop_front();
     return r;
   };
-  if (!ready.empty() && rx_->filter_generation != filter_generation_.load()) {
-    // The filter changed since these were read: they must pass the new one.
-    std::lock_guard<std::mutex> lock(mutex_);
-    rx_->filter_generation = filter_generation_.load();
-    const IdFilter& filter = state_->filter;
-    ready.erase(std::remove_if(ready.begin(), ready.end(),
-                               [&filter](const Result<CanFrame>& f) {
-                                 return f && !f->is_error && !filter.accepts(f->id);
-                               }),
-                ready.end());
-  }
+  refilter_ready();
   if (!ready.empty()) return next_ready();  // read by an earlier recvmmsg: no system call
+  // The clock is read only by a call that has to wait (a poll with timeout 0 reads none).
+  std::optional<steady_clock::time_point> deadline;
+  if (timeout > std::chrono::nanoseconds::zero()) deadline = steady_clock::now() + timeout;
   bool poll_reported_error = false;
   for (;;) {
     auto socket = acquire_socket();
     if (!socket) {
       // Nothing to wait on: wait out the timeout like an idle bus, so callers do not spin.
-      std::this_thread::sleep_until(deadline);
+      if (deadline) std::this_thread::sleep_until(*deadline);
       return down_error();
     }
     const int fd = socket->fd.get();
@@ -517,7 +529,8 @@ Result<CanFrame> SocketCanBus::receive(std::chrono::nanoseconds timeout) {
         return Error{Errc::kIoError, interface_ + ": poll reported an error on the CAN socket (" +
                                          (so_error ? errno_text(so_error) : "no detail") + ")"};
       }
-      const auto remaining = deadline - steady_clock::now();
+      const auto remaining =
+          deadline ? *deadline - steady_clock::now() : steady_clock::duration::zero();
       if (remaining <= steady_clock::duration::zero()) {
         return Error{Errc::kTimeout, interface_ + ": no frame within the timeout"};
       }
@@ -542,6 +555,45 @@ Result<CanFrame> SocketCanBus::receive(std::chrono::nanoseconds timeout) {
   }
 }
 
+std::size_t SocketCanBus::receive_queued(std::vector<Result<CanFrame>>& out, std::size_t max) {
+  std::lock_guard<std::mutex> receive_lock(receive_mutex_);
+  std::deque<Result<CanFrame>>& ready = rx_->ready;
+  refilter_ready();
+  std::size_t count = 0;
+  bool queue_read = false;  // a recvmmsg of this call found the kernel's queue drained
+  for (;;) {
+    while (!ready.empty() && count < max) {
+      out.push_back(std::move(ready.front()));
+      ready.pop_front();
+      ++count;
+      if (!out.back()) return count;  // stop after an error: the rest is for the next call
+    }
+    if (count >= max || queue_read) return count;
+    auto socket = acquire_socket();
+    if (!socket) {
+      out.push_back(down_error());
+      return count + 1;
+    }
+    int err = 0;
+    const int n = read_batch(socket, err);
+    if (n >= 0) {
+      // A short batch emptied the queue; a full one may have left frames behind.
+      queue_read = n < static_cast<int>(kReceiveBatch);
+      continue;
+    }
+    if (err == EINTR) continue;
+    if (is_interface_loss(err)) {
+      if (!on_interface_lost(socket, err)) {
+        out.push_back(down_error());
+        return count + 1;
+      }
+      continue;  // reopened at once
+    }
+    out.push_back(Error{errc_for(err), interface_ + ": cannot receive: " + errno_text(err)});
+    return count + 1;
+  }
+}
+
 int SocketCanBus::fd() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return state_->socket ? state_->socket->fd.get() : -1;
@@ -550,13 +602,17 @@ int SocketCanBus::fd() const {
 BusStatus SocketCanBus::status() const {
   std::lock_guard<std::mutex> lock(mutex_);
   State& s = *state_;
-  if (s.socket) {
-    // Drops after the last frame we read are only reported with the next frame; SO_MEMINFO
-    // has the counter now.
+  // Every frame queued after a drop carries the kernel's drop count (SO_RXQ_OVFL), so while
+  // frames flow the count is current as they are read. Drops after the last frame read are told
+  // by the next one; SO_MEMINFO has them now, and is asked (a system call) only when they can
+  // matter: nothing was read since the last status(), or a full batch (a backlog) was.
+  if (s.socket && (!s.read_since_status || s.full_batch_since_status)) {
     if (const long long drops = current_socket_drops(s.socket->fd.get()); drops >= 0) {
       s.account_drops(*s.socket, static_cast<std::uint32_t>(drops));
     }
   }
+  s.read_since_status = false;
+  s.full_batch_since_status = false;
   return s.tracker.status();
 }
 

@@ -19,8 +19,11 @@
 //    estimate), states at state_publish_rate, diagnostics at 1 Hz, cmd_vel_out for every motion
 //    frame sent. However slow a subscriber or however much is published, the driver's schedule
 //    does not move;
-//  * two callback queues each spun by one thread: cmd_vel (never queued behind anything) and the
-//    services (which wait for the chassis's answer). No ROS callback touches the bus.
+//  * cmd_vel runs on the thread that delivers it (roscpp's network thread, or an in-process
+//    publisher's), through an ImmediateCallbackQueue: it posts to the driver's mailbox and
+//    returns, never queued behind anything and with no thread woken for it;
+//  * one callback queue spun by one thread for the services (which wait for the chassis's
+//    answer). No ROS callback touches the bus.
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
@@ -52,6 +55,7 @@
 #include <ranger_can/sim/sim_bus_source.hpp>
 
 #include "ranger_base/diagnostics.hpp"
+#include "ranger_base/immediate_callback_queue.hpp"
 #include "ranger_base/parameters.hpp"
 
 namespace ranger_base {
@@ -118,7 +122,8 @@ class RangerNode {
 
   ros::NodeHandle nh_;
   ros::NodeHandle private_nh_;
-  ros::CallbackQueue cmd_queue_, service_queue_;
+  ImmediateCallbackQueue cmd_queue_;
+  ros::CallbackQueue service_queue_;
   ros::NodeHandle cmd_nh_, service_nh_;  // nh_ with those queues
   const NodeParameters params_;
 
@@ -141,7 +146,7 @@ class RangerNode {
   diagnostic_updater::Updater updater_;
   std::unique_ptr<ChassisDiagnostics> diagnostics_;
 
-  std::unique_ptr<ros::AsyncSpinner> cmd_spinner_, service_spinner_;
+  std::unique_ptr<ros::AsyncSpinner> service_spinner_;
 
   std::atomic<bool> stopping_{false};   // services stop waiting
   std::atomic<bool> stop_sent_{false};  // the driver's shutdown stop was observed

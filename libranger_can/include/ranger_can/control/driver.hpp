@@ -175,10 +175,12 @@ struct StandstillProbe {
 // A frame the driver sent, as the observer sees it.
 struct SentEvent {
   SentFrame sent;                              // frame, message, achieved twist, shutdown flag
-  std::chrono::system_clock::time_point wall;  // wall time right after the send
+  std::chrono::system_clock::time_point wall;  // wall time right after the send (see
+                                               // set_sent_observer)
 };
 
-// A consistent copy of the runtime's state, published after every iteration.
+// A consistent copy of the runtime's state, published after every iteration. (Driver::publish
+// refills snapshots no reader holds any more: it assigns every field.)
 struct DriverSnapshot {
   std::uint64_t sequence = 0;  // increases with every publication
   Timestamp now{0};            // driver clock at publication
@@ -202,7 +204,8 @@ struct DriverSnapshot {
   // Where the settings came from, and (kAuto) the identification: phase, decided profile,
   // evidence lines, confidence, and the failure message naming what to set.
   ProtocolChoice protocol = ProtocolChoice::kForced;
-  std::optional<IdentificationStatus> identification;
+  // (Shared between snapshots while it does not change: after the decision it rarely does.)
+  std::shared_ptr<const IdentificationStatus> identification;
   // The plausibility monitors: persistent mismatches (WARN, with the value to try) and the one
   // that stopped the robot (also ControllerState::implausible_reason).
   PlausibilityStatus plausibility;
@@ -243,8 +246,12 @@ class Driver {
 
   // Called on the driver thread (or in step()) after every frame sent, outside the driver's
   // locks; must not block (it delays the next frame): queue the event and return. Set before
-  // start().
-  void set_sent_observer(SentObserver observer) { sent_observer_ = std::move(observer); }
+  // start(). Without `wall_time` the events' wall stamp is left at the epoch (one clock read per
+  // frame saved, which under emulation is a system call).
+  void set_sent_observer(SentObserver observer, bool wall_time = true) {
+    sent_observer_ = std::move(observer);
+    sent_wall_time_ = wall_time;
+  }
   // Called with every received frame (any ID), before the driver handles it. Set before start().
   void set_frame_tap(FrameTap tap) { frame_tap_ = std::move(tap); }
   // Called on the driver thread (or in step()) with the snapshot just published, after every
@@ -307,6 +314,7 @@ class Driver {
   void loop();
   void wake();
   void wait(std::chrono::nanoseconds timeout);
+  void wait_until(Timestamp due);  // timer_fd_: until `due` or a wake()
   void try_open(Timestamp now);
   void apply_mail(Timestamp now);
   void handle_frame(const CanFrame& frame, Timestamp now);
@@ -332,6 +340,7 @@ class Driver {
   const std::shared_ptr<BusSource> source_;
   const Clock& clock_;
   SentObserver sent_observer_;
+  bool sent_wall_time_ = true;
   FrameTap frame_tap_;
   StepObserver step_observer_;
 
@@ -340,6 +349,10 @@ class Driver {
   std::unique_ptr<ChassisController> controller_;
   ProtocolProfile profile_;  // the settings in use (decoding, odometry, monitors)
   std::optional<ChassisIdentifier> identifier_;
+  // Its status as last published; copied again while the identification runs, and after a
+  // change once it is done (a new identifier, a setting adopted while driving).
+  std::shared_ptr<const IdentificationStatus> identification_;
+  bool identification_changed_ = false;
   PlausibilityMonitor monitor_;
   std::string applied_stop_;  // the monitor's stop passed to the controller
   std::optional<StandstillProbe> probe_;
@@ -361,7 +374,8 @@ class Driver {
   Timestamp last_version_frame_{0};
   std::vector<DriverVendorAction> deferred_;  // waiting for vendor_frames_ to be known
   std::vector<std::pair<std::uint64_t, LightsRequest>> sent_lights_;  // request id, what
-  std::vector<SentEvent> events_;  // sent during this iteration, delivered after it
+  std::vector<SentEvent> events_;           // sent during this iteration, delivered after it
+  std::vector<Result<CanFrame>> received_;  // this iteration's frames (capacity kept)
   bool stopped_ = false;
 
   // ---- the mailbox ----
@@ -376,9 +390,18 @@ class Driver {
   mutable std::mutex snapshot_mutex_;
   std::condition_variable snapshot_changed_;
   std::shared_ptr<const DriverSnapshot> snapshot_;
+  // Owned by the driver thread: the snapshot it published last, and the one before, which
+  // publish() fills again once no reader holds it (strings and vectors keep their capacity, so a
+  // steady state publishes without allocating).
+  std::shared_ptr<DriverSnapshot> published_;
+  std::shared_ptr<DriverSnapshot> spare_;
 
   // ---- the thread ----
   int wake_fd_ = -1;
+  // An absolute CLOCK_MONOTONIC timer for the next due instant (a monotonic clock only), and
+  // the instant it is armed for (or -1): re-armed only when that changes.
+  int timer_fd_ = -1;
+  Timestamp timer_armed_{-1};
   bool stop_requested_ = false;  // guarded by mail_mutex_
   std::thread thread_;
 };

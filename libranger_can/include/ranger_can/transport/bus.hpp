@@ -9,19 +9,22 @@
 //  * receive() waits at most `timeout` and returns kTimeout when nothing came. Frames carry a
 //    receive timestamp from the bus's clock. Error frames come back with is_error = true after
 //    updating state(); callers may ignore them.
+//  * receive_queued() returns what has already arrived, without waiting, as receive(0) would one
+//    call at a time, with as few system calls as the implementation can manage.
 //  * Only frames whose ID passes the receive filter are delivered (default: RANGER IDs only).
 //  * A lost interface (unplugged, link down) is reported through state() == kDown and recovered
 //    by the implementation itself (reopen on the next call after it reappears); nothing throws.
 #pragma once
 
 #include <chrono>
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <string_view>
 #include <vector>
 
-#include "ranger_can/wire/frame.hpp"
 #include "ranger_can/result.hpp"
+#include "ranger_can/wire/frame.hpp"
 
 namespace ranger {
 
@@ -61,6 +64,14 @@ class Bus {
 
   virtual Status send(const CanFrame& frame) = 0;
   virtual Result<CanFrame> receive(std::chrono::nanoseconds timeout) = 0;
+
+  // What has already arrived, without waiting: appends to `out` at most `max` results, in order,
+  // exactly as successive receive(0ns) calls would return them, and returns how many it appended.
+  // It stops after the first error (a frame the bus could not read, the interface gone; never
+  // kTimeout, which just ends the list), leaving what follows for the next call. Frames that
+  // arrive while it runs may be left for the next call. The default calls receive(0ns);
+  // SocketCanBus reads the whole queue with one recvmmsg() per kReceiveBatch frames.
+  virtual std::size_t receive_queued(std::vector<Result<CanFrame>>& out, std::size_t max);
 
   // A file descriptor that becomes readable when receive() would not block (for poll/epoll), or
   // -1 while none is available (e.g. interface down).

@@ -7,9 +7,11 @@
 //  * send() never blocks: a full transmit queue (ENOBUFS from the qdisc, EAGAIN from the socket
 //    buffer) drops the frame, counts it in tx_dropped and returns kWouldBlock.
 //  * Frames are read in batches: one recvmmsg() takes everything queued (up to kReceiveBatch
-//    frames), and receive() hands them out one by one without another system call.
+//    frames), and receive() hands them out one by one without another system call;
+//    receive_queued() hands out the whole queue, and receive(0) reads no clock.
 //  * Frames the kernel dropped because we read too slowly are counted in rx_dropped
-//    (SO_RXQ_OVFL on every frame, SO_MEMINFO when the status is read).
+//    (SO_RXQ_OVFL on every frame queued after a drop; SO_MEMINFO when the status is read after
+//    a quiet spell or a backlog).
 //  * Losing the interface (link down: ENETDOWN; adapter unplugged: ENODEV) closes the socket,
 //    reports kDown with the reason, and later send()/receive() calls reopen it by name once it is
 //    back (first attempt at once, then at most one per `reopen_interval` on the injected clock).
@@ -75,6 +77,7 @@ class SocketCanBus final : public Bus {
 
   Status send(const CanFrame& frame) override;
   Result<CanFrame> receive(std::chrono::nanoseconds timeout) override;
+  std::size_t receive_queued(std::vector<Result<CanFrame>>& out, std::size_t max) override;
   int fd() const override;
   BusStatus status() const override;
   void set_filter(const std::vector<std::uint32_t>& ids) override;
@@ -92,6 +95,8 @@ class SocketCanBus final : public Bus {
   // Reads what `socket` has queued (one recvmmsg, not waiting) into rx_: the number of frames
   // read, 0 for none (EAGAIN), -1 for an error (`err` set).
   int read_batch(const std::shared_ptr<Socket>& socket, int& err);
+  // Drops the frames read before the last set_filter() that the new filter refuses.
+  void refilter_ready();
 
   struct State;
   struct ReceiveBatch;
