@@ -78,10 +78,6 @@ bool is_socketcan(const std::string& port) {
   return kind && *kind == ranger::BusKind::kSocketCan;
 }
 
-std::string hex_word(std::uint32_t word) {
-  return ranger::text::hex(word, 8);
-}
-
 // Publishes a message as a shared pointer: a subscriber in the same process gets this very
 // message, without serialisation.
 template <class M>
@@ -401,7 +397,8 @@ bool RangerNode::on_clear_errors(ranger_msgs::ClearErrors::Request& req,
     res.error_word = *outcome.error_word;
     const auto names =
         protocol::error_bit_names(res.error_word, driver_->snapshot()->profile.error_word);
-    res.message = asked + ": the chassis answered with error word " + hex_word(res.error_word) +
+    res.message = asked + ": the chassis answered with error word " +
+                  ranger::text::hex(res.error_word, 8) +
                   (names.empty() ? " (no errors)" : " (" + join(names) + ")");
     ROS_INFO("%s", res.message.c_str());
   } else {
@@ -785,9 +782,11 @@ void RangerNode::log_state_changes(const ranger::DriverSnapshot& s) {
   if (c.error_bits != last_error_bits_) {
     const auto names = protocol::error_bit_names(c.error_bits, s.profile.error_word);
     if (names.empty()) {
-      ROS_INFO("chassis errors cleared (error word %s)", hex_word(c.error_bits).c_str());
+      ROS_INFO("chassis errors cleared (error word %s)",
+               ranger::text::hex(c.error_bits, 8).c_str());
     } else {
-      ROS_WARN("chassis error word %s: %s", hex_word(c.error_bits).c_str(), join(names).c_str());
+      ROS_WARN("chassis error word %s: %s", ranger::text::hex(c.error_bits, 8).c_str(),
+               join(names).c_str());
     }
     last_error_bits_ = c.error_bits;
   }

@@ -29,14 +29,13 @@ constexpr std::size_t kMaxFramesPerIteration = 512;
 
 // ThreadSanitizer does not model the acquire fence publish() relies on to reuse a snapshot: under
 // it every snapshot is a new one.
-#if defined(__SANITIZE_THREAD__)
-constexpr bool kReuseSnapshots = false;
-#elif defined(__has_feature)
+#if defined(__has_feature)  // clang
 #if __has_feature(thread_sanitizer)
-constexpr bool kReuseSnapshots = false;
-#else
-constexpr bool kReuseSnapshots = true;
+#define RANGER_UNDER_TSAN 1
 #endif
+#endif
+#if defined(__SANITIZE_THREAD__) || defined(RANGER_UNDER_TSAN)  // gcc, clang
+constexpr bool kReuseSnapshots = false;
 #else
 constexpr bool kReuseSnapshots = true;
 #endif
@@ -59,14 +58,6 @@ OdometryConfig odometry_config(const DriverConfig& config) {
   c.geometry = config.controller.geometry;
   c.profile = config.controller.profile;
   return c;
-}
-
-std::string join_names(const std::vector<std::string>& names) {
-  return text::join(names);
-}
-
-std::string hex2(std::uint8_t v) {
-  return text::hex(v, 2);
 }
 
 double axis(std::int8_t raw) {
@@ -219,6 +210,7 @@ struct Driver::Mail {
 Driver::Driver(DriverConfig config, std::shared_ptr<BusSource> source, const Clock& clock)
     : config_(std::move(config)),
       source_(std::move(source)),
+      bus_name_(source_ ? source_->name() : ""),
       clock_(clock),
       profile_(config_.controller.profile),
       monitor_(config_.plausibility, config_.controller.geometry, config_.controller.profile),
@@ -229,7 +221,7 @@ Driver::Driver(DriverConfig config, std::shared_ptr<BusSource> source, const Clo
   wake_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
   if (clock_.monotonic()) timer_fd_ = ::timerfd_create(CLOCK_MONOTONIC, TFD_NONBLOCK | TFD_CLOEXEC);
   auto first = std::make_shared<DriverSnapshot>();
-  first->bus_name = source_ ? source_->name() : "";
+  first->bus_name = bus_name_;
   first->profile = config_.controller.profile;
   first->protocol = config_.protocol;
   snapshot_ = std::move(first);
@@ -314,7 +306,7 @@ Result<std::uint64_t> Driver::clear_errors(std::uint8_t code) {
   std::uint64_t id = 0;
   {
     std::lock_guard<std::mutex> lock(mail_mutex_);
-    id = add_request(RequestOutcome::Kind::kClearErrors, "clear_errors " + hex2(code)).id;
+    id = add_request(RequestOutcome::Kind::kClearErrors, "clear_errors " + text::hex(code, 2)).id;
     mail_->actions.push_back({RequestOutcome::Kind::kClearErrors, id, code, false});
   }
   wake();
@@ -664,7 +656,7 @@ void Driver::update_requests(Timestamp now) {
         r.error_word = c.error_bits;
         const auto names = protocol::error_bit_names(c.error_bits, profile_.error_word);
         r.message = names.empty() ? std::string("the chassis reports no error")
-                                  : "the chassis still reports: " + join_names(names);
+                                  : "the chassis still reports: " + text::join(names);
       } else if (now - r.sent > config_.request_answer_timeout) {
         r.state = RequestOutcome::State::kFailed;
         r.message = "the chassis did not answer (no 0x211) within " +
@@ -758,7 +750,7 @@ void Driver::publish(Timestamp now) {
   }
   // Every field is assigned (a reused snapshot keeps nothing of its last publication).
   s->now = now;
-  s->bus_name = source_ ? source_->name() : "";
+  s->bus_name = bus_name_;
   s->bus_open = bus_ != nullptr;
   s->read_only = source_ && source_->read_only();
   s->bus_error = bus_error_;

@@ -42,9 +42,6 @@ std::string deg(double rad) {
 std::string secs(std::chrono::nanoseconds d) {
   return fmt("%.2f", seconds(d)) + " s";
 }
-std::string hex_id(std::uint32_t id) {
-  return text::hex(id);
-}
 
 const std::array<AngleUnit, 2> kUnits = {AngleUnit::kCentidegree, AngleUnit::kMilliradian};
 const std::array<SteeringSign, 2> kSigns = {SteeringSign::kRightPositive,
@@ -387,7 +384,7 @@ void ChassisIdentifier::observe_passive(const CanFrame& frame) {
   const protocol::FrameInfo* info = protocol::find_frame(id);
   const bool chassis_frame = protocol::is_chassis_frame(frame);
   if (chassis_frame && (info->revisions & protocol::kInManual) == 0) {
-    const std::string what = hex_id(id) + " (" + std::string(protocol::frame_name(id)) + ")";
+    const std::string what = text::hex(id) + " (" + std::string(protocol::frame_name(id)) + ")";
     if (std::find(agx_signatures_.begin(), agx_signatures_.end(), what) == agx_signatures_.end()) {
       agx_signatures_.push_back(what);
     }
@@ -840,7 +837,7 @@ void ChassisIdentifier::decide_passive(Timestamp now) {
   if (!padded_ids_.empty()) {
     std::string ids;
     for (std::uint32_t id : padded_ids_)
-      ids += (ids.empty() ? "" : ", ") + hex_id(id);
+      ids += (ids.empty() ? "" : ", ") + text::hex(id);
     set("tx_dlc", "8",
         "the chassis pads its frames (" + ids +
             " longer than their layout): commands padded to 8 bytes");

@@ -471,6 +471,20 @@ int SocketCanBus::read_batch(const std::shared_ptr<Socket>& socket, int& err) {
   return n;
 }
 
+Result<int> SocketCanBus::read_queued(std::shared_ptr<Socket>& socket) {
+  for (;;) {
+    if (!socket) return down_error();
+    int err = 0;
+    const int n = read_batch(socket, err);
+    if (n >= 0) return n;
+    if (err == EINTR) continue;
+    if (!is_interface_loss(err)) {
+      return Error{errc_for(err), interface_ + ": cannot receive: " + errno_text(err)};
+    }
+    socket = on_interface_lost(socket, err);  // reopened at once if only briefly away
+  }
+}
+
 void SocketCanBus::refilter_ready() {
   std::deque<Result<CanFrame>>& ready = rx_->ready;
   if (ready.empty() || rx_->filter_generation == filter_generation_.load()) return;
@@ -507,51 +521,43 @@ Result<CanFrame> SocketCanBus::receive(std::chrono::nanoseconds timeout) {
       if (deadline) std::this_thread::sleep_until(*deadline);
       return down_error();
     }
-    const int fd = socket->fd.get();
-
-    int err = 0;
-    const int n = read_batch(socket, err);
-    if (n > 0) {
+    const auto n = read_queued(socket);
+    if (!n) return n.error();
+    if (*n > 0) {
       if (!ready.empty()) return next_ready();
       continue;  // every frame was filtered out: read again
     }
-    if (n < 0 && err == EINTR) continue;
-    if (n == 0) {  // nothing queued
-      if (poll_reported_error) {
-        int so_error = 0;
-        socklen_t len = sizeof so_error;
-        ::getsockopt(fd, SOL_SOCKET, SO_ERROR, &so_error, &len);
-        if (so_error != 0 && is_interface_loss(so_error)) {
-          if (!on_interface_lost(socket, so_error)) return down_error();
-          poll_reported_error = false;
-          continue;
-        }
-        return Error{Errc::kIoError, interface_ + ": poll reported an error on the CAN socket (" +
-                                         (so_error ? errno_text(so_error) : "no detail") + ")"};
+    // Nothing queued.
+    const int fd = socket->fd.get();
+    if (poll_reported_error) {
+      int so_error = 0;
+      socklen_t len = sizeof so_error;
+      ::getsockopt(fd, SOL_SOCKET, SO_ERROR, &so_error, &len);
+      if (so_error != 0 && is_interface_loss(so_error)) {
+        if (!on_interface_lost(socket, so_error)) return down_error();
+        poll_reported_error = false;
+        continue;
       }
-      const auto remaining =
-          deadline ? *deadline - steady_clock::now() : steady_clock::duration::zero();
-      if (remaining <= steady_clock::duration::zero()) {
-        return Error{Errc::kTimeout, interface_ + ": no frame within the timeout"};
-      }
-      const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(remaining).count();
-      struct timespec wait = {static_cast<time_t>(ns / 1000000000),
-                              static_cast<long>(ns % 1000000000)};
-      struct pollfd pfd = {fd, POLLIN, 0};
-      const int r = ::ppoll(&pfd, 1, &wait, nullptr);
-      if (r < 0 && errno != EINTR) {
-        return Error{Errc::kIoError, interface_ + ": poll failed: " + errno_text(errno)};
-      }
-      if (r > 0 && !(pfd.revents & POLLIN) && (pfd.revents & (POLLERR | POLLHUP | POLLNVAL))) {
-        poll_reported_error = true;
-      }
-      continue;  // read again: a pending socket error is reported by recvmmsg itself
+      return Error{Errc::kIoError, interface_ + ": poll reported an error on the CAN socket (" +
+                                       (so_error ? errno_text(so_error) : "no detail") + ")"};
     }
-    if (is_interface_loss(err)) {
-      if (!on_interface_lost(socket, err)) return down_error();
-      continue;  // reopened at once: the interface was only briefly away
+    const auto remaining =
+        deadline ? *deadline - steady_clock::now() : steady_clock::duration::zero();
+    if (remaining <= steady_clock::duration::zero()) {
+      return Error{Errc::kTimeout, interface_ + ": no frame within the timeout"};
     }
-    return Error{errc_for(err), interface_ + ": cannot receive: " + errno_text(err)};
+    const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(remaining).count();
+    struct timespec wait = {static_cast<time_t>(ns / 1000000000),
+                            static_cast<long>(ns % 1000000000)};
+    struct pollfd pfd = {fd, POLLIN, 0};
+    const int r = ::ppoll(&pfd, 1, &wait, nullptr);
+    if (r < 0 && errno != EINTR) {
+      return Error{Errc::kIoError, interface_ + ": poll failed: " + errno_text(errno)};
+    }
+    if (r > 0 && !(pfd.revents & POLLIN) && (pfd.revents & (POLLERR | POLLHUP | POLLNVAL))) {
+      poll_reported_error = true;
+    }
+    // Read again: a pending socket error is reported by recvmmsg itself.
   }
 }
 
@@ -570,27 +576,13 @@ std::size_t SocketCanBus::receive_queued(std::vector<Result<CanFrame>>& out, std
     }
     if (count >= max || queue_read) return count;
     auto socket = acquire_socket();
-    if (!socket) {
-      out.push_back(down_error());
+    const auto n = read_queued(socket);
+    if (!n) {
+      out.push_back(n.error());
       return count + 1;
     }
-    int err = 0;
-    const int n = read_batch(socket, err);
-    if (n >= 0) {
-      // A short batch emptied the queue; a full one may have left frames behind.
-      queue_read = n < static_cast<int>(kReceiveBatch);
-      continue;
-    }
-    if (err == EINTR) continue;
-    if (is_interface_loss(err)) {
-      if (!on_interface_lost(socket, err)) {
-        out.push_back(down_error());
-        return count + 1;
-      }
-      continue;  // reopened at once
-    }
-    out.push_back(Error{errc_for(err), interface_ + ": cannot receive: " + errno_text(err)});
-    return count + 1;
+    // A short batch emptied the queue; a full one may have left frames behind.
+    queue_read = *n < static_cast<int>(kReceiveBatch);
   }
 }
 

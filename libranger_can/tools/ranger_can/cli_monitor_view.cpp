@@ -57,10 +57,6 @@ std::string age_text(Timestamp received, Timestamp now) {
   return fmt("%.1f s ago", ms / 1000);
 }
 
-std::string hex_id(std::uint32_t id) {
-  return text::hex(id);
-}
-
 // Nominal frames per second of a feedback ID (0 for commands and on-change frames): the frame
 // table's period.
 double nominal_rate(std::uint32_t id) {
@@ -298,7 +294,7 @@ std::string ChassisMonitor::render_text(std::string_view iface, const BusStatus&
   for (auto id : ids) {
     const double r = rate(id, now);
     const double nominal = nominal_rate(id);
-    std::string cell = hex_id(id) + fmt(" %5.1f", r);
+    std::string cell = text::hex(id) + fmt(" %5.1f", r);
     cell += nominal > 0 ? fmt(" (%2.0f)", nominal) : "     ";
     if (nominal > 0 && std::abs(r - nominal) > 0.2 * nominal) cell = st.red(cell);
     row += "  " + cell;
@@ -402,7 +398,7 @@ std::string ChassisMonitor::render_json(std::string_view iface, const BusStatus&
   }
   w.key("rates").begin_object();
   for (const FrameIdCounts& c : stats_.counts())
-    w.key(hex_id(c.id)).number(rate(c.id, now));
+    w.key(text::hex(c.id)).number(rate(c.id, now));
   w.end_object();
   w.end_object();
   return out;

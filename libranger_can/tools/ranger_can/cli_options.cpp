@@ -144,10 +144,6 @@ Error usage(std::string message) {
   return Error{Errc::kInvalidArgument, std::move(message)};
 }
 
-std::string join(const std::vector<std::string>& words, const char* separator) {
-  return text::join(words, separator);
-}
-
 Status check_value(const std::string& what, const ValueRule& rule, const std::string& value) {
   switch (rule.kind) {
     case ValueRule::Kind::kAny:
@@ -169,7 +165,7 @@ Status check_value(const std::string& what, const ValueRule& rule, const std::st
       if (std::find(rule.choices.begin(), rule.choices.end(), value) != rule.choices.end()) {
         return ok_status();
       }
-      return usage(what + ": '" + value + "' is not one of " + join(rule.choices, ", "));
+      return usage(what + ": '" + value + "' is not one of " + text::join(rule.choices, ", "));
     case ValueRule::Kind::kCustom: {
       Status s = rule.check ? rule.check(value) : ok_status();
       if (!s) return usage(what + ": " + s.error().message);

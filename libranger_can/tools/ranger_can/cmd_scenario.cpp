@@ -97,10 +97,6 @@ int scenario_main(const ParsedArgs& args, Io io) {
   });
 }
 
-std::string join(const std::vector<std::string>& names, const char* sep) {
-  return text::join(names, sep);
-}
-
 }  // namespace
 
 const CommandSpec& scenario_command() {
@@ -135,7 +131,7 @@ const CommandSpec& scenario_command() {
                  checked_by(check_every)),
           option("--chassis-variant", "VARIANT",
                  "the virtual chassis (bus spec sim:VARIANT), one of: " +
-                     join(sim::variant_names(), ", ") +
+                     text::join(sim::variant_names(), ", ") +
                      " (default manual); it applies over --model, --protocol and --set, which "
                      "configure the driver and the chassis alike",
                  one_of(sim::variant_names())),

@@ -338,6 +338,7 @@ class Driver {
 
   const DriverConfig config_;
   const std::shared_ptr<BusSource> source_;
+  const std::string bus_name_;  // source_->name(), for every snapshot
   const Clock& clock_;
   SentObserver sent_observer_;
   bool sent_wall_time_ = true;

@@ -95,6 +95,10 @@ class SocketCanBus final : public Bus {
   // Reads what `socket` has queued (one recvmmsg, not waiting) into rx_: the number of frames
   // read, 0 for none (EAGAIN), -1 for an error (`err` set).
   int read_batch(const std::shared_ptr<Socket>& socket, int& err);
+  // read_batch() on `socket`, retried after EINTR and, after a lost interface, on the reopened
+  // socket (`socket` follows it; null while down): the frames read (0: nothing queued), or the
+  // error to report (the interface down, or why it cannot be read).
+  Result<int> read_queued(std::shared_ptr<Socket>& socket);
   // Drops the frames read before the last set_filter() that the new filter refuses.
   void refilter_ready();
 

@@ -305,13 +305,13 @@ inline constexpr Fault kAllFaults[] = {
 inline constexpr int kFaultCount = static_cast<int>(std::size(kAllFaults));
 std::string_view to_string(Fault f);  // "battery_under_voltage", ...
 
-// ---- The fault table
-// ----------------------------------------------------------------------------- One row per fault
-// the chassis reports in 0x211, by meaning: its bit in each error-word layout (kNoBit when the
-// layout has none), its stable snake_case name (ControllerState::faults, the ROS message's
-// SystemErrors field, diagnostics, the scenario language: the same name on both revisions), whether
-// it is critical (the chassis does not drive until it is cleared: our reading, interpretation.hpp)
-// and a description. Every bit position of either layout is written here and nowhere else.
+// ---- The fault table --------------------------------------------------------------------------
+// One row per fault the chassis reports in 0x211, by meaning: its bit in each error-word layout
+// (kNoBit when the layout has none), its stable snake_case name (ControllerState::faults, the ROS
+// message's SystemErrors field, diagnostics, the scenario language: the same name on both
+// revisions), whether it is critical (the chassis does not drive until it is cleared: our reading,
+// interpretation.hpp) and a description. Every bit position of either layout is written here and
+// nowhere else.
 inline constexpr int kNoBit = -1;
 struct FaultInfo {
   Fault fault;
