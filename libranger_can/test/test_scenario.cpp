@@ -109,45 +109,18 @@ TEST(ScenarioParse, EveryActionWithItsLineNumber) {
   EXPECT_EQ(s.expectations, 4u);
 }
 
-// The enumerators 0, 1, ... of a contiguous enum until to_string says "unknown" are exactly its
-// `all` list: an enumerator added without its name in the list fails here.
-template <typename Enum, std::size_t N>
-void expect_all_list_complete(const Enum (&all)[N], const char* what) {
-  std::vector<std::string> named;
-  for (int i = 0; i < 256; ++i) {
-    const std::string_view name = to_string(static_cast<Enum>(i));
-    if (name == "unknown") break;
-    named.emplace_back(name);
-  }
-  EXPECT_EQ(named, text::names_of(all)) << what;
-}
-
-TEST(EnumNames, EveryAllListHoldsEveryEnumerator) {
-  expect_all_list_complete(kAllMotionRefusals, "MotionRefusal");
-  expect_all_list_complete(kAllControllerFaults, "ControllerFault");
-  expect_all_list_complete(kAllLinkStates, "LinkState");
-  expect_all_list_complete(kAllIdentificationPhases, "IdentificationPhase");
-  expect_all_list_complete(protocol::kAllFaults, "Fault");
-  expect_all_list_complete(protocol::kAllMotionModes, "MotionMode");
-  expect_all_list_complete(protocol::kAllControlModes, "ControlMode");
-  expect_all_list_complete(protocol::kAllVehicleStatuses, "VehicleStatus");
-  expect_all_list_complete(protocol::kAllRemoteSwitches, "RemoteSwitch");
-  expect_all_list_complete(protocol::kAllLightModes, "LightMode");
-  expect_all_list_complete(protocol::kAllDirections, "Direction");
-}
-
-// Every name the driver can report, taken from the enums' `all` lists and the fault table (a new
+// Every name the driver can report, taken from the enums' name tables and the fault table (a new
 // enumerator or fault is covered without touching this test), is a valid `expect` value that
 // parses back to the same name.
 TEST(ScenarioParse, EveryNameOfTheEnumsAndTheFaultTableIsAccepted) {
   std::vector<std::pair<std::string, std::string>> checks;  // field, name
-  for (const auto& n : text::names_of(kAllMotionRefusals))
+  for (const auto& n : kMotionRefusalNames.names())
     checks.emplace_back("refusal", n);
-  for (const auto& n : text::names_of(protocol::kAllControlModes))
+  for (const auto& n : protocol::kControlModeNames.names())
     checks.emplace_back("control_mode", n);
-  for (const auto& n : text::names_of(protocol::kAllMotionModes))
+  for (const auto& n : protocol::kMotionModeNames.names())
     checks.emplace_back("motion_mode", n);
-  for (const auto& n : text::names_of(kAllControllerFaults))
+  for (const auto& n : kControllerFaultNames.names())
     checks.emplace_back("fault", n);
   for (const protocol::FaultInfo& f : protocol::kFaultTable)
     checks.emplace_back("fault", std::string(f.name));

@@ -80,34 +80,6 @@ bool lights_match(const LightsState& s, const LightsRequest& r) {
 
 }  // namespace
 
-std::string_view to_string(VendorFrames v) {
-  switch (v) {
-    case VendorFrames::kUnknown:
-      return "unknown";
-    case VendorFrames::kPresent:
-      return "present";
-    case VendorFrames::kAbsent:
-      return "absent";
-  }
-  return "unknown";
-}
-
-std::string_view to_string(FirmwareVersion::State s) {
-  switch (s) {
-    case FirmwareVersion::State::kNotAsked:
-      return "not_asked";
-    case FirmwareVersion::State::kAsked:
-      return "asked";
-    case FirmwareVersion::State::kAnswered:
-      return "answered";
-    case FirmwareVersion::State::kUnanswered:
-      return "unanswered";
-    case FirmwareVersion::State::kUnsupported:
-      return "unsupported";
-  }
-  return "unknown";
-}
-
 RemoteState remote_state_from(const RemoteControlState& rc, Timestamp received) {
   RemoteState r;
   r.swa = rc.swa;
@@ -127,42 +99,6 @@ std::string describe(protocol::LightMode front, std::uint8_t front_brightness,
                      protocol::LightMode rear, std::uint8_t rear_brightness) {
   return "front " + light_text(front, front_brightness) + ", rear " +
          light_text(rear, rear_brightness);
-}
-
-std::string_view to_string(RequestOutcome::Kind k) {
-  switch (k) {
-    case RequestOutcome::Kind::kClearErrors:
-      return "clear_errors";
-    case RequestOutcome::Kind::kUltrasonic:
-      return "ultrasonic";
-    case RequestOutcome::Kind::kResume:
-      return "resume";
-    case RequestOutcome::Kind::kLights:
-      return "lights";
-    case RequestOutcome::Kind::kPark:
-      return "park";
-    case RequestOutcome::Kind::kFirmwareVersion:
-      return "firmware_version";
-  }
-  return "unknown";
-}
-
-std::string_view to_string(RequestOutcome::State s) {
-  switch (s) {
-    case RequestOutcome::State::kPending:
-      return "pending";
-    case RequestOutcome::State::kSent:
-      return "sent";
-    case RequestOutcome::State::kAnswered:
-      return "answered";
-    case RequestOutcome::State::kFailed:
-      return "failed";
-  }
-  return "unknown";
-}
-
-std::string_view to_string(ProtocolChoice c) {
-  return c == ProtocolChoice::kAuto ? "auto" : "forced";
 }
 
 Status DriverConfig::validate() const {

@@ -270,26 +270,6 @@ Angle221Decision decide_221(const CanFrame& motion, const std::array<double, 4>&
 
 }  // namespace
 
-std::string_view to_string(IdentificationPhase p) {
-  switch (p) {
-    case IdentificationPhase::kListening:
-      return "listening";
-    case IdentificationPhase::kAwaitingControl:
-      return "awaiting_control";
-    case IdentificationPhase::kSpinCheck:
-      return "spin_check";
-    case IdentificationPhase::kSteerProbe:
-      return "steer_probe";
-    case IdentificationPhase::kReturning:
-      return "returning";
-    case IdentificationPhase::kDecided:
-      return "decided";
-    case IdentificationPhase::kFailed:
-      return "failed";
-  }
-  return "unknown";
-}
-
 Status IdentificationConfig::validate() const {
   if (listen_time.count() <= 0 || timeout.count() <= 0 || step_timeout.count() <= 0 ||
       settle_time.count() <= 0) {

@@ -137,20 +137,6 @@ const std::vector<DriverParameter> kParameters = {
 
 }  // namespace
 
-std::string_view to_string(ParameterType t) {
-  switch (t) {
-    case ParameterType::kBool:
-      return "bool";
-    case ParameterType::kInteger:
-      return "int";
-    case ParameterType::kNumber:
-      return "double";
-    case ParameterType::kSeconds:
-      return "seconds";
-  }
-  return "unknown";
-}
-
 bool ParameterRange::contains(double v) const {
   return (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi);
 }

@@ -6,8 +6,8 @@
 #include <type_traits>
 #include <vector>
 
-#include "cli_json.hpp"
 #include "ranger_can/control/geometry.hpp"
+#include "ranger_can/json.hpp"
 #include "ranger_can/text.hpp"
 #include "ranger_can/wire/interpretation.hpp"
 #include "ranger_can/wire/protocol.hpp"

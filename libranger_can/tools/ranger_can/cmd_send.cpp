@@ -34,15 +34,14 @@ Error bad(const std::string& what) {
 // The modes `send mode` takes: every motion mode but park, which has a command of its own.
 std::vector<std::string> mode_names() {
   std::vector<std::string> names;
-  for (const protocol::MotionMode m : protocol::kAllMotionModes)
-    if (m != protocol::MotionMode::kPark) names.emplace_back(protocol::to_string(m));
+  for (const auto& [mode, name] : protocol::kMotionModeNames)
+    if (mode != protocol::MotionMode::kPark) names.emplace_back(name);
   return names;
 }
 
 Result<Message> parse_mode(const Words& w) {
-  for (const protocol::MotionMode m : protocol::kAllMotionModes)
-    if (m != protocol::MotionMode::kPark && w[0] == protocol::to_string(m))
-      return Message{MotionModeCommand{m}};
+  const auto mode = protocol::kMotionModeNames.parse(w[0]);
+  if (mode && *mode != protocol::MotionMode::kPark) return Message{MotionModeCommand{*mode}};
   return bad("mode: unknown motion mode '" + w[0] + "' (" + text::join(mode_names()) + ")");
 }
 
@@ -114,20 +113,19 @@ Result<Message> parse_ultrasonic(const Words& w) {
   return bad("ultrasonic: expected 'on' or 'off', got '" + w[0] + "'");
 }
 
-constexpr double kRadPerDeg = M_PI / 180.0;  // the user's unit, not the wire's
-
 Result<Message> parse_motion(const Words& w) {
   auto v = parse_double_in("motion V", w[0], -interpretation::kMaxLinearSpeedMps,
                            interpretation::kMaxLinearSpeedMps);
   if (!v) return v.error();
-  auto steer = parse_double_in("motion STEER_DEG", w[1], -kMaxObliqueSteeringRad / kRadPerDeg,
-                               kMaxObliqueSteeringRad / kRadPerDeg);
+  // Degrees: the user's unit, not the wire's.
+  auto steer = parse_double_in("motion STEER_DEG", w[1], -rad_to_deg(kMaxObliqueSteeringRad),
+                               rad_to_deg(kMaxObliqueSteeringRad));
   if (!steer) return steer.error();
   auto spin = parse_double_in("motion SPIN", w[2], -kMaxSpinSpeedMps, kMaxSpinSpeedMps);
   if (!spin) return spin.error();
   MotionCommand m;
   m.linear_speed = *v;
-  m.steering_angle = interpretation::manual_from_rep103_command_steering(*steer * kRadPerDeg);
+  m.steering_angle = interpretation::manual_from_rep103_command_steering(deg_to_rad(*steer));
   m.spin_speed = *spin;
   return Message{m};
 }
@@ -166,7 +164,7 @@ const std::vector<SendCommand>& send_commands() {
        "0x111 once: V linear speed m/s (forward +, |V| <= " +
            number_text(interpretation::kMaxLinearSpeedMps) +
            "), STEER_DEG steering in degrees, REP-103 sign: positive = LEFT (|STEER_DEG| <= " +
-           number_text(kMaxObliqueSteeringRad / kRadPerDeg) +
+           number_text(rad_to_deg(kMaxObliqueSteeringRad)) +
            "; sent with the manual's sign), SPIN wheel speed m/s, counter-clockwise + (|SPIN| <= " +
            number_text(kMaxSpinSpeedMps) +
            "). The chassis stops again 500 ms later unless repeated.",

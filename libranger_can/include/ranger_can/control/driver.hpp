@@ -37,6 +37,7 @@
 #include "ranger_can/control/odometry.hpp"
 #include "ranger_can/control/plausibility.hpp"
 #include "ranger_can/result.hpp"
+#include "ranger_can/text.hpp"
 #include "ranger_can/transport/bus.hpp"
 #include "ranger_can/transport/bus_source.hpp"
 // The pack's facts (chemistry, voltage range), for programs that include nothing from wire/.
@@ -49,7 +50,13 @@ enum class ProtocolChoice {
   kForced,  // controller.profile as it is (a preset, --set values, a commissioning file)
   kAuto,    // identified from the chassis before anything moves (identification.hpp)
 };
-std::string_view to_string(ProtocolChoice c);  // "forced" / "auto"
+inline constexpr auto kProtocolChoiceNames = text::enum_names<ProtocolChoice>({
+    {ProtocolChoice::kForced, "forced"},
+    {ProtocolChoice::kAuto, "auto"},
+});
+inline std::string_view to_string(ProtocolChoice c) {
+  return kProtocolChoiceNames.name(c);
+}
 
 struct DriverConfig {
   ControllerConfig controller;  // geometry, limits, protocol profile, timeouts, ...
@@ -100,8 +107,26 @@ struct RequestOutcome {
   std::optional<std::uint32_t> error_word;
   Timestamp sent{0};  // driver clock
 };
-std::string_view to_string(RequestOutcome::Kind k);   // "clear_errors", "ultrasonic", "resume", ...
-std::string_view to_string(RequestOutcome::State s);  // "pending", "sent", "answered", "failed"
+inline constexpr auto kRequestKindNames = text::enum_names<RequestOutcome::Kind>({
+    {RequestOutcome::Kind::kClearErrors, "clear_errors"},
+    {RequestOutcome::Kind::kUltrasonic, "ultrasonic"},
+    {RequestOutcome::Kind::kResume, "resume"},
+    {RequestOutcome::Kind::kLights, "lights"},
+    {RequestOutcome::Kind::kPark, "park"},
+    {RequestOutcome::Kind::kFirmwareVersion, "firmware_version"},
+});
+inline constexpr auto kRequestStateNames = text::enum_names<RequestOutcome::State>({
+    {RequestOutcome::State::kPending, "pending"},
+    {RequestOutcome::State::kSent, "sent"},
+    {RequestOutcome::State::kAnswered, "answered"},
+    {RequestOutcome::State::kFailed, "failed"},
+});
+inline std::string_view to_string(RequestOutcome::Kind k) {
+  return kRequestKindNames.name(k);
+}
+inline std::string_view to_string(RequestOutcome::State s) {
+  return kRequestStateNames.name(s);
+}
 
 // Whether the chassis speaks the vendor's additions (0x231 light state, 0x241 remote state, 0x4A1
 // version answers).
@@ -110,7 +135,14 @@ enum class VendorFrames {
   kPresent,  // 0x231 or 0x241 received
   kAbsent,   // heard for DriverConfig::vendor_frames_wait without either
 };
-std::string_view to_string(VendorFrames v);  // "unknown", "present", "absent"
+inline constexpr auto kVendorFramesNames = text::enum_names<VendorFrames>({
+    {VendorFrames::kUnknown, "unknown"},
+    {VendorFrames::kPresent, "present"},
+    {VendorFrames::kAbsent, "absent"},
+});
+inline std::string_view to_string(VendorFrames v) {
+  return kVendorFramesNames.name(v);
+}
 
 // The remote control's switches and sticks (0x241), sticks and knob normalised to -1..1
 // (protocol::kRemoteAxisFullScale; saturated).
@@ -162,7 +194,16 @@ struct FirmwareVersion {
   State state = State::kNotAsked;
   std::string text;  // the answer's frames, in order
 };
-std::string_view to_string(FirmwareVersion::State s);  // "not_asked", "asked", ...
+inline constexpr auto kFirmwareStateNames = text::enum_names<FirmwareVersion::State>({
+    {FirmwareVersion::State::kNotAsked, "not_asked"},
+    {FirmwareVersion::State::kAsked, "asked"},
+    {FirmwareVersion::State::kAnswered, "answered"},
+    {FirmwareVersion::State::kUnanswered, "unanswered"},
+    {FirmwareVersion::State::kUnsupported, "unsupported"},
+});
+inline std::string_view to_string(FirmwareVersion::State s) {
+  return kFirmwareStateNames.name(s);
+}
 
 // A zero-speed probe at standstill (`ranger_can commission`): the wheels stand in `mode` at
 // `steering` (REP-103 rad: the front wheels' reference angle in Ackermann, the direction of travel

@@ -59,6 +59,7 @@
 
 #include "ranger_can/control/geometry.hpp"
 #include "ranger_can/result.hpp"
+#include "ranger_can/text.hpp"
 #include "ranger_can/types.hpp"
 #include "ranger_can/wire/codec.hpp"
 #include "ranger_can/wire/frame.hpp"
@@ -99,12 +100,18 @@ enum class IdentificationPhase {
   kDecided,
   kFailed,
 };
-std::string_view to_string(IdentificationPhase p);  // "listening", ..., "decided", "failed"
-inline constexpr IdentificationPhase kAllIdentificationPhases[] = {
-    IdentificationPhase::kListening, IdentificationPhase::kAwaitingControl,
-    IdentificationPhase::kSpinCheck, IdentificationPhase::kSteerProbe,
-    IdentificationPhase::kReturning, IdentificationPhase::kDecided,
-    IdentificationPhase::kFailed};
+inline constexpr auto kIdentificationPhaseNames = text::enum_names<IdentificationPhase>({
+    {IdentificationPhase::kListening, "listening"},
+    {IdentificationPhase::kAwaitingControl, "awaiting_control"},
+    {IdentificationPhase::kSpinCheck, "spin_check"},
+    {IdentificationPhase::kSteerProbe, "steer_probe"},
+    {IdentificationPhase::kReturning, "returning"},
+    {IdentificationPhase::kDecided, "decided"},
+    {IdentificationPhase::kFailed, "failed"},
+});
+inline std::string_view to_string(IdentificationPhase p) {
+  return kIdentificationPhaseNames.name(p);
+}
 
 // One decided (or kept) setting and why.
 struct IdentifiedSetting {

@@ -15,6 +15,7 @@
 
 #include "ranger_can/control/driver.hpp"
 #include "ranger_can/result.hpp"
+#include "ranger_can/text.hpp"
 
 namespace ranger {
 
@@ -24,7 +25,15 @@ enum class ParameterType {
   kNumber,   // a finite number in the range
   kSeconds,  // a duration, given in seconds
 };
-std::string_view to_string(ParameterType t);  // "bool", "int", "double", "seconds"
+inline constexpr auto kParameterTypeNames = text::enum_names<ParameterType>({
+    {ParameterType::kBool, "bool"},
+    {ParameterType::kInteger, "int"},
+    {ParameterType::kNumber, "double"},
+    {ParameterType::kSeconds, "seconds"},
+});
+inline std::string_view to_string(ParameterType t) {
+  return kParameterTypeNames.name(t);
+}
 
 struct ParameterRange {
   double lo = 0.0;
