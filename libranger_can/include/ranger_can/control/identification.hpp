@@ -194,8 +194,19 @@ class ChassisIdentifier {
     SteeringSign sign;
   };
   void start(Timestamp now);
+  // The passive evidence, frame by frame: what only agx_v2 sends and padding (every chassis
+  // frame), 0x211, 0x291, 0x361 and the rolling wheels (0x271 + 0x281).
   void observe_passive(const CanFrame& frame);
+  void observe_origin(const CanFrame& frame);
+  void observe_status(const CanFrame& frame);
+  void observe_bms(const CanFrame& frame);
+  void observe_rolling(const CanFrame& frame);
   void observe_probe(const CanFrame& frame, Timestamp now);
+  // The phases, tick by tick; why the identification timed out in the phase it is in.
+  std::string timeout_reason() const;
+  void tick_listening(Timestamp now);
+  void tick_awaiting_control(Timestamp now);
+  void tick_step(Timestamp now);
   void decide_passive(Timestamp now);
   void begin_step(IdentificationPhase phase, Timestamp now);
   bool settled(Timestamp now) const;
@@ -211,7 +222,7 @@ class ChassisIdentifier {
   void evaluate_steer(Timestamp now);
   void fail(std::string why, Timestamp now);
   void decide(Timestamp now);
-  void set(std::string_view name, std::string_view value, std::string evidence);
+  void set(ProtocolSetting setting, std::string_view value, std::string evidence);
   void note(std::string line);
   std::optional<std::array<double, 4>> wheel_angles(const CanFrame& frame, AngleUnit unit,
                                                     SteeringSign sign) const;
