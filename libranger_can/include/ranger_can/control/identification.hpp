@@ -81,11 +81,11 @@ struct IdentificationConfig {
   std::chrono::nanoseconds settle_time = std::chrono::milliseconds(300);
   // The probe's steering angle, rad (REP-103: to the left). 6 deg stays within the 40 deg
   // Ackermann range even when the chassis reads it 5.7 times larger (0.001 rad for 0.01 deg).
-  double probe_angle = 6.0 * M_PI / 180.0;
+  double probe_angle = deg_to_rad(6.0);
   bool spin_check = true;  // switch to spin mode at standstill to read the 0x271 unit and sign
   // Accepted when the best combination explains every wheel within this (rad, plus 10 % of the
   // angle) and the second best is at least `margin` times worse.
-  double angle_tolerance = 2.0 * M_PI / 180.0;
+  double angle_tolerance = deg_to_rad(2.0);
   double margin = 3.0;
 
   Status validate() const;  // durations > 0, probe angle in (1, 7] deg, tolerances > 0
