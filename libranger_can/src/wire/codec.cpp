@@ -364,9 +364,9 @@ Message decode_version(const CanFrame& f) {
   return v;
 }
 
-}  // namespace
-
-Result<Message> decode(const CanFrame& f, const ProtocolProfile& p) {
+// Whether `f` is a RANGER frame its decoder can read: not an error frame, a known ID, at least its
+// layout's length (the one length check: every decoder reads its layout's leading bytes only).
+Status check_decodable(const CanFrame& f) {
   if (f.is_error) {
     return Error{Errc::kInvalidArgument,
                  "error frame (class " + hex(f.id, 8) + ") carries no RANGER message"};
@@ -376,9 +376,15 @@ Result<Message> decode(const CanFrame& f, const ProtocolProfile& p) {
     return Error{Errc::kUnknownId, "ID " + hex(f.id) + " is not part of the RANGER protocol (DLC " +
                                        std::to_string(f.dlc) + ")"};
   }
-  // The one length check: every decoder below reads its layout's `layout` leading bytes only.
   if (f.dlc > CanFrame::kMaxDlc) return dlc_above_8(f);
   if (f.dlc < layout) return too_short(f, layout);
+  return ok_status();
+}
+
+}  // namespace
+
+Result<Message> decode(const CanFrame& f, const ProtocolProfile& p) {
+  if (Status st = check_decodable(f); !st) return st.error();
   const std::uint8_t* d = f.data.data();
   // The motors' frames: one layout each for the eight motors.
   if (f.id >= kHighSpeedFirst && f.id < kHighSpeedFirst + protocol::kMotorCount) {

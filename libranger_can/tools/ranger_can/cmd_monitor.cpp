@@ -72,6 +72,21 @@ Result<ChassisMonitor> identified_monitor(const ParsedArgs& args, const Vehicle&
   return monitor;
 }
 
+// A frame received (or the receive's error): to the monitor, or kept for the identification.
+void take(const Result<CanFrame>& frame, std::optional<ChassisMonitor>& monitor,
+          std::vector<CanFrame>& heard, Timestamp now) {
+  if (frame) {
+    if (monitor) {
+      monitor->on_frame(*frame, now);
+    } else {
+      heard.push_back(*frame);
+    }
+  } else if (frame.error().code != Errc::kTimeout) {
+    // The bus reports and recovers a lost interface itself; the view shows the state.
+    ::usleep(20000);
+  }
+}
+
 int monitor_main(const ParsedArgs& args, Io io) {
   const MonitorOptions o = options_from(args);
   const Result<Vehicle> vehicle = vehicle_from_args(args);
@@ -123,17 +138,9 @@ int monitor_main(const ParsedArgs& args, Io io) {
       next_view += period;
       if (next_view <= now) next_view = now + period;
     }
-    auto frame = (*bus)->receive(std::min<std::chrono::nanoseconds>(next_view - clock.now(), 50ms));
-    if (frame) {
-      if (monitor) {
-        monitor->on_frame(*frame, clock.now());
-      } else {
-        heard.push_back(*frame);
-      }
-    } else if (frame.error().code != Errc::kTimeout) {
-      // The bus reports and recovers a lost interface itself; the view shows the state.
-      ::usleep(20000);
-    }
+    const auto frame =
+        (*bus)->receive(std::min<std::chrono::nanoseconds>(next_view - clock.now(), 50ms));
+    take(frame, monitor, heard, clock.now());
   }
   return 0;
 }
