@@ -204,17 +204,42 @@ std::uint64_t Driver::request_firmware_version() {
 RequestOutcome Driver::wait_for(std::uint64_t id, std::chrono::nanoseconds timeout) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   const auto s = snapshots_.wait_until(
-      [id](const DriverSnapshot& snap) {
+      [&](const DriverSnapshot& snap) {
         const RequestOutcome* r = snap.request(id);
-        return r && r->settled();
+        return (r && r->settled()) || finished_;
       },
       deadline);
-  if (const RequestOutcome* r = s->request(id)) return *r;
-  RequestOutcome lost;
-  lost.id = id;
-  lost.state = RequestOutcome::State::kFailed;
-  lost.message = "unknown request";
-  return lost;
+  RequestOutcome outcome;
+  if (const RequestOutcome* r = s->request(id)) {
+    outcome = *r;
+    if (!outcome.settled() && finished_) outcome.message = "the driver stopped";
+    return outcome;
+  }
+  outcome.id = id;
+  outcome.state = RequestOutcome::State::kFailed;
+  outcome.message = "unknown request";
+  return outcome;
+}
+
+std::chrono::nanoseconds Driver::answer_budget(RequestOutcome::Kind kind) const {
+  using namespace std::chrono_literals;
+  const ControllerConfig& c = config_.controller;
+  const auto answer = config_.request_answer_timeout;
+  constexpr auto kMargin = 200ms;  // the driver's next iteration
+  switch (kind) {
+    case RequestOutcome::Kind::kResume:
+      return answer;
+    case RequestOutcome::Kind::kClearErrors:
+      return answer + kMargin;
+    case RequestOutcome::Kind::kUltrasonic:
+      return c.ultrasonic_confirm_timeout * (c.ultrasonic_max_attempts + 1);
+    case RequestOutcome::Kind::kPark:  // to rest first, then the switch with its retries
+      return c.mode_switch_timeout * (c.mode_switch_max_attempts + 1) + answer + 3s;
+    case RequestOutcome::Kind::kLights:  // the vendor frames may still be listened for
+    case RequestOutcome::Kind::kFirmwareVersion:
+      return config_.vendor_frames_wait + answer + kMargin;
+  }
+  return answer + kMargin;
 }
 
 // ---- the iteration ---------------------------------------------------------------------------
@@ -428,13 +453,15 @@ void Driver::step(Timestamp now) {
 
 void Driver::finish(Timestamp now) {
   if (controller_) controller_->shutdown(now);
+  finished_ = true;  // the publication below wakes the waiters
   const bool stop_sent = std::any_of(sent_.begin(), sent_.end(), [](const SentEvent& e) {
     return e.sent.shutdown && std::holds_alternative<MotionCommand>(e.sent.message);
   });
   if (!stop_sent) {
     tracker_.no_stop_sent(!bus_ ? "the bus " + bus_name_ + " was never opened"
-                          : source_ && source_->read_only() ? "a replayed log is read-only"
-                                                            : "the driver had nothing to stop",
+                          : source_ && source_->read_only()
+                              ? "the bus is read-only (nothing is ever sent on it)"
+                              : "the driver had nothing to stop",
                           now, step_events_);
   }
   publish(now);

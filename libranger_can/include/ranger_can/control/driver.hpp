@@ -22,6 +22,7 @@
 // its events are then as deterministic as the rest.
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <functional>
@@ -166,9 +167,15 @@ class Driver {
   // ControllerState::standstill_probe) and the probe is commanded; nullopt ends it.
   void standstill_probe(std::optional<StandstillProbe> probe);
 
-  // Blocks the calling thread until request `id` is answered or failed, or `timeout` passes
-  // (then the outcome as it stands). Only with start(); in lock-step read the snapshot instead.
+  // Blocks the calling thread until request `id` is answered or failed, `timeout` passes, or
+  // the driver stops ("the driver stopped"); then the outcome as it stands. Only with start(); in
+  // lock-step read the snapshot instead.
   RequestOutcome wait_for(std::uint64_t id, std::chrono::nanoseconds timeout);
+  // How long a request of `kind` may take to settle: the driver's own timeouts for it (the
+  // chassis's answer, the ultrasonic's attempts, a park switch's attempts after coming to rest,
+  // the wait for the vendor frames) and a margin for its next iteration. What a front end waits
+  // for at most.
+  std::chrono::nanoseconds answer_budget(RequestOutcome::Kind kind) const;
 
   // The latest snapshot (never null). Cheap: a shared pointer copy under a short lock.
   std::shared_ptr<const DriverSnapshot> snapshot() const { return snapshots_.latest(); }
@@ -230,6 +237,7 @@ class Driver {
   std::vector<DriverEvent> step_events_;    // made during this iteration, delivered after it
   std::vector<Result<CanFrame>> received_;  // this iteration's frames (capacity kept)
   bool stopped_ = false;
+  std::atomic<bool> finished_{false};  // the stop is sent: waiters stop waiting
 
   // ---- shared with the callers' threads (each locks itself) ----
   DriverMailbox mailbox_;
