@@ -44,10 +44,6 @@ const ranger::Clock& bus_clock() {
   return clock;
 }
 
-double secs(nanoseconds d) {
-  return ranger::seconds(d);
-}
-
 using ranger::text::join;
 
 // "name<separator>value, ..." of (name, value) pairs, for the log.
@@ -224,7 +220,7 @@ void RangerNode::log_protocol() const {
         "(listening first, then a few degrees of steering at zero speed; identify_timeout %.1f "
         "s); nothing is driven until then, and the plausibility monitors check them while "
         "driving",
-        secs(params_.driver.identification.timeout));
+        ranger::seconds(params_.driver.identification.timeout));
     if (!pp.model_settings.empty()) {
       ROS_INFO(
           "the %s's own readings (%s) are not assumed with protocol auto: the identification "
@@ -298,16 +294,16 @@ void RangerNode::wake_publication() {
 void RangerNode::on_sim_inject(const std_msgs::String::ConstPtr& msg) {
   if (!sim_) return;
   const std::string& line = msg->data;
-  auto action = ranger::sim::parse_chassis_command(line);
-  if (!action) {
+  const auto said = sim_->with_chassis(
+      [&](ranger::sim::VirtualChassis& c) { return ranger::sim::apply_chassis_command(line, c); });
+  if (!said) {
     ROS_WARN("sim/inject \"%s\" not applied: %s (valid commands: %s; see ranger_base/README.md)",
-             line.c_str(), action.error().message.c_str(),
+             line.c_str(), said.error().message.c_str(),
              join(ranger::sim::chassis_command_names()).c_str());
     return;
   }
-  const std::string said = sim_->with_chassis(*action);
   ROS_INFO("sim/inject \"%s\" applied to the virtual chassis%s%s", line.c_str(),
-           said.empty() ? "" : ": ", said.c_str());
+           said->empty() ? "" : ": ", said->c_str());
 }
 
 bool RangerNode::on_resume(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {

@@ -73,14 +73,23 @@ class ListeningSource : public BusSource {
   std::string iface_;
 };
 
-// The driver's events as the monitor shows them: JSON objects, or text lines with the view's
-// time ("   1.234 warn: chassis on can0 went silent ..."; the debug ones left out). On a screen
-// that is cleared for every view, the last few lines are shown under the view instead.
+// The read-only driver's iterations and its events as the monitor shows them: JSON objects, or
+// text lines with the view's time ("   1.234 warn: chassis on can0 went silent ..."; the debug
+// ones left out). On a screen that is cleared for every view, the last few lines are shown under
+// the view instead.
 class EventLines {
  public:
   EventLines(Driver& driver, Timestamp start, bool json, bool under_view)
       : driver_(driver), start_(start), json_(json), under_view_(under_view) {}
 
+  // Runs the driver at `now` (at most every 10 ms: it reads what queued meanwhile); what is new
+  // to print now.
+  std::string step(Timestamp now) {
+    if (now < next_step_) return "";
+    driver_.step(now);
+    next_step_ = now + std::chrono::milliseconds(10);
+    return take();
+  }
   // What is new since the last call: printed now (returned), or kept for the view.
   std::string take() {
     std::vector<DriverEvent> events;
@@ -102,7 +111,7 @@ class EventLines {
       recent_.pop_front();
     return "";
   }
-  // The recent lines, for the bottom of a cleared screen.
+  // The recent lines, for the bottom of a cleared screen ("" when they are printed as they come).
   std::string recent() const {
     std::string out;
     for (const std::string& lines : recent_)
@@ -116,6 +125,7 @@ class EventLines {
   Timestamp start_;
   bool json_, under_view_;
   std::uint64_t seen_ = 0;
+  Timestamp next_step_{0};
   std::deque<std::string> recent_;
 };
 
@@ -157,18 +167,13 @@ int monitor_main(const ParsedArgs& args, Io io) {
   if (!identify) monitor.emplace(seconds(o.window), vehicle->profile);
   const Timestamp start = clock.now();
   EventLines events(driver, start, o.json, clear);
-  Timestamp next_step = start;
   const auto period = seconds(1.0 / o.rate);
   Timestamp next_view = start + (o.once ? seconds(o.window) : std::max(period, seconds(0.5)));
   long views = 0;
 
   while (!StopSignals::requested()) {
     const Timestamp now = clock.now();
-    if (now >= next_step) {  // the driver at most every 10 ms (it reads what queued meanwhile)
-      driver.step(now);
-      next_step = now + std::chrono::milliseconds(10);
-      io.out << events.take();
-    }
+    io.out << events.step(now);
     if (now >= next_view && !monitor) {
       ProtocolProfile profile = identify_log(heard, vehicle->geometry).profile;
       if (Status st = apply_set_options(profile, args); !st) {
@@ -181,9 +186,9 @@ int monitor_main(const ParsedArgs& args, Io io) {
     }
     if (now >= next_view) {
       const BusStatus status = (*bus)->status();
-      std::string view = o.json ? monitor->render_json(o.iface, status, now) + "\n"
-                                : monitor->render_text(o.iface, status, now, color) +
-                                      (clear ? events.recent() : std::string());
+      std::string view = o.json
+                             ? monitor->render_json(o.iface, status, now) + "\n"
+                             : monitor->render_text(o.iface, status, now, color) + events.recent();
       if (clear) {
         view = "\x1b[H\x1b[2J" + view;
       } else if (!o.json && views > 0) {
