@@ -241,12 +241,13 @@ void DriverEventTracker::command_refused(const Error& error, std::uint64_t count
                                          std::vector<DriverEvent>& out) {
   const bool not_finite = error.code == Errc::kNotFinite;
   Timestamp& next = not_finite ? next_not_finite_ : next_refused_;
-  unreported_refusals_ += count;
+  std::uint64_t& unreported = not_finite ? unreported_not_finite_ : unreported_refused_;
+  unreported += count;
   if (now < next) return;
   next = now + (not_finite ? config_.not_finite_interval : config_.refused_interval);
   emit(out, now, EventKind::kCommandRefused, not_finite ? Severity::kError : Severity::kWarn,
-       CommandRefusedEvent{error.code, error.message, unreported_refusals_});
-  unreported_refusals_ = 0;
+       CommandRefusedEvent{error.code, error.message, unreported});
+  unreported = 0;
 }
 
 void DriverEventTracker::frame_sent(const SentFrame& sent, Timestamp now,

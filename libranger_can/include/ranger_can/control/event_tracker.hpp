@@ -95,7 +95,7 @@ class DriverEventTracker {
   std::string firmware_;
   // Spacing of repeated reports.
   Timestamp next_not_finite_{0}, next_refused_{0}, next_adjusted_{0};
-  std::uint64_t unreported_refusals_ = 0;
+  std::uint64_t unreported_not_finite_ = 0, unreported_refused_ = 0;
 };
 
 }  // namespace ranger
