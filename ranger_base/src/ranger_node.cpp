@@ -36,7 +36,6 @@
 namespace ranger_base {
 namespace {
 
-namespace protocol = ranger::protocol;
 using std::chrono::milliseconds;
 using std::chrono::nanoseconds;
 using State = ranger::RequestOutcome::State;
@@ -171,10 +170,9 @@ RangerNode::RangerNode(const ros::NodeHandle& nh, const ros::NodeHandle& private
 
   if (params_.publish_odom_tf) tf_pub_ = nh_.advertise<tf2_msgs::TFMessage>("/tf", 100);
 
-  updater_.setHardwareID(hardware_id(nh_.getNamespace(), params_.port_name));
   diagnostics_ = std::make_unique<ChassisDiagnostics>(
       updater_, [this] { return driver_->snapshot(); },
-      ProtocolContext{params_.protocol.source, params_.port_name});
+      ranger::DiagnosticContext{params_.port_name, params_.protocol.source, nh_.getNamespace()});
   // Both observers run on the driver thread: they queue, or wake the publication thread, and
   // return (publication never runs on the thread that owns the 0x111 keep-alive).
   publication_wake_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
@@ -391,12 +389,11 @@ bool RangerNode::on_clear_errors(ranger_msgs::ClearErrors::Request& req,
   }
   const auto outcome = wait_for(*posted, params_.driver.request_answer_timeout + kAnswerMargin);
   const std::string asked = "clear_errors code " + std::to_string(req.code) + " (" +
-                            protocol::error_clear_description(req.code) + ")";
+                            ranger::error_clear_description(req.code) + ")";
   if (outcome.state == State::kAnswered && outcome.error_word) {
     res.success = true;
     res.error_word = *outcome.error_word;
-    const auto names =
-        protocol::error_bit_names(res.error_word, driver_->snapshot()->profile.error_word);
+    const auto names = ranger::fault_names(res.error_word, driver_->snapshot()->profile.error_word);
     res.message = asked + ": the chassis answered with error word " +
                   ranger::text::hex(res.error_word, 8) +
                   (names.empty() ? " (no errors)" : " (" + join(names) + ")");
@@ -437,19 +434,19 @@ bool RangerNode::on_set_ultrasonic(ranger_msgs::SetUltrasonic::Request& req,
 bool RangerNode::on_set_motion_mode(ranger_msgs::SetMotionMode::Request& req,
                                     ranger_msgs::SetMotionMode::Response& res) {
   using Req = ranger_msgs::SetMotionMode::Request;
-  std::optional<protocol::MotionMode> mode;
+  std::optional<ranger::MotionMode> mode;
   switch (req.mode) {
     case Req::ACKERMANN:
-      mode = protocol::MotionMode::kAckermann;
+      mode = ranger::MotionMode::kAckermann;
       break;
     case Req::OBLIQUE:
-      mode = protocol::MotionMode::kOblique;
+      mode = ranger::MotionMode::kOblique;
       break;
     case Req::SPIN:
-      mode = protocol::MotionMode::kSpin;
+      mode = ranger::MotionMode::kSpin;
       break;
     case Req::SIDE_SLIP:
-      mode = protocol::MotionMode::kSideSlip;
+      mode = ranger::MotionMode::kSideSlip;
       break;
     case Req::AUTOMATIC:
       break;
@@ -462,18 +459,18 @@ bool RangerNode::on_set_motion_mode(ranger_msgs::SetMotionMode::Request& req,
   }
   if (mode) {
     const auto s = driver_->snapshot();
-    if (!protocol::motion_mode_to_wire(*mode, s->profile.mode_numbering)) {
+    if (!ranger::can_drive_in(*mode, s->profile)) {
       res.success = false;
-      res.message = std::string(protocol::to_string(*mode)) + ": unsupported by protocol " +
+      res.message = std::string(ranger::to_string(*mode)) + ": unsupported by protocol " +
                     s->profile.revision + " (its motion-mode numbering has no " +
-                    std::string(protocol::to_string(*mode)) + " mode; side slip is the MINI V1's)";
+                    std::string(ranger::to_string(*mode)) + " mode; side slip is the MINI V1's)";
       ROS_WARN("set_motion_mode: %s", res.message.c_str());
       return true;
     }
   }
   driver_->set_motion_mode(mode);
   res.success = true;
-  res.message = mode ? "motion mode pinned to " + std::string(protocol::to_string(*mode)) +
+  res.message = mode ? "motion mode pinned to " + std::string(ranger::to_string(*mode)) +
                            " (the switch happens at standstill)"
                      : "automatic motion-mode selection";
   ROS_INFO("set_motion_mode: %s", res.message.c_str());
@@ -780,7 +777,7 @@ void RangerNode::log_state_changes(const ranger::DriverSnapshot& s) {
     last_refusal_ = c.refusal;
   }
   if (c.error_bits != last_error_bits_) {
-    const auto names = protocol::error_bit_names(c.error_bits, s.profile.error_word);
+    const auto names = ranger::fault_names(c.error_bits, s.profile.error_word);
     if (names.empty()) {
       ROS_INFO("chassis errors cleared (error word %s)",
                ranger::text::hex(c.error_bits, 8).c_str());
@@ -796,7 +793,7 @@ void RangerNode::log_state_changes(const ranger::DriverSnapshot& s) {
     ROS_INFO("0x%03" PRIX32
              " (%s) frames arrive longer than their layout: decoded from their "
              "leading bytes, the rest ignored",
-             id.id, std::string(protocol::frame_name(id.id)).c_str());
+             id.id, std::string(ranger::frame_name(id.id)).c_str());
   }
   if (c.last_solution && c.last_solution->flags != ranger::kKinematicsExact) {
     ROS_WARN_THROTTLE(5.0, "cmd_vel adjusted to what the chassis can do: %s",
