@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Checks libranger_can's layering: each layer includes only the layers below it.
 
-    types.hpp, result.hpp, clock.hpp  <  wire/  <  transport/  <  control/  <  sim/
+    types.hpp, result.hpp, clock.hpp  <  wire/  <  transport/  <  control/  <  sim/  <  frontend/
 
 Also checks that the ROS node (ranger_base/src and ranger_base/include) holds no protocol
 knowledge: no include of anything under ranger_can/wire/, and no name from the protocol namespace
@@ -13,7 +13,7 @@ import pathlib
 import re
 import sys
 
-ORDER = {"": 0, "wire": 1, "transport": 2, "control": 3, "sim": 4}
+ORDER = {"": 0, "wire": 1, "transport": 2, "control": 3, "sim": 4, "frontend": 5}
 INCLUDE = re.compile(r'#include\s+[<"]ranger_can/(?:([a-z]+)/)?[a-z_]+\.hpp[>"]')
 PROTOCOL_NAME = re.compile(r"\bprotocol::|\branger::protocol\b")
 

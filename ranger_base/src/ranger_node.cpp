@@ -127,7 +127,7 @@ ranger::Result<std::unique_ptr<RangerNode>> RangerNode::create(const ros::NodeHa
 ranger::Result<std::unique_ptr<RangerNode>> RangerNode::from_parameters(
     const ros::NodeHandle& nh, const ros::NodeHandle& private_nh) {
   const NodeHandleParameterSource source(private_nh);
-  for (const auto& name : unknown_parameter_names(source)) {
+  for (const auto& name : ranger::unknown_parameter_names(source, kAlsoRead)) {
     ROS_WARN("unknown parameter %s ignored (see ranger_base/README.md for the names)",
              source.display_name(name).c_str());
   }
