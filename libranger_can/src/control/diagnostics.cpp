@@ -3,6 +3,7 @@
 #include <cmath>
 #include <optional>
 
+#include "ranger_can/control/driver_events.hpp"
 #include "ranger_can/control/vocabulary.hpp"
 #include "ranger_can/text.hpp"
 
@@ -140,95 +141,6 @@ std::string add_identification(const IdentificationStatus& id, const DriverSnaps
   }
   return "identifying the chassis (" + std::string(to_string(id.phase)) +
          "): nothing is driven until it is decided";
-}
-
-// The words of the refusals that follow a stop the commander did not ask for; "" for the others.
-std::string stop_words(const ControllerState& c) {
-  using R = MotionRefusal;
-  switch (c.refusal) {
-    case R::kLinkLost:
-      return c.link == LinkState::kNeverConnected
-                 ? "no chassis heard yet (waiting for its system status)"
-                 : "chassis silent (link lost): motion stopped";
-    case R::kRemote:
-      return "remote control has the chassis: cmd_vel not applied";
-    case R::kEstop:
-      return "emergency stop pressed: release it, then call resume";
-    case R::kCriticalError:
-      return "critical chassis error (" + text::join(c.faults) +
-             "): clear it (clear_errors), then call resume";
-    case R::kLowBattery:
-      return "battery below low_battery_soc: the chassis cuts the drives";
-    case R::kModeSwitchFailed:
-      return "motion-mode switch not confirmed by the chassis: send a zero cmd_vel or call resume";
-    case R::kImplausible:
-      return "the chassis's feedback contradicts the protocol settings: " +
-             (c.implausible_reason.empty() ? std::string("(no reason given)")
-                                           : c.implausible_reason) +
-             ". Set that parameter (or load a commissioning file), or call resume to try again";
-    case R::kRearmRequired:
-      return "rearm_required after " + text::join(cause_names(c.latched_causes)) +
-             ": call resume (or send a zero cmd_vel) to drive again";
-    default:
-      return "";
-  }
-}
-
-std::string identifying_words(const DriverSnapshot& snapshot) {
-  const ControllerState& c = snapshot.controller;
-  if (c.standstill_probe && !c.identifying) return "standstill probe (ranger_can commission)";
-  // The identification's own words: its phase, or (failed) what to set.
-  const auto& id = snapshot.identification;
-  std::string words = id && !id->message.empty()
-                          ? id->message
-                          : std::string("identifying the chassis's protocol settings");
-  if (listening(c)) {
-    words +=
-        " (nothing is sent until the chassis has been heard; motion waits for the "
-        "identification)";
-  }
-  return words;
-}
-
-// The words of the refusals that hold motion for a reason of the commander's or the driver's.
-std::string hold_words(const DriverSnapshot& snapshot) {
-  const ControllerState& c = snapshot.controller;
-  using R = MotionRefusal;
-  switch (c.refusal) {
-    case R::kNone:
-      if (c.steer_first_factor < 1.0) {
-        return "steering first: speed held at " +
-               std::to_string(static_cast<int>(std::lround(c.steer_first_factor * 100.0))) +
-               " % until the wheels reach the commanded angle";
-      }
-      return "";
-    case R::kStandby:
-      if (c.reclaim_blocked)
-        return "remote control had the chassis: call resume to take CAN control";
-      return c.awaiting_command_mode ? "standby: requesting CAN command mode"
-                                     : "standby (auto_command_mode is off)";
-    case R::kModeUnknown:
-      if (c.chassis_mode == MotionMode::kPark) {
-        return "the chassis is in park mode (parked before this driver ran): call park with "
-               "data = false to leave it";
-      }
-      return "motion mode unknown (no motion-mode feedback yet)";
-    case R::kSwitching:
-      return "motion-mode switch in progress";
-    case R::kCmdTimeout:
-      return "no recent cmd_vel (cmd_vel_timeout): chassis commanded to stop";
-    case R::kBelowMinimum:
-      return "below_minimum: cmd_vel is below what the chassis can express (mode_selection/"
-             "min_linear_speed, min_yaw_rate): not driven";
-    case R::kIdentifying:
-      return identifying_words(snapshot);
-    case R::kParked:
-      return c.parked() ? "parked: call park with data = false to drive again"
-                        : "parking (bringing the chassis to rest, then to park mode): call park "
-                          "with data = false to drive again";
-    default:
-      return std::string(to_string(c.refusal));
-  }
 }
 
 }  // namespace
@@ -497,8 +409,7 @@ std::string refusal_name(const ControllerState& c) {
 }
 
 std::string describe_refusal(const DriverSnapshot& snapshot) {
-  std::string words = stop_words(snapshot.controller);
-  return words.empty() ? hold_words(snapshot) : words;
+  return describe_refusal(snapshot.controller, snapshot.identification.get());
 }
 
 std::vector<std::string> cause_names(StopCauses causes) {

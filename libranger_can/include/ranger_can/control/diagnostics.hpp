@@ -118,8 +118,8 @@ bool listening(const ControllerState& state);
 // Why motion is refused, by stable name ("estop", "identifying", ...; "" while driven).
 std::string refusal_name(const ControllerState& state);
 // Why motion is refused, and what to do about it, in words (ranger_msgs' motion_inhibited_detail,
-// diagnostics, the log); "" while the chassis is driven as asked. The identification's words come
-// from snapshot.identification.
+// diagnostics; the driver's refusal events carry the same): driver_events.hpp's describe_refusal
+// of the snapshot's controller state and identification.
 std::string describe_refusal(const DriverSnapshot& snapshot);
 // The stop causes of a set by name ("emergency_stop", "remote", ...), in the library's order.
 std::vector<std::string> cause_names(StopCauses causes);
