@@ -666,6 +666,14 @@ PYBIND11_MODULE(_ranger_can, m) {
         [] { return std::vector<std::string>(kWheelJointNames.begin(), kWheelJointNames.end()); });
   m.def("error_clear_description", &protocol::error_clear_description);
   m.def(
+      "error_names",
+      [](std::uint32_t word, const std::string& layout) {
+        ProtocolProfile p;
+        check(set_setting(p, "error_word", layout));
+        return protocol::error_bit_names(word, p.error_word);
+      },
+      py::arg("error_word"), py::arg("layout"));
+  m.def(
       "_cli",
       [](const std::vector<std::string>& args, const std::string& input) {
         py::gil_scoped_release release;
