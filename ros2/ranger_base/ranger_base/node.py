@@ -71,7 +71,10 @@ class RangerNode(Node):
         except RangerError as e:
             errors.append(str(e))
         if errors:
-            raise ParameterError("\n".join(errors))
+            text = "\n".join(errors)
+            for name in parameters.declared_names():  # ROS 2 spells nesting with '.'
+                text = text.replace(f"{display}{name} ", f"{display}{parameters.ros2_name(name)} ")
+            raise ParameterError(text)
         self.add_on_set_parameters_callback(self._on_set_parameters)
 
         ns = self.get_namespace()
@@ -331,7 +334,7 @@ class RangerNode(Node):
                                      now - 1.0)
                 if now >= next_diag:
                     self._publish_diagnostics(s)
-                    next_diag = max(next_diag + 1.0, now - 1.0)
+                    next_diag = max(next_diag + self.params["diagnostic_period"], now - 1.0)
                 wait = min(next_state, next_diag, max(next_motion, now)) - time.monotonic()
                 self.driver.wait_snapshot(seq, max(0.0, min(wait, 0.1)) if wait > 0 else 0.02)
             except Exception as e:  # noqa: BLE001 (nothing may end the publication thread)

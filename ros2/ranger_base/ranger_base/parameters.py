@@ -56,6 +56,8 @@ NODE_ROWS = [
             "x, y, z, roll, pitch, yaw: the floor of the pose covariance"),
     NodeRow("twist_covariance_diagonal", "double_list", DEFAULT_TWIST_COVARIANCE,
             "published as the twist covariance"),
+    NodeRow("diagnostic_period", "double", 1.0, "/diagnostics every this many seconds", 0.0,
+            60.0, True, False, True, "s"),
     NodeRow("ultrasonic/field_of_view", "double", 0.52, "sensor_msgs/Range field_of_view",
             0.0, math.pi, True, False, True, "rad"),
     NodeRow("ultrasonic/min_range", "double", 0.05, "sensor_msgs/Range min_range", 0.0, 10.0,
@@ -217,7 +219,7 @@ def declare_all(node, display: str) -> Declared:
     _check_frames(out.node, display, out.errors)
     umin, umax = out.node["ultrasonic/min_range"], out.node["ultrasonic/max_range"]
     if not umax > umin:
-        out.errors.append(f"parameter {display}ultrasonic.max_range = {_number_text(umax)} is out "
+        out.errors.append(f"parameter {display}ultrasonic/max_range = {_number_text(umax)} is out "
                           f"of range: valid ({_number_text(umin)}, 32.767] m")
     for row in ranger_can.parameters():
         name = ros2_name(row.name)
