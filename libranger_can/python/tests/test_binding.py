@@ -318,3 +318,24 @@ def test_parameters_table_names_every_row_with_its_range():
     assert rows["sim/errors"].type == "string_list"
     assert set(ranger_can.motion_modes()) >= {"ackermann", "oblique", "spin", "side_slip", "park"}
     assert "estop" in ranger_can.chassis_command_names()
+
+
+def test_type_stubs_name_everything_the_module_offers():
+    import ranger_can._ranger_can as ext
+    package = os.path.dirname(ranger_can.__file__)
+    with open(os.path.join(package, "_ranger_can.pyi"), encoding="utf-8") as f:
+        stub = f.read()
+    with open(os.path.join(package, "__init__.pyi"), encoding="utf-8") as f:
+        init_stub = f.read()
+    for name, value in vars(ext).items():
+        if name.startswith("__") or name == "_Session":
+            continue
+        assert re.search(rf"\b(class|def) {name}\b", stub), f"{name} not in _ranger_can.pyi"
+        if isinstance(value, type):
+            body = stub.split(f"class {name}")[1].split("\nclass ")[0]
+            for attr in dir(value):
+                if not attr.startswith("_"):
+                    assert re.search(rf"\b{attr}\b", body), f"{name}.{attr} not in the stub"
+    for attr in dir(ranger_can.Driver):
+        if not attr.startswith("_"):
+            assert re.search(rf"\b{attr}\b", init_stub), f"Driver.{attr} not in __init__.pyi"
