@@ -45,7 +45,8 @@ class NodeProcess:
                                      stderr=subprocess.STDOUT, start_new_session=True)
 
     def output(self):
-        self.log.flush()
+        if not self.log.closed:
+            self.log.flush()
         with open(self.log_path, encoding="utf-8", errors="replace") as f:
             return f.read()
 

@@ -221,6 +221,8 @@ def test_shutdown_stops_the_chassis(robots, sig):
     assert r.stop(sig) == 0
     log = r.process.output()
     assert "stop sent to the chassis" in log
-    time.sleep(0.5)  # the last cmd_vel_out on its way to the client (pacing, not an assertion)
-    last = r.client.history[f"{r.ns}/cmd_vel_out"][-1]
-    assert last.twist.linear.x == 0.0 and last.twist.angular.z == 0.0
+    # The shutdown's stop is the last cmd_vel_out the node published.
+    def last_is_zero():
+        last = r.client.history[f"{r.ns}/cmd_vel_out"][-1]
+        return last.twist.linear.x == 0.0 and last.twist.angular.z == 0.0
+    r.client.wait_for(last_is_zero, 10, "the stop on cmd_vel_out")
