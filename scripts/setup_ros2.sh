@@ -43,6 +43,8 @@ fi
 
 echo "setup_ros2: making the ROS 2 venv in $venv"
 [ -x "$venv/bin/python" ] || "$python" -m venv "$venv"
+# The wheels install ROS 2 package manifests (share/*/package.xml): no ROS 1 tool may find them.
+touch "$venv/COLCON_IGNORE" "$venv/CATKIN_IGNORE" "$venv/AMENT_IGNORE"
 "$venv/bin/python" -m pip install -q --disable-pip-version-check "${packages[@]}"
 
 # ---- the wheels' CMake exports: the builder's include paths -> this machine's ----------------

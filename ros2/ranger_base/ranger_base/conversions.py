@@ -32,17 +32,22 @@ def _diagonal(values):
     return out
 
 
-def to_odometry(o, params) -> Odometry:
+def _odometry(stamp_ns, params, pose, twist) -> Odometry:
     msg = Odometry()
-    msg.header.stamp = to_time(o.stamp_ns)
+    msg.header.stamp = to_time(stamp_ns)
     msg.header.frame_id = params["odom_frame"]
     msg.child_frame_id = params["base_frame"]
-    msg.pose.pose.position.x = o.x
-    msg.pose.pose.position.y = o.y
-    msg.pose.pose.orientation = yaw_quaternion(o.yaw)
-    msg.twist.twist.linear.x = o.vx
-    msg.twist.twist.linear.y = o.vy
-    msg.twist.twist.angular.z = o.wz
+    msg.pose.pose.position.x, msg.pose.pose.position.y = pose[0], pose[1]
+    msg.pose.pose.orientation = yaw_quaternion(pose[2])
+    msg.twist.twist.linear.x, msg.twist.twist.linear.y = twist[0], twist[1]
+    msg.twist.twist.angular.z = twist[2]
+    return msg
+
+
+def to_odometry(o, params) -> Odometry:
+    """Pose covariance = diag(pose_covariance_diagonal) + the odometry's x/y/yaw variance;
+    twist covariance = diag(twist_covariance_diagonal)."""
+    msg = _odometry(o.stamp_ns, params, (o.x, o.y, o.yaw), (o.vx, o.vy, o.wz))
     pose = _diagonal(params["pose_covariance_diagonal"])
     pose[0] += o.pose_variance[0]
     pose[7] += o.pose_variance[1]
@@ -72,17 +77,8 @@ def to_joint_state(j) -> JointState:
 
 
 def to_ground_truth(g, params) -> Odometry:
-    msg = Odometry()
-    msg.header.stamp = to_time(g.stamp_ns)
-    msg.header.frame_id = params["odom_frame"]
-    msg.child_frame_id = params["base_frame"]
-    msg.pose.pose.position.x = g.x
-    msg.pose.pose.position.y = g.y
-    msg.pose.pose.orientation = yaw_quaternion(g.yaw)
-    msg.twist.twist.linear.x = g.vx
-    msg.twist.twist.linear.y = g.vy
-    msg.twist.twist.angular.z = g.wz
-    return msg
+    """The virtual chassis's true pose and twist (zero covariance: exact)."""
+    return _odometry(g.stamp_ns, params, (g.x, g.y, g.yaw), (g.vx, g.vy, g.wz))
 
 
 def to_twist_stamped(sent, frame_id) -> TwistStamped:
