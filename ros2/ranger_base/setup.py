@@ -17,5 +17,7 @@ setup(
     description="ranger_base_node for ROS 2 (rclpy over the ranger_can binding)",
     license="BSD-3-Clause",
     tests_require=["pytest"],
-    entry_points={"console_scripts": ["ranger_base_node = ranger_base.node:main"]},
+    entry_points={"console_scripts": [
+        "ranger_base_node = ranger_base.node:main",
+        "measure_performance = ranger_base.measure_performance:main"]},
 )

@@ -26,6 +26,7 @@ from geometry_msgs.msg import Twist, TwistStamped
 from nav_msgs.msg import Odometry
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.callback_groups import MutuallyExclusiveCallbackGroup
+from rclpy.event_handler import PublisherEventCallbacks, SubscriptionEventCallbacks
 from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
@@ -49,6 +50,12 @@ MOTION_MODES = {SetMotionMode.Request.ACKERMANN: "ackermann",
 LIGHT_MODES = {SetLights.Request.OFF: "off", SetLights.Request.ON: "on",
                SetLights.Request.BREATHING: "breathing", SetLights.Request.CUSTOM: "custom"}
 LIGHT_CODES = {v: k for k, v in LIGHT_MODES.items()}
+
+
+def _advance(due, period, now):
+    """A fixed-rate schedule: one period after the last due time; after a stall, from now."""
+    due += period
+    return due if due >= now else now + period
 
 
 class ParameterError(Exception):
@@ -86,29 +93,30 @@ class RangerNode(Node):
         self._last_ultrasonic = {}
 
         q = 10
-        self.odom_pub = self.create_publisher(Odometry, "odom", q)
-        self.joint_pub = self.create_publisher(JointState, "joint_states", q)
-        self.system_pub = self.create_publisher(SystemState, "system_state", q)
-        self.actuator_pub = self.create_publisher(ActuatorStateArray, "actuator_state", q)
-        self.bms_pub = self.create_publisher(BmsStateArray, "bms_state", q)
-        self.battery_pub = self.create_publisher(BatteryState, "battery_state", q)
-        self.ultrasonic_pub = self.create_publisher(UltrasonicState, "ultrasonic_state", q)
-        self.remote_pub = self.create_publisher(RemoteState, "remote_state", q)
-        self.range_pubs = [self.create_publisher(Range, f"ultrasonic/range_{i}", q)
+        self.odom_pub = self._publisher(Odometry, "odom", q)
+        self.joint_pub = self._publisher(JointState, "joint_states", q)
+        self.system_pub = self._publisher(SystemState, "system_state", q)
+        self.actuator_pub = self._publisher(ActuatorStateArray, "actuator_state", q)
+        self.bms_pub = self._publisher(BmsStateArray, "bms_state", q)
+        self.battery_pub = self._publisher(BatteryState, "battery_state", q)
+        self.ultrasonic_pub = self._publisher(UltrasonicState, "ultrasonic_state", q)
+        self.remote_pub = self._publisher(RemoteState, "remote_state", q)
+        self.range_pubs = [self._publisher(Range, f"ultrasonic/range_{i}", q)
                            for i in range(1, 9)]
-        self.cmd_out_pub = (self.create_publisher(TwistStamped, "cmd_vel_out", 100)
+        self.cmd_out_pub = (self._publisher(TwistStamped, "cmd_vel_out", 100)
                             if self.params["publish_cmd"] else None)
-        self.truth_pub = (self.create_publisher(Odometry, "sim/ground_truth", q)
+        self.truth_pub = (self._publisher(Odometry, "sim/ground_truth", q)
                           if self.driver.is_sim else None)
-        self.tf_pub = (self.create_publisher(TFMessage, "/tf", 100)
+        self.tf_pub = (self._publisher(TFMessage, "/tf", 100)
                        if self.params["publish_odom_tf"] else None)
-        self.diag_pub = self.create_publisher(DiagnosticArray, "/diagnostics", q)
+        self.diag_pub = self._publisher(DiagnosticArray, "/diagnostics", q)
 
         # cmd_vel on a group of its own: never queued behind a service waiting for the chassis.
         self._cmd_group = MutuallyExclusiveCallbackGroup()
         self._service_group = MutuallyExclusiveCallbackGroup()
-        self.cmd_sub = self.create_subscription(Twist, "cmd_vel", self._on_cmd_vel, 1,
-                                                callback_group=self._cmd_group)
+        self.cmd_sub = self.create_subscription(
+            Twist, "cmd_vel", self._on_cmd_vel, 1, callback_group=self._cmd_group,
+            event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False))
         self.inject_sub = (self.create_subscription(String, "sim/inject", self._on_inject, 10,
                                                     callback_group=self._service_group)
                            if self.driver.is_sim else None)
@@ -126,6 +134,12 @@ class RangerNode(Node):
         ]
         self._thread = threading.Thread(target=self._publication_loop, name="ranger_publish",
                                         daemon=True)
+
+    def _publisher(self, msg_type, topic, depth):
+        # No QoS event handlers: each one is Python work in every executor wake-up.
+        return self.create_publisher(
+            msg_type, topic, depth,
+            event_callbacks=PublisherEventCallbacks(use_default_callbacks=False))
 
     # ---- life cycle ----
     def start(self):
@@ -318,34 +332,46 @@ class RangerNode(Node):
         return pub is not None and pub.get_subscription_count() > 0
 
     def _publication_loop(self):
+        """Wakes when a publication is due (or, with cmd_vel_out, when a frame was sent), not at
+        every driver iteration: motion waits for the driver's next snapshot only when it is due
+        and the latest one had no new estimate."""
         next_motion = next_state = next_diag = time.monotonic()
-        seq = 0
+        waiting = False  # motion is due, the latest snapshot had nothing new
+        sent = []
         while not self._stop.is_set():
             try:
-                self._publish_sent()
+                self._publish_sent(sent)
                 now = time.monotonic()
                 s = self.driver.snapshot()
-                seq = s.sequence
-                if now >= next_motion and self._publish_motion(s):
-                    next_motion = max(next_motion + 1.0 / self.params["publish_rate"], now - 1.0)
+                if now >= next_motion:
+                    waiting = not self._publish_motion(s)
+                    if not waiting:
+                        next_motion = _advance(next_motion, 1.0 / self.params["publish_rate"], now)
                 if now >= next_state:
                     self._publish_states(s)
-                    next_state = max(next_state + 1.0 / self.params["state_publish_rate"],
-                                     now - 1.0)
+                    next_state = _advance(next_state, 1.0 / self.params["state_publish_rate"], now)
                 if now >= next_diag:
                     self._publish_diagnostics(s)
-                    next_diag = max(next_diag + self.params["diagnostic_period"], now - 1.0)
-                wait = min(next_state, next_diag, max(next_motion, now)) - time.monotonic()
-                self.driver.wait_snapshot(seq, max(0.0, min(wait, 0.1)) if wait > 0 else 0.02)
+                    next_diag = _advance(next_diag, self.params["diagnostic_period"], now)
+                due = min(next_state, next_diag) if waiting else min(next_motion, next_state,
+                                                                       next_diag)
+                wait = max(0.0, min(due - time.monotonic(), 1.0))
+                if waiting:
+                    self.driver.wait_snapshot(s.sequence, min(wait, 0.05))
+                    sent = self.driver.sent() if self.cmd_out_pub else []
+                elif self.cmd_out_pub is not None:
+                    sent = self.driver.wait_sent(wait)
+                else:
+                    self._stop.wait(wait)
             except Exception as e:  # noqa: BLE001 (nothing may end the publication thread)
                 self.get_logger().error(f"publishing failed: {e}", throttle_duration_sec=5.0)
-                time.sleep(0.05)
-        self._publish_sent()  # the shutdown's stop
+                sent = []
+                self._stop.wait(0.05)
+        # What was taken but not published yet, and the shutdown's stop.
+        self._publish_sent(sent + (self.driver.sent() if self.cmd_out_pub else []))
 
-    def _publish_sent(self):
-        if self.cmd_out_pub is None:
-            return
-        for m in self.driver.sent():
+    def _publish_sent(self, sent):
+        for m in sent:
             self.cmd_out_pub.publish(conversions.to_twist_stamped(m, self.params["base_frame"]))
 
     def _publish_motion(self, s) -> bool:
