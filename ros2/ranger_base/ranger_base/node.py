@@ -448,14 +448,20 @@ def main(args=None):
         rclpy.try_shutdown()
         return 2
     requested = threading.Event()
+    # A signal wakes the executor at once (a guard condition), so it need not poll for it.
+    wake = node.create_guard_condition(lambda: None)
+
+    def on_signal(*_):
+        requested.set()
+        wake.trigger()
     for sig in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(sig, lambda *_: requested.set())
+        signal.signal(sig, on_signal)
     executor = MultiThreadedExecutor(num_threads=3)
     executor.add_node(node)
     node.start()
     try:
         while not requested.is_set() and rclpy.ok():
-            executor.spin_once(timeout_sec=0.1)
+            executor.spin_once(timeout_sec=1.0)
     except ExternalShutdownException:
         pass
     finally:
