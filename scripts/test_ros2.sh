@@ -39,17 +39,7 @@ failed=0
 
 (
   # shellcheck disable=SC1091
-  source "$venv/bin/activate"
-  set +u
-  # shellcheck disable=SC1091
-  source "$ws/install/setup.bash"
-  set -u
-  tf2=$venv/tf2_msgs_prefix  # generated for the tests only (no wheel exists)
-  export PYTHONPATH=$tf2/lib/python3.11/site-packages:${PYTHONPATH:-}
-  export LD_LIBRARY_PATH=$tf2/lib:${LD_LIBRARY_PATH:-}
-  export AMENT_PREFIX_PATH=$tf2:${AMENT_PREFIX_PATH:-}
-  export ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST ROS_DOMAIN_ID=${RANGER_ROS2_DOMAIN_ID:-87}
-  export ROS_LOG_DIR=$root/build/ros2_log
+  RANGER_ROS2_VENV=$venv source scripts/ros2_env.sh "${RANGER_ROS2_DOMAIN_ID:-87}"
   rc=0
   python -m pytest -p no:cacheprovider -q libranger_can/python/tests \
     --junitxml="$results/ros2_binding.xml" || rc=1
