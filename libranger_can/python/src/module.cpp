@@ -39,19 +39,32 @@ struct LibraryError {
 
 std::string_view code_name(Errc c) {
   switch (c) {
-    case Errc::kUnknownId: return "unknown_id";
-    case Errc::kBadDlc: return "bad_dlc";
-    case Errc::kOutOfRange: return "out_of_range";
-    case Errc::kNotFinite: return "not_finite";
-    case Errc::kInvalidArgument: return "invalid_argument";
-    case Errc::kParseError: return "parse_error";
-    case Errc::kIoError: return "io_error";
-    case Errc::kNoSuchInterface: return "no_such_interface";
-    case Errc::kNotCanInterface: return "not_can_interface";
-    case Errc::kInterfaceDown: return "interface_down";
-    case Errc::kWouldBlock: return "would_block";
-    case Errc::kTimeout: return "timeout";
-    case Errc::kPermissionDenied: return "permission_denied";
+    case Errc::kUnknownId:
+      return "unknown_id";
+    case Errc::kBadDlc:
+      return "bad_dlc";
+    case Errc::kOutOfRange:
+      return "out_of_range";
+    case Errc::kNotFinite:
+      return "not_finite";
+    case Errc::kInvalidArgument:
+      return "invalid_argument";
+    case Errc::kParseError:
+      return "parse_error";
+    case Errc::kIoError:
+      return "io_error";
+    case Errc::kNoSuchInterface:
+      return "no_such_interface";
+    case Errc::kNotCanInterface:
+      return "not_can_interface";
+    case Errc::kInterfaceDown:
+      return "interface_down";
+    case Errc::kWouldBlock:
+      return "would_block";
+    case Errc::kTimeout:
+      return "timeout";
+    case Errc::kPermissionDenied:
+      return "permission_denied";
   }
   return "error";
 }
@@ -425,8 +438,9 @@ PYBIND11_MODULE(_ranger_can, m) {
                              [](const S& s) { return s.c().steer_first_factor; })
       .def_property_readonly("faults", [](const S& s) { return s.c().faults; })
       .def_property_readonly("error_word", [](const S& s) { return s.c().error_bits; })
-      .def_property_readonly("error_layout",
-                             [](const S& s) { return std::string(to_string(s.s().profile.error_word)); })
+      .def_property_readonly(
+          "error_layout",
+          [](const S& s) { return std::string(to_string(s.s().profile.error_word)); })
       .def_property_readonly("error_names",
                              [](const S& s) {
                                return protocol::error_bit_names(s.c().error_bits,
@@ -514,7 +528,8 @@ PYBIND11_MODULE(_ranger_can, m) {
            py::arg("port"), py::arg("params"), py::arg("record_sent") = false,
            py::arg("display_prefix") = "")
       .def("start", [](PySession& p) { p.s().start(); })
-      .def("stop", [](PySession& p) { p.s().stop(); }, py::call_guard<py::gil_scoped_release>())
+      .def(
+          "stop", [](PySession& p) { p.s().stop(); }, py::call_guard<py::gil_scoped_release>())
       .def_property_readonly("started", [](PySession& p) { return p.s().started(); })
       .def_property_readonly("stopped", [](PySession& p) { return p.s().stopped(); })
       .def_property_readonly("stop_sent", [](PySession& p) { return p.s().stop_sent(); })
@@ -531,10 +546,9 @@ PYBIND11_MODULE(_ranger_can, m) {
                                const auto& g = p.setup().driver.controller.geometry;
                                return py::make_tuple(g.wheelbase, g.track, g.wheel_radius);
                              })
-      .def_property_readonly("max_linear_speed",
-                             [](const PySession& p) {
-                               return p.setup().driver.controller.limits.max_linear_speed;
-                             })
+      .def_property_readonly(
+          "max_linear_speed",
+          [](const PySession& p) { return p.setup().driver.controller.limits.max_linear_speed; })
       .def("budget", &PySession::budget, py::arg("kind"))
       .def("snapshot", [](PySession& p) { return Snapshot(p.s().snapshot()); })
       .def(
@@ -574,11 +588,12 @@ PYBIND11_MODULE(_ranger_can, m) {
           py::arg("mode"))
       .def("clear_errors",
            [](PySession& p, int code) {
-             if (code < 0 || code > 255) invalid("clear_errors: code " + std::to_string(code) +
-                                                 " outside 0..255");
+             if (code < 0 || code > 255)
+               invalid("clear_errors: code " + std::to_string(code) + " outside 0..255");
              return value_or_throw(p.s().driver().clear_errors(static_cast<std::uint8_t>(code)));
            })
-      .def("set_ultrasonic", [](PySession& p, bool on) { return p.s().driver().set_ultrasonic(on); })
+      .def("set_ultrasonic",
+           [](PySession& p, bool on) { return p.s().driver().set_ultrasonic(on); })
       .def("resume", [](PySession& p) { return p.s().driver().resume(); })
       .def(
           "set_lights",
@@ -609,9 +624,7 @@ PYBIND11_MODULE(_ranger_can, m) {
           },
           py::arg("id"), py::arg("timeout"))
       .def("inject",
-           [](PySession& p, const std::string& line) {
-             return value_or_throw(p.s().inject(line));
-           })
+           [](PySession& p, const std::string& line) { return value_or_throw(p.s().inject(line)); })
       .def("ground_truth",
            [](PySession& p) -> std::optional<GroundTruthView> {
              if (!p.s().sim()) return std::nullopt;
@@ -660,8 +673,9 @@ PYBIND11_MODULE(_ranger_can, m) {
     return out;
   });
   m.def("chassis_command_names", &sim::chassis_command_names);
-  m.def("steering_joint_names",
-        [] { return std::vector<std::string>(kSteeringJointNames.begin(), kSteeringJointNames.end()); });
+  m.def("steering_joint_names", [] {
+    return std::vector<std::string>(kSteeringJointNames.begin(), kSteeringJointNames.end());
+  });
   m.def("wheel_joint_names",
         [] { return std::vector<std::string>(kWheelJointNames.begin(), kWheelJointNames.end()); });
   m.def("error_clear_description", &protocol::error_clear_description);

@@ -144,8 +144,7 @@ class Reader {
       }
       case ParameterType::kNumber:
       case ParameterType::kSeconds:
-        row.set(config,
-                number(name, now, r.lo, r.hi, r.lo_open, r.hi_open, std::string(row.unit)));
+        row.set(config, number(name, now, r.lo, r.hi, r.lo_open, r.hi_open, std::string(row.unit)));
         break;
     }
   }
@@ -218,8 +217,8 @@ SpeedLimits read_axis(Reader& r, const std::string& axis, const std::string& uni
   SpeedLimits l;
   const std::string vel = unit + "/s", acc = unit + "/s^2";
   l.has_velocity_limits = r.flag(axis + "/has_velocity_limits", l.has_velocity_limits);
-  l.max_velocity = r.number(axis + "/max_velocity", l.max_velocity, 0.0, kMaxAxisVelocity, false,
-                            false, vel);
+  l.max_velocity =
+      r.number(axis + "/max_velocity", l.max_velocity, 0.0, kMaxAxisVelocity, false, false, vel);
   l.min_velocity = r.number(axis + "/min_velocity", -l.max_velocity, -kMaxAxisVelocity,
                             l.max_velocity, false, false, vel);
   l.has_acceleration_limits = r.flag(axis + "/has_acceleration_limits", l.has_acceleration_limits);
@@ -233,9 +232,8 @@ SpeedLimits read_axis(Reader& r, const std::string& axis, const std::string& uni
 void read_sim(Reader& r, const std::string& port, sim::SimSourceOptions& sim) {
   auto& s = sim.chassis;
   s.initial_soc = r.number("sim/initial_soc", s.initial_soc, 0.0, 100.0, false, false, "%");
-  s.mode_switch_duration = from_seconds(r.number("sim/mode_switch_duration",
-                                                 seconds(s.mode_switch_duration), 0.0, 10.0,
-                                                 false, false, "s"));
+  s.mode_switch_duration = from_seconds(r.number(
+      "sim/mode_switch_duration", seconds(s.mode_switch_duration), 0.0, 10.0, false, false, "s"));
   s.boot_in_remote_mode = r.flag("sim/boot_in_remote_mode", s.boot_in_remote_mode);
   s.version = r.text("sim/firmware_version", s.version);
   const double metres =
@@ -261,8 +259,7 @@ void read_protocol(Reader& r, const ModelPreset& model, Setup& setup) {
   for (const auto& n : protocol_revision_names())
     choices.push_back(n);
   setup.protocol = r.text("protocol", setup.protocol);
-  const bool known =
-      std::find(choices.begin(), choices.end(), setup.protocol) != choices.end();
+  const bool known = std::find(choices.begin(), choices.end(), setup.protocol) != choices.end();
   if (!known) {
     r.fail("protocol", "= \"" + setup.protocol + "\": expected one of " + join(choices) +
                            " (auto: identified from the chassis before anything moves)");
@@ -411,8 +408,8 @@ std::vector<ParameterRow> make_rows() {
     const std::string axis = a.axis, vel = std::string(a.unit) + "/s",
                       acc = std::string(a.unit) + "/s^2";
     rows.push_back(text_row(axis + "/has_velocity_limits", "bool", "false", {}, "", "limits"));
-    rows.push_back(number_row(axis + "/max_velocity", vel, 0.0, kMaxAxisVelocity, false, false,
-                              "0", "", "limits"));
+    rows.push_back(number_row(axis + "/max_velocity", vel, 0.0, kMaxAxisVelocity, false, false, "0",
+                              "", "limits"));
     rows.push_back(number_row(axis + "/min_velocity", vel, -kMaxAxisVelocity, kMaxAxisVelocity,
                               false, false, "-max_velocity", "", "limits"));
     rows.push_back(text_row(axis + "/has_acceleration_limits", "bool", "false", {}, "", "limits"));

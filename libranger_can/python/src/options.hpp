@@ -25,12 +25,12 @@ using Value = std::variant<bool, std::int64_t, double, std::string, std::vector<
 // One row: what a front end declares (ROS 2 descriptors) and documents.
 struct ParameterRow {
   std::string name;
-  std::string type;     // "bool", "int", "double", "string", "string_list"
-  std::string unit;     // "s", "m/s", "" ...
+  std::string type;  // "bool", "int", "double", "string", "string_list"
+  std::string unit;  // "s", "m/s", "" ...
   double lo = 0.0, hi = 0.0;
   bool lo_open = false, hi_open = false;
-  bool has_range = false;    // numbers: lo/hi hold
-  std::string default_text;  // as the README shows it ("" for the model's own)
+  bool has_range = false;            // numbers: lo/hi hold
+  std::string default_text;          // as the README shows it ("" for the model's own)
   std::vector<std::string> choices;  // string rows with a closed set of values
   std::string meaning;
   std::string group;  // "driver", "vehicle", "protocol", "limits", "odometry", "sim"

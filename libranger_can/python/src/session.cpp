@@ -118,8 +118,8 @@ Result<std::string> Session::inject(const std::string& line) {
   auto action = sim::parse_chassis_command(line);
   if (!action) {
     return Error{action.error().code,
-                 "inject \"" + line + "\": " + action.error().message + " (valid commands: " +
-                     text::join(sim::chassis_command_names()) + ")"};
+                 "inject \"" + line + "\": " + action.error().message +
+                     " (valid commands: " + text::join(sim::chassis_command_names()) + ")"};
   }
   return sim_->with_chassis(*action);
 }

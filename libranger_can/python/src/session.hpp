@@ -81,7 +81,7 @@ class Session {
 
   mutable std::mutex mutex_;
   std::condition_variable changed_;
-  std::uint64_t sequence_ = 0;  // of the newest snapshot, guarded by mutex_
+  std::uint64_t sequence_ = 0;   // of the newest snapshot, guarded by mutex_
   std::deque<SentMotion> sent_;  // bounded, guarded by mutex_
   bool stop_sent_ = false;       // guarded by mutex_
 };

@@ -154,7 +154,8 @@ std::vector<UltrasonicView> ultrasonic_view(const DriverSnapshot& s) {
       out.push_back(std::move(u));
     }
   }
-  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.sensor < b.sensor; });
+  std::sort(out.begin(), out.end(),
+            [](const auto& a, const auto& b) { return a.sensor < b.sensor; });
   return out;
 }
 
@@ -204,19 +205,16 @@ std::optional<LightsView> lights_view(const DriverSnapshot& s) {
 std::vector<FrameView> frames_view(const DriverSnapshot& s) {
   std::vector<FrameView> out;
   for (const FrameIdCounts& c : s.frames.counts()) {
-    out.push_back(FrameView{c.id, std::string(protocol::frame_name(c.id)), c.frames, c.rejected,
-                            c.padded});
+    out.push_back(
+        FrameView{c.id, std::string(protocol::frame_name(c.id)), c.frames, c.rejected, c.padded});
   }
   return out;
 }
 
 OutcomeView outcome_view(const RequestOutcome& o) {
-  return OutcomeView{o.id,
-                     std::string(to_string(o.kind)),
-                     o.what,
-                     std::string(to_string(o.state)),
-                     o.message,
-                     o.error_word};
+  return OutcomeView{o.id,      std::string(to_string(o.kind)),
+                     o.what,    std::string(to_string(o.state)),
+                     o.message, o.error_word};
 }
 
 GroundTruthView ground_truth_view(const sim::ChassisSnapshot& c) {

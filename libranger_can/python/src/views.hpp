@@ -70,8 +70,7 @@ struct IdentificationView {
 
 struct RemoteView {
   std::string swa, swb, swc, swd;
-  double left_vertical = 0, left_horizontal = 0, right_vertical = 0, right_horizontal = 0,
-         knob = 0;
+  double left_vertical = 0, left_horizontal = 0, right_vertical = 0, right_horizontal = 0, knob = 0;
   std::int64_t stamp_ns = 0;
   std::int64_t received_ns = 0;  // the driver's clock: tells a new report from the last one
 };
