@@ -27,15 +27,17 @@ from typing import Dict, List, Optional
 
 from ._errors import RangerError, RequestFailed, RequestTimeout
 from ._ranger_can import (  # noqa: F401  (re-exported)
-    Battery, CliResult, FrameCount, GroundTruth, Identification, Joints, Lights, Motor, Odometry,
+    Battery, CliResult, Event, FrameCount, GroundTruth, Identification, Joints, Lights, Motor, Odometry,
     ParameterRow, RemoteState, RequestOutcome, SentMotion, Snapshot, UltrasonicReading,
     __version__, _cli, _Session, bms_status_bit_names, chassis_command_names,
-    driver_status_bit_names, error_clear_description, fault_names, light_modes, model_names,
+    driver_status_bit_names, error_clear_description, error_names, event_kinds, fault_names,
+    light_modes, model_names,
     motion_modes, parameters, protocol_names, refusal_names, steering_joint_names, variant_names,
     wheel_joint_names)
 
 __all__ = [
     "Driver", "RangerError", "RequestFailed", "RequestTimeout", "Snapshot", "RequestOutcome",
+    "Event", "event_kinds",
     "decode", "replay_odometry", "parameters", "model_names", "variant_names", "protocol_names",
     "motion_modes", "light_modes", "refusal_names", "fault_names", "steering_joint_names",
     "wheel_joint_names", "__version__",
@@ -78,6 +80,8 @@ class Driver:
             values["protocol"] = protocol
         self._s = _Session(port, values, record_sent, display_prefix)
         self._closed = False
+        self._event_seq = 0
+        self.events_missed = 0
         with _open_lock:
             _open.add(self)
         if start:
@@ -179,6 +183,16 @@ class Driver:
                     + (f", identification {ident.phase}: {ident.message}" if ident else ""))
                 raise RequestTimeout(f"{self.port}: not ready within {timeout} s ({why})")
             s = self._s.wait_snapshot(s.sequence, min(left, _SLICE))
+
+    def events(self) -> List[Event]:
+        """The driver's events (transitions with a severity: link, control mode, re-arm,
+        identification, refusals, faults, plausibility, requests, the shutdown stop, ...) since
+        the last call, oldest first; events_missed counts those the driver's ring no longer held."""
+        events, missed = self._s.events_since(self._event_seq)
+        self.events_missed += missed
+        if events:
+            self._event_seq = events[-1].sequence
+        return events
 
     # ---- commands (the driver's mailbox: never waits for the bus) ----
     def command(self, vx: float = 0.0, vy: float = 0.0, wz: float = 0.0,

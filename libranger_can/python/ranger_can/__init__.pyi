@@ -4,7 +4,7 @@ from typing import Callable, Dict, List, Optional
 
 from ._errors import RangerError as RangerError, RequestFailed as RequestFailed
 from ._errors import RequestTimeout as RequestTimeout
-from ._ranger_can import (Battery as Battery, FrameCount as FrameCount, GroundTruth as GroundTruth,
+from ._ranger_can import (Battery as Battery, Event as Event, event_kinds as event_kinds, FrameCount as FrameCount, GroundTruth as GroundTruth,
                           Identification as Identification, Joints as Joints, Lights as Lights,
                           Motor as Motor, Odometry as Odometry, ParameterRow as ParameterRow,
                           RemoteState as RemoteState, RequestOutcome as RequestOutcome,
@@ -29,6 +29,7 @@ class Driver:
     is_sim: bool
     stop_sent: bool
     closed: bool
+    events_missed: int
     def __init__(self, port: str = ..., *, model: Optional[str] = ...,
                  protocol: Optional[str] = ..., params: Optional[Dict[str, object]] = ...,
                  record_sent: bool = ..., start: bool = ..., display_prefix: str = ...,
@@ -43,6 +44,7 @@ class Driver:
     def wait_until(self, predicate: Callable[[Snapshot], bool],
                    timeout: float = ...) -> Snapshot: ...
     def wait_ready(self, timeout: float = ...) -> Snapshot: ...
+    def events(self) -> List[Event]: ...
     def command(self, vx: float = ..., vy: float = ..., wz: float = ...,
                 mode: Optional[str] = ...) -> None: ...
     def set_motion_mode(self, mode: Optional[str]) -> None: ...

@@ -175,28 +175,15 @@ class PySession {
   Session& s() { return *s_; }
   const Setup& setup() const { return s_->setup(); }
 
-  // How long a request of `kind` may take before a front end gives up waiting (the driver's own
-  // answer timeout and what the request goes through first), as the ROS 1 node waits.
-  double budget(const std::string& kind) const {
-    const DriverConfig& d = setup().driver;
-    const ControllerConfig& c = d.controller;
-    const auto margin = std::chrono::milliseconds(200);
-    std::chrono::nanoseconds t{0};
-    if (kind == "resume") {
-      t = d.request_answer_timeout;
-    } else if (kind == "clear_errors" || kind == "firmware_version") {
-      t = d.request_answer_timeout + margin;
-    } else if (kind == "ultrasonic") {
-      t = c.ultrasonic_confirm_timeout * (c.ultrasonic_max_attempts + 1);
-    } else if (kind == "lights") {
-      t = d.vendor_frames_wait + d.request_answer_timeout + margin;
-    } else if (kind == "park") {
-      t = c.mode_switch_timeout * (c.mode_switch_max_attempts + 1) + d.request_answer_timeout +
-          std::chrono::seconds(3);
-    } else {
-      invalid("request kind \"" + kind + "\" unknown");
+  // How long a request of `kind` may take before a front end gives up waiting: the driver's
+  // own answer budget for it.
+  double budget(const std::string& kind) {
+    using K = RequestOutcome::Kind;
+    for (K k : {K::kClearErrors, K::kUltrasonic, K::kResume, K::kLights, K::kPark,
+                K::kFirmwareVersion}) {
+      if (to_string(k) == kind) return seconds(s_->driver().answer_budget(k));
     }
-    return seconds(t);
+    invalid("request kind \"" + kind + "\" unknown");
   }
 
  private:
@@ -349,6 +336,15 @@ PYBIND11_MODULE(_ranger_can, m) {
         return "RequestOutcome(" + o.kind + " #" + std::to_string(o.id) + ": " + o.state +
                (o.message.empty() ? "" : ", " + o.message) + ")";
       });
+  py::class_<EventView>(m, "Event")
+      .def_readonly("sequence", &EventView::sequence)
+      .def_readonly("time_ns", &EventView::time_ns)
+      .def_readonly("kind", &EventView::kind)
+      .def_readonly("severity", &EventView::severity)
+      .def_readonly("text", &EventView::text)
+      .def_readonly("json", &EventView::json)
+      .def("__repr__",
+           [](const EventView& e) { return "Event(" + e.severity + " " + e.kind + ": " + e.text + ")"; });
   py::class_<GroundTruthView>(m, "GroundTruth")
       .def_readonly("x", &GroundTruthView::x)
       .def_readonly("y", &GroundTruthView::y)
@@ -425,6 +421,10 @@ PYBIND11_MODULE(_ranger_can, m) {
                              [](const S& s) { return name_of(s.c().mode_override); })
       .def_property_readonly("refusal",
                              [](const S& s) { return std::string(to_string(s.c().refusal)); })
+      .def_property_readonly("refusal_detail",
+                             [](const S& s) {
+                               return describe_refusal(s.c(), s.s().identification.get());
+                             })
       .def_property_readonly("rearm_required", [](const S& s) { return s.c().rearm_required(); })
       .def_property_readonly("latched_causes",
                              [](const S& s) { return cause_names(s.c().latched_causes); })
@@ -630,6 +630,17 @@ PYBIND11_MODULE(_ranger_can, m) {
              if (!p.s().sim()) return std::nullopt;
              return ground_truth_view(p.s().sim()->snapshot());
            })
+      .def(
+          "events_since",
+          [](PySession& p, std::uint64_t after) {
+            std::vector<DriverEvent> events;
+            const std::uint64_t missed = p.s().driver().events_since(after, events);
+            std::vector<EventView> out;
+            for (const auto& e : events)
+              out.push_back(event_view(e));
+            return py::make_tuple(out, missed);
+          },
+          py::arg("after"))
       .def("take_sent", [](PySession& p) { return p.s().take_sent(); })
       .def(
           "wait_sent",
@@ -652,6 +663,7 @@ PYBIND11_MODULE(_ranger_can, m) {
   m.def("motion_modes", [] { return all_names(protocol::kAllMotionModes); });
   m.def("light_modes", [] { return all_names(protocol::kAllLightModes); });
   m.def("refusal_names", [] { return all_names(kAllMotionRefusals); });
+  m.def("event_kinds", [] { return all_names(kAllEventKinds); });
   m.def("fault_names", [] {
     std::vector<std::string> out;
     for (const auto& f : protocol::kFaultTable)

@@ -211,6 +211,11 @@ std::vector<FrameView> frames_view(const DriverSnapshot& s) {
   return out;
 }
 
+EventView event_view(const DriverEvent& e) {
+  return EventView{e.sequence,          ns(e.time), std::string(to_string(e.kind)),
+                   std::string(to_string(e.severity)), describe(e), to_json(e)};
+}
+
 OutcomeView outcome_view(const RequestOutcome& o) {
   return OutcomeView{o.id,      std::string(to_string(o.kind)),
                      o.what,    std::string(to_string(o.state)),

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "ranger_can/control/driver.hpp"
+#include "ranger_can/control/driver_events.hpp"
 #include "ranger_can/sim/virtual_chassis.hpp"
 
 namespace ranger::python {
@@ -104,7 +105,16 @@ struct GroundTruthView {
   LightsView lights;
 };
 
+struct EventView {
+  std::uint64_t sequence = 0;
+  std::int64_t time_ns = 0;  // the driver's clock (monotonic)
+  std::string kind, severity;
+  std::string text;  // describe(): the line the ROS node logs
+  std::string json;  // to_json()
+};
+
 OdometryView odometry_view(const DriverSnapshot& s);
+EventView event_view(const DriverEvent& e);
 JointsView joints_view(const DriverSnapshot& s);
 std::vector<MotorView> motors_view(const DriverSnapshot& s);
 std::vector<BatteryView> batteries_view(const DriverSnapshot& s);

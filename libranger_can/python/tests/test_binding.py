@@ -118,9 +118,16 @@ def test_no_fresh_command_stops_the_chassis(sim):
 
 
 def test_estop_latches_until_resume(sim):
+    sim.events()  # what happened before
     assert sim.inject("estop on") is not None
     s = sim.wait_until(lambda s: s.refusal == "estop", timeout=10)
     assert "emergency_stop" in s.active_causes
+    assert "emergency stop" in s.refusal_detail  # the library's words, with what to do
+    sim.wait_snapshot()  # the events of the iteration that refused are in the ring by then
+    events = sim.events()
+    refusals = [e for e in events if e.kind == "refusal_changed"]
+    assert refusals and refusals[-1].severity == "warn", events
+    assert all(e.kind in ranger_can.event_kinds() for e in events)
     with pytest.raises(RequestFailed, match="emergency_stop"):
         sim.resume()
     sim.inject("estop off")
@@ -276,6 +283,8 @@ def test_close_stops_the_chassis_and_is_idempotent():
     d.close()
     d.close()
     assert d.stop_sent
+    stops = [e for e in d.events() if e.kind == "shutdown_stop"]
+    assert stops and "stop sent to the chassis" in stops[-1].text
     sent = d.sent()
     assert sent and sent[-1].shutdown and sent[-1].vx == 0.0
     assert d.closed

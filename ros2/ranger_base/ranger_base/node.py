@@ -89,7 +89,6 @@ class RangerNode(Node):
 
         ns = self.get_namespace()
         self.hardware_id = f"ranger:{ns}:{self.port}"
-        self.events = adapters.Events(self.port)
         self._stop = threading.Event()
         self._stopped = False
         self._last_odom = self._last_joints = self._last_remote = 0
@@ -166,16 +165,8 @@ class RangerNode(Node):
         if self.cmd_sub is not None:
             self.destroy_subscription(self.cmd_sub)
             self.cmd_sub = None
-        self.driver.close()
-        if self.driver.stop_sent:
-            self.get_logger().info("stop sent to the chassis (zero motion command)")
-        else:
-            s = self.driver.snapshot()
-            self.get_logger().info(
-                "no stop sent to the chassis: " +
-                (f"the bus {self.port} was never opened" if not s.bus_open else
-                 "a replayed log is read-only" if s.read_only else
-                 "the driver had nothing to stop"))
+        self.driver.close()  # the stop; its event ("stop sent to the chassis ...") logged here
+        self._log_events()
         self._stop.set()
         if self._thread.is_alive():
             self._thread.join()
@@ -407,7 +398,7 @@ class RangerNode(Node):
         stamp = self.get_clock().now().to_msg()
         if self._heard(self.system_pub):
             self.system_pub.publish(conversions.to_system_state(s, stamp,
-                                                                adapters.refusal_detail(s)))
+                                                                s.refusal_detail))
         if self._heard(self.actuator_pub):
             self.actuator_pub.publish(conversions.to_actuator_state(s.motors, stamp))
         if self._heard(self.bms_pub):
@@ -429,10 +420,15 @@ class RangerNode(Node):
                 pub = self.range_pubs[u.sensor - 1] if 1 <= u.sensor <= 8 else None
                 if self._heard(pub):
                     pub.publish(conversions.to_range(u, self.params))
-        for event in self.events.poll(s):
-            log = (self.get_logger().info, self.get_logger().warn,
-                   self.get_logger().error)[event.level]
-            log(event.text)
+        self._log_events()
+
+    def _log_events(self):
+        """The driver's events, each at its severity (the library decides what is a transition
+        and words it; the ROS 1 node logs the same)."""
+        log = self.get_logger()
+        for event in self.driver.events():
+            {"debug": log.debug, "info": log.info, "warn": log.warn,
+             "error": log.error}.get(event.severity, log.info)(event.text)
 
     def _publish_diagnostics(self, s):
         groups = adapters.diagnostic_groups(s, self.driver.protocol_source)

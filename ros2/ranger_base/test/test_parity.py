@@ -102,19 +102,27 @@ def test_ros2_node_has_the_ros1_nodes_topics_services_types_and_parameters(ros, 
         def local(name):
             return name if not name.startswith(ns + "/") else name[len(ns) + 1:]
 
-        client.wait_for(lambda: len(graph()[2]) >= len(services), 30, "the services")
-        pubs, subs, srvs = graph()
-        have_topics = {}
-        for direction, table in (("out", pubs), ("in", subs)):
-            for name, types in table.items():
-                if name in ROS2_INFRASTRUCTURE_TOPICS:
-                    continue
-                have_topics[local(name)] = (direction, types[0])
         want_topics = {n: (d, ros2_type(t, "msg")) for n, (d, t) in topics.items()}
+        want_services = {n: ros2_type(t, "srv") for n, t in services.items()}
+
+        def have():
+            pubs, subs, srvs = graph()
+            found = {}
+            for direction, table in (("out", pubs), ("in", subs)):
+                for name, types in table.items():
+                    if name not in ROS2_INFRASTRUCTURE_TOPICS:
+                        found[local(name)] = (direction, types[0])
+            return found, {local(n): t[0] for n, t in srvs.items()
+                           if not local(n).startswith("ranger_base_node/")}
+
+        # Discovery reports the node's entities over a moment: wait for it to settle.
+        try:
+            client.wait_for(lambda: have() == (want_topics, want_services), 30, "the graph")
+        except AssertionError:
+            pass
+        have_topics, have_services = have()
         assert have_topics == want_topics
-        have_services = {local(n): t[0] for n, t in srvs.items()
-                         if not local(n).startswith("ranger_base_node/")}
-        assert have_services == {n: ros2_type(t, "srv") for n, t in services.items()}
+        assert have_services == want_services
 
         listed = client.call(ListParameters, f"{ns}/ranger_base_node/list_parameters",
                              ListParameters.Request())
