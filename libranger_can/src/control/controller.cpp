@@ -44,6 +44,45 @@ Status check_duration(const char* name, std::chrono::nanoseconds d) {
 
 }  // namespace
 
+Status check_finite(const MotionRequest& request) {
+  const struct {
+    const char* name;
+    double value;
+  } components[] = {{"linear.x", request.twist.vx},         {"linear.y", request.twist.vy},
+                    {"linear.z", request.out_of_plane.vz},  {"angular.x", request.out_of_plane.wx},
+                    {"angular.y", request.out_of_plane.wy}, {"angular.z", request.twist.wz}};
+  for (const auto& c : components) {
+    if (!std::isfinite(c.value)) {
+      return Error{Errc::kNotFinite,
+                   std::string(c.name) + " is " + (std::isnan(c.value) ? "NaN" : "infinite")};
+    }
+  }
+  return ok_status();
+}
+
+bool can_drive_in(MotionMode mode, const ProtocolProfile& profile) {
+  return drivable_mode(mode) &&
+         protocol::motion_mode_to_wire(mode, profile.mode_numbering).has_value();
+}
+
+std::vector<MotionMode> drivable_modes(const ProtocolProfile& profile) {
+  std::vector<MotionMode> out;
+  for (MotionMode m : protocol::kAllMotionModes) {
+    if (can_drive_in(m, profile)) out.push_back(m);
+  }
+  return out;
+}
+
+Status check_drivable(MotionMode mode, const ProtocolProfile& profile) {
+  if (can_drive_in(mode, profile)) return ok_status();
+  std::string modes;
+  for (MotionMode m : drivable_modes(profile))
+    modes += (modes.empty() ? "" : ", ") + std::string(protocol::to_string(m));
+  return Error{Errc::kInvalidArgument, std::string(protocol::to_string(mode)) +
+                                           ": unsupported by protocol " + profile.revision +
+                                           " (it drives " + modes + ")"};
+}
+
 std::string_view to_string(MotionRefusal r) {
   switch (r) {
     case MotionRefusal::kNone:
@@ -72,6 +111,8 @@ std::string_view to_string(MotionRefusal r) {
       return "switching";
     case MotionRefusal::kCmdTimeout:
       return "cmd_timeout";
+    case MotionRefusal::kInvalidCommand:
+      return "invalid_command";
     case MotionRefusal::kBelowMinimum:
       return "below_minimum";
     case MotionRefusal::kIdentifying:
@@ -166,6 +207,7 @@ ChassisController::ChassisController(Bus& bus, ControllerConfig config)
       limiter_vx_(config_.limit_vx),
       limiter_vy_(config_.limit_vy),
       limiter_wz_(config_.limit_wz) {
+  state_.zero_twist_rearms = config_.rearm_on_zero_twist;
   update_faults();
 }
 
@@ -280,36 +322,34 @@ Status ChassisController::set_command(const MotionRequest& request, Timestamp no
   if (state_.shut_down) {
     return Error{Errc::kInvalidArgument, "controller: set_command after shutdown"};
   }
-  const struct {
-    const char* name;
-    double value;
-  } components[] = {{"vx", request.twist.vx}, {"vy", request.twist.vy}, {"wz", request.twist.wz}};
-  for (const auto& c : components) {
-    if (!std::isfinite(c.value)) {
-      // A NaN is a caller bug, not a wish to keep driving the previous command: stop.
-      state_.requested = MotionRequest{};
-      state_.has_command = true;
-      state_.last_command_time = now;
-      state_.cmd_timed_out = false;
-      command_changed_ = true;
-      return Error{Errc::kNotFinite, std::string("controller: command ") + c.name + " is " +
-                                         (std::isnan(c.value) ? "NaN" : "infinite") + "; stopping"};
+  if (Status st = check_finite(request); !st) {
+    // A NaN is a caller bug, not a wish to keep driving the previous command: stop, and say so
+    // (kInvalidCommand) until a valid request comes.
+    state_.requested = MotionRequest{};
+    state_.has_command = true;
+    state_.last_command_time = now;
+    state_.cmd_timed_out = false;
+    state_.invalid_command = st.error().message;
+    ++state_.counters.invalid_commands;
+    command_changed_ = true;
+    return Error{Errc::kNotFinite, "controller: command " + st.error().message + "; stopping"};
+  }
+  if (request.mode) {
+    if (Status st = check_drivable(*request.mode, config_.profile); !st) {
+      return Error{Errc::kInvalidArgument, "controller: motion mode " + st.error().message};
     }
   }
-  if (request.mode && !can_drive_in(*request.mode)) {
-    return Error{Errc::kInvalidArgument,
-                 "controller: motion mode " + std::string(protocol::to_string(*request.mode)) +
-                     " cannot be driven under protocol " + config_.profile.revision +
-                     " (ackermann, oblique, spin; side_slip where the mode numbering has it)"};
-  }
   if (is_zero(request.twist)) {
-    // A zero twist abandons a switch that never completed, and re-arms once every cause of an
-    // involuntary stop has cleared: the commander has seen the stop and asks for rest.
+    // A zero twist abandons a switch that never completed. It re-arms only where the owner opted
+    // in (rearm_on_zero_twist), once every cause of an involuntary stop has cleared.
     if (mode_switch_.status().failed) mode_switch_.cancel();
     update_causes();
-    if (latch_.on_zero_command(state_.active_causes)) ++state_.counters.rearms;
+    if (config_.rearm_on_zero_twist && latch_.on_zero_command(state_.active_causes)) {
+      ++state_.counters.rearms;
+    }
     state_.latched_causes = latch_.causes();
   }
+  state_.invalid_command.clear();
   state_.requested = request;
   state_.has_command = true;
   state_.last_command_time = now;
@@ -319,8 +359,7 @@ Status ChassisController::set_command(const MotionRequest& request, Timestamp no
 }
 
 bool ChassisController::can_drive_in(MotionMode mode) const {
-  return drivable_mode(mode) &&
-         protocol::motion_mode_to_wire(mode, config_.profile.mode_numbering).has_value();
+  return ranger::can_drive_in(mode, config_.profile);
 }
 
 void ChassisController::request_motion_mode(std::optional<MotionMode> mode, Timestamp now) {
@@ -368,7 +407,7 @@ Status ChassisController::set_ultrasonic(bool enable, Timestamp now) {
 
 Status ChassisController::request_park(bool on, Timestamp now) {
   state_.now = now;
-  if (on && !protocol::motion_mode_to_wire(MotionMode::kPark, config_.profile.mode_numbering)) {
+  if (!protocol::motion_mode_to_wire(MotionMode::kPark, config_.profile.mode_numbering)) {
     return Error{Errc::kInvalidArgument, "park: unsupported by protocol " +
                                              config_.profile.revision +
                                              " (its motion-mode numbering has no park mode)"};
@@ -622,6 +661,7 @@ MotionRefusal ChassisController::evaluate_refusal() const {
   if (!state_.motion_mode && !(leave_park_ && state_.parked())) return MotionRefusal::kModeUnknown;
   if (identifying) return MotionRefusal::kIdentifying;
   if (state_.cmd_timed_out) return MotionRefusal::kCmdTimeout;
+  if (!state_.invalid_command.empty()) return MotionRefusal::kInvalidCommand;
   if (selector_.below_minimum(state_.requested.twist)) return MotionRefusal::kBelowMinimum;
   return MotionRefusal::kNone;
 }
@@ -637,6 +677,18 @@ bool ChassisController::at_standstill(Timestamp now) const {
     return std::fabs(fb.motion->value.speed) <= config_.standstill_speed;
   }
   return false;  // no fresh feedback: standstill cannot be confirmed
+}
+
+std::uint32_t ChassisController::adjustments(const KinematicsSolution& solution) const {
+  // Automatic selection with a switch to come (the selector waits for confirm_time and the dwell
+  // before it hands the request to the mode that expresses it): the current mode's solution is a
+  // stopgap of a few hundred milliseconds (a rotation asked at standstill turns the wheels to
+  // full lock until spin), not what becomes of the request.
+  const bool automatic = !state_.requested.mode && !state_.mode_override;
+  if (automatic && selector_.classify(state_.requested.twist, solution.mode) != solution.mode) {
+    return kKinematicsExact;
+  }
+  return solution.flags;
 }
 
 double ChassisController::steer_first_factor(const KinematicsSolution& solution,
@@ -675,7 +727,8 @@ void ChassisController::run_motion(Timestamp now) {
   const bool leaving_park =
       leave_park_ && state_.parked() &&
       (refusal == MotionRefusal::kNone || refusal == MotionRefusal::kCmdTimeout ||
-       refusal == MotionRefusal::kBelowMinimum || refusal == MotionRefusal::kModeSwitchFailed);
+       refusal == MotionRefusal::kBelowMinimum || refusal == MotionRefusal::kModeSwitchFailed ||
+       refusal == MotionRefusal::kInvalidCommand);
   const bool may_drive =
       ((refusal == MotionRefusal::kNone || refusal == MotionRefusal::kModeSwitchFailed) &&
        state_.has_command) ||
@@ -728,6 +781,7 @@ void ChassisController::run_motion(Timestamp now) {
   MotionCommand command{};
   const KinematicsSolution* solution = nullptr;
   state_.steer_first_factor = 1.0;
+  state_.adjustments = 0;
   if (refusal == MotionRefusal::kNone && state_.has_command && state_.motion_mode) {
     const double dt = limiter_started_ ? seconds(now - last_limit_time_) : 0.0;
     const BodyTwist& target = state_.requested.twist;
@@ -749,6 +803,7 @@ void ChassisController::run_motion(Timestamp now) {
         if (state_.steer_first_factor == 1.0) command_changed_ = true;
       }
       state_.steer_first_factor = factor;
+      state_.adjustments = adjustments(*solved);
       command = solved->command;
       state_.last_solution = *solved;
       solution = &*state_.last_solution;

@@ -45,17 +45,16 @@ constexpr std::size_t kMaxRequests = 16;
 constexpr std::chrono::nanoseconds kAnswerDelay =
     std::chrono::milliseconds(protocol::frame_period_ms(protocol::kSystemStatusId));
 
-bool finite(const BodyTwist& t) {
-  return std::isfinite(t.vx) && std::isfinite(t.vy) && std::isfinite(t.wz);
-}
 bool is_zero(const BodyTwist& t) {
   return t.vx == 0.0 && t.vy == 0.0 && t.wz == 0.0;
 }
 
-// The odometry shares the controller's geometry and protocol profile: one vehicle, one reading.
+// The odometry shares the controller's geometry, limits and protocol profile: one vehicle, one
+// reading.
 OdometryConfig odometry_config(const DriverConfig& config) {
   OdometryConfig c = config.odometry;
   c.geometry = config.controller.geometry;
+  c.limits = config.controller.limits;
   c.profile = config.controller.profile;
   return c;
 }
@@ -266,9 +265,9 @@ Status Driver::command(const MotionRequest& request) {
                                              (source_ ? source_->name() : std::string("a bus")) +
                                              (open_error_.empty() ? "" : ": " + open_error_)};
     }
-    if (!finite(request.twist)) {
-      st = Error{Errc::kNotFinite,
-                 "command refused (NaN or infinite component): the chassis is commanded to stop"};
+    if (Status finite = check_finite(request); !finite) {
+      st = Error{Errc::kNotFinite, "command refused (" + finite.error().message +
+                                       "): the chassis is commanded to stop"};
     }
     if (mail_->command && is_zero(mail_->command->twist)) mail_->zero_seen = true;
     mail_->command = request;
@@ -277,12 +276,16 @@ Status Driver::command(const MotionRequest& request) {
   return st;
 }
 
-void Driver::set_motion_mode(std::optional<protocol::MotionMode> mode) {
+Status Driver::set_motion_mode(std::optional<protocol::MotionMode> mode) {
+  if (mode) {
+    if (Status st = check_drivable(*mode, snapshot()->profile); !st) return st;
+  }
   {
     std::lock_guard<std::mutex> lock(mail_mutex_);
     mail_->mode = mode;
   }
   wake();
+  return ok_status();
 }
 
 RequestOutcome& Driver::add_request(RequestOutcome::Kind kind, std::string what, bool on) {
@@ -866,7 +869,9 @@ void Driver::run_identification(Timestamp now) {
   const MotionRefusal refusal = controller_->state().refusal;
   switch (refusal) {
     case MotionRefusal::kRearmRequired:
-      identifier_->hold_probe("motion needs the re-arm (call resume, or send a zero twist)");
+      identifier_->hold_probe(config_.controller.rearm_on_zero_twist
+                                  ? "motion needs the re-arm (call resume, or send a zero twist)"
+                                  : "motion needs the re-arm (call resume)");
       break;
     case MotionRefusal::kRemote:  // (as of the last tick: the hand-back is being heard now)
     case MotionRefusal::kEstop:
@@ -925,7 +930,7 @@ void Driver::run_plausibility(Timestamp now) {
   applied_stop_ = stop->text();
   controller_->set_implausible(applied_stop_);  // the stop, latched
   // Auto: a setting the identification could not decide at rest is learned here. The stop stays
-  // latched (a zero twist or resume re-arms); the cause itself is gone with the setting.
+  // latched (resume re-arms); the cause itself is gone with the setting.
   if (identifier_) identification_changed_ = true;  // adopt() records the stop either way
   if (identifier_ && identifier_->adopt(stop->setting, stop->try_value, stop->detail)) {
     use_profile(with_configured_settings(identifier_->status()), /*reset_odometry=*/false);
