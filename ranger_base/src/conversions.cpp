@@ -75,6 +75,12 @@ ranger::BodyTwist to_body_twist(const geometry_msgs::Twist& twist) {
   return {twist.linear.x, twist.linear.y, twist.angular.z};
 }
 
+ranger::MotionRequest to_motion_request(const geometry_msgs::Twist& twist) {
+  return ranger::MotionRequest{
+      to_body_twist(twist), std::nullopt,
+      ranger::OutOfPlaneTwist{twist.linear.z, twist.angular.x, twist.angular.y}};
+}
+
 bool has_non_planar_components(const geometry_msgs::Twist& twist) {
   return twist.linear.z != 0.0 || twist.angular.x != 0.0 || twist.angular.y != 0.0;
 }
@@ -318,7 +324,8 @@ std::string describe_refusal(const ranger::DriverSnapshot& snapshot) {
     case R::kLowBattery:
       return "battery below low_battery_soc: the chassis cuts the drives";
     case R::kModeSwitchFailed:
-      return "motion-mode switch not confirmed by the chassis: send a zero cmd_vel or call resume";
+      return "motion-mode switch not confirmed by the chassis: send a zero cmd_vel (it abandons "
+             "the switch), then call resume";
     case R::kImplausible:
       return "the chassis's feedback contradicts the protocol settings: " +
              (c.implausible_reason.empty() ? std::string("(no reason given)")
@@ -326,7 +333,9 @@ std::string describe_refusal(const ranger::DriverSnapshot& snapshot) {
              ". Set that parameter (or load a commissioning file), or call resume to try again";
     case R::kRearmRequired:
       return "rearm_required after " + join(cause_names(c.latched_causes)) +
-             ": call resume (or send a zero cmd_vel) to drive again";
+             (c.zero_twist_rearms ? ": call resume (or send a zero cmd_vel: rearm_on_zero_twist)"
+                                  : ": call resume") +
+             " to drive again";
     case R::kStandby:
       if (c.reclaim_blocked) {
         return "remote control had the chassis: call resume to take CAN control";
@@ -343,6 +352,10 @@ std::string describe_refusal(const ranger::DriverSnapshot& snapshot) {
       return "motion-mode switch in progress";
     case R::kCmdTimeout:
       return "no recent cmd_vel (cmd_vel_timeout): chassis commanded to stop";
+    case R::kInvalidCommand:
+      return "invalid_command: cmd_vel refused, " + c.invalid_command +
+             " (a NaN or an infinity in any of its six fields refuses the whole twist): chassis "
+             "commanded to stop until a valid cmd_vel comes";
     case R::kBelowMinimum:
       return "below_minimum: cmd_vel is below what the chassis can express (mode_selection/"
              "min_linear_speed, min_yaw_rate): not driven";
@@ -376,6 +389,9 @@ ranger_msgs::SystemState to_system_state(const ranger::DriverSnapshot& snapshot,
   out.header.stamp = stamp;
   out.link_up = state.link == ranger::LinkState::kConnected;
   out.motion_known = snapshot.motion_known;
+  out.odometry_gap = ranger::seconds(snapshot.odometry.last_gap);
+  out.odometry_gap_end = to_ros_time(snapshot.odometry.last_gap_end);
+  out.odometry_gaps = static_cast<std::uint32_t>(snapshot.odometry.gaps);
   if (const auto& s = feedback.system_status) {
     out.vehicle_status = s->value.vehicle_status_raw;
     out.vehicle_status_name = std::string(protocol::to_string(s->value.vehicle_status));

@@ -48,6 +48,9 @@ constexpr nanoseconds kAnswerMargin = milliseconds(200);
 constexpr nanoseconds kWaitSlice = milliseconds(20);
 // While the chassis was never heard, "still waiting" is repeated this often.
 constexpr nanoseconds kWaitingReminder = std::chrono::seconds(30);
+// A service answered the same way as its last logged call is logged again only this long after
+// it (a client calling at 100 Hz does not fill the log).
+constexpr nanoseconds kRepeatedLogPeriod = std::chrono::seconds(10);
 
 const ranger::Clock& driver_clock() {
   static const ranger::SteadyClock clock;
@@ -283,17 +286,16 @@ void RangerNode::shutdown() {
 // -----------------------------------------------------------------------------------
 
 void RangerNode::on_cmd_vel(const geometry_msgs::Twist::ConstPtr& msg) {
-  const ranger::BodyTwist twist = to_body_twist(*msg);
-  if (has_non_planar_components(*msg)) {
-    ROS_WARN_THROTTLE(5.0, "cmd_vel: linear.z, angular.x and angular.y are ignored (planar base)");
-  }
-  const ranger::Status st = driver_->command(ranger::MotionRequest{twist, std::nullopt});
+  // All six fields go to the driver: the library refuses a NaN or an infinity in any of them.
+  const ranger::Status st = driver_->command(to_motion_request(*msg));
   if (!st) {
     if (st.error().code == ranger::Errc::kNotFinite) {
       ROS_ERROR_THROTTLE(1.0, "cmd_vel refused, chassis stopped: %s", st.error().message.c_str());
     } else {
       ROS_WARN_THROTTLE(5.0, "cmd_vel not applied: %s", st.error().message.c_str());
     }
+  } else if (has_non_planar_components(*msg)) {
+    ROS_WARN_THROTTLE(5.0, "cmd_vel: linear.z, angular.x and angular.y are ignored (planar base)");
   }
 }
 
@@ -342,6 +344,28 @@ void RangerNode::on_sim_inject(const std_msgs::String::ConstPtr& msg) {
            said.empty() ? "" : ": ", said.c_str());
 }
 
+void RangerNode::log_service(bool ok, const std::string& service, const std::string& text) {
+  const auto now = std::chrono::steady_clock::now();
+  int repeated = 0;
+  {
+    std::lock_guard<std::mutex> lock(service_log_mutex_);
+    LoggedOutcome& last = service_log_[service];
+    if (text == last.text && now - last.at < kRepeatedLogPeriod) {
+      ++last.repeated;  // the same answer again: counted, logged with the next line
+      return;
+    }
+    repeated = last.repeated;
+    last = LoggedOutcome{text, now, 0};
+  }
+  const std::string more =
+      repeated > 0 ? " (and " + std::to_string(repeated) + " more answered like the last one)" : "";
+  if (ok) {
+    ROS_INFO("%s%s", text.c_str(), more.c_str());
+  } else {
+    ROS_WARN("%s%s", text.c_str(), more.c_str());
+  }
+}
+
 ranger::RequestOutcome RangerNode::wait_for(std::uint64_t id, nanoseconds timeout) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   for (;;) {
@@ -363,20 +387,19 @@ bool RangerNode::on_resume(std_srvs::Trigger::Request&, std_srvs::Trigger::Respo
     res.success = false;
     res.message = "resume refused: not connected to " + params_.port_name +
                   (before->bus_error.empty() ? "" : ": " + before->bus_error);
-    ROS_WARN("%s", res.message.c_str());
+    log_service(false, "resume", res.message);
     return true;
   }
   const auto outcome = wait_for(driver_->resume(), params_.driver.request_answer_timeout);
   res.success = outcome.state == State::kAnswered;
   if (res.success) {
     res.message = "re-armed: cmd_vel drives the chassis again";
-    ROS_INFO("resume: %s", res.message.c_str());
   } else {
     res.message = outcome.message.empty()
                       ? "resume not applied (" + std::string(ranger::to_string(outcome.state)) + ")"
                       : outcome.message;
-    ROS_WARN("resume: %s", res.message.c_str());
   }
+  log_service(res.success, "resume", "resume: " + res.message);
   return true;
 }
 
@@ -385,8 +408,9 @@ bool RangerNode::on_clear_errors(ranger_msgs::ClearErrors::Request& req,
   res.success = false;
   const auto posted = driver_->clear_errors(req.code);
   if (!posted) {
-    res.message = posted.error().message;
+    res.message = "clear_errors: " + posted.error().message;
     res.error_word = driver_->snapshot()->controller.error_bits;
+    log_service(false, "clear_errors", res.message);
     return true;
   }
   const auto outcome = wait_for(*posted, params_.driver.request_answer_timeout + kAnswerMargin);
@@ -400,13 +424,13 @@ bool RangerNode::on_clear_errors(ranger_msgs::ClearErrors::Request& req,
     res.message = asked + ": the chassis answered with error word " +
                   ranger::text::hex(res.error_word, 8) +
                   (names.empty() ? " (no errors)" : " (" + join(names) + ")");
-    ROS_INFO("%s", res.message.c_str());
+    log_service(true, "clear_errors", res.message);
   } else {
     res.error_word = driver_->snapshot()->controller.error_bits;
     res.message = asked + ": " +
                   (outcome.state == State::kFailed ? outcome.message
                                                    : std::string("the chassis did not answer"));
-    ROS_WARN("%s", res.message.c_str());
+    log_service(false, "clear_errors", res.message);
   }
   return true;
 }
@@ -420,6 +444,7 @@ bool RangerNode::on_set_ultrasonic(ranger_msgs::SetUltrasonic::Request& req,
     res.message = std::string(req.enable ? "contradictory request (enable and disable both true)"
                                          : "empty request (neither enable nor disable)") +
                   ": set exactly one of them; nothing sent";
+    log_service(false, "set_ultrasonic", "set_ultrasonic: " + res.message);
     return true;
   }
   const auto& c = params_.driver.controller;
@@ -430,53 +455,51 @@ bool RangerNode::on_set_ultrasonic(ranger_msgs::SetUltrasonic::Request& req,
   res.message = outcome.message.empty()
                     ? "the chassis did not confirm the ultrasonic setting in time"
                     : outcome.message;
-  if (res.success) ROS_INFO("set_ultrasonic: %s", res.message.c_str());
+  log_service(res.success, "set_ultrasonic", "set_ultrasonic: " + res.message);
   return true;
 }
 
 bool RangerNode::on_set_motion_mode(ranger_msgs::SetMotionMode::Request& req,
                                     ranger_msgs::SetMotionMode::Response& res) {
   using Req = ranger_msgs::SetMotionMode::Request;
+  // The service's numbers for the modes a twist can be driven in.
+  static constexpr struct {
+    std::uint8_t number;
+    protocol::MotionMode mode;
+  } kModes[] = {{Req::ACKERMANN, protocol::MotionMode::kAckermann},
+                {Req::OBLIQUE, protocol::MotionMode::kOblique},
+                {Req::SPIN, protocol::MotionMode::kSpin},
+                {Req::SIDE_SLIP, protocol::MotionMode::kSideSlip}};
   std::optional<protocol::MotionMode> mode;
-  switch (req.mode) {
-    case Req::ACKERMANN:
-      mode = protocol::MotionMode::kAckermann;
-      break;
-    case Req::OBLIQUE:
-      mode = protocol::MotionMode::kOblique;
-      break;
-    case Req::SPIN:
-      mode = protocol::MotionMode::kSpin;
-      break;
-    case Req::SIDE_SLIP:
-      mode = protocol::MotionMode::kSideSlip;
-      break;
-    case Req::AUTOMATIC:
-      break;
-    default:
-      res.success = false;
-      res.message = "mode " + std::to_string(req.mode) +
-                    " unknown: use 0 (Ackermann), 1 (oblique), 2 (spin), 4 (side slip) or 255 "
-                    "(automatic)";
-      return true;
+  for (const auto& m : kModes) {
+    if (m.number == req.mode) mode = m.mode;
   }
-  if (mode) {
-    const auto s = driver_->snapshot();
-    if (!protocol::motion_mode_to_wire(*mode, s->profile.mode_numbering)) {
-      res.success = false;
-      res.message = std::string(protocol::to_string(*mode)) + ": unsupported by protocol " +
-                    s->profile.revision + " (its motion-mode numbering has no " +
-                    std::string(protocol::to_string(*mode)) + " mode; side slip is the MINI V1's)";
-      ROS_WARN("set_motion_mode: %s", res.message.c_str());
-      return true;
+  if (!mode && req.mode != Req::AUTOMATIC) {
+    // The valid values are the ones valid on this chassis (the settings in use).
+    const auto profile = driver_->snapshot()->profile;
+    std::string valid;
+    for (const auto& m : kModes) {
+      if (ranger::can_drive_in(m.mode, profile)) {
+        valid += std::to_string(m.number) + " (" + std::string(protocol::to_string(m.mode)) + "), ";
+      }
     }
+    res.success = false;
+    res.message = "mode " + std::to_string(req.mode) + " unknown: under protocol " +
+                  profile.revision + " use " + valid + "or " + std::to_string(Req::AUTOMATIC) +
+                  " (automatic)";
+    log_service(false, "set_motion_mode", "set_motion_mode: " + res.message);
+    return true;
   }
-  driver_->set_motion_mode(mode);
-  res.success = true;
-  res.message = mode ? "motion mode pinned to " + std::string(protocol::to_string(*mode)) +
-                           " (the switch happens at standstill)"
-                     : "automatic motion-mode selection";
-  ROS_INFO("set_motion_mode: %s", res.message.c_str());
+  const ranger::Status st = driver_->set_motion_mode(mode);
+  res.success = st.ok();
+  if (!st) {
+    res.message = st.error().message;
+  } else {
+    res.message = mode ? "motion mode pinned to " + std::string(protocol::to_string(*mode)) +
+                             " (the switch happens at standstill)"
+                       : "automatic motion-mode selection";
+  }
+  log_service(res.success, "set_motion_mode", "set_motion_mode: " + res.message);
   return true;
 }
 
@@ -487,11 +510,13 @@ bool RangerNode::on_set_lights(ranger_msgs::SetLights::Request& req,
   if (!wanted) {
     res.message = wanted.error().message + ": nothing sent";
     fill_lights_response(driver_->snapshot()->lights, res);
+    log_service(false, "set_lights", "set_lights: " + res.message);
     return true;
   }
   const auto posted = driver_->set_lights(*wanted);
   if (!posted) {
     res.message = posted.error().message;
+    log_service(false, "set_lights", "set_lights: " + res.message);
     return true;
   }
   // The vendor frames may still be being listened for: their wait, then the answer's.
@@ -503,11 +528,7 @@ bool RangerNode::on_set_lights(ranger_msgs::SetLights::Request& req,
                                               std::string(ranger::to_string(outcome.state)) + ")"
                                         : outcome.message;
   fill_lights_response(driver_->snapshot()->lights, res);
-  if (res.success) {
-    ROS_INFO("set_lights: %s", res.message.c_str());
-  } else {
-    ROS_WARN("set_lights: %s", res.message.c_str());
-  }
+  log_service(res.success, "set_lights", "set_lights: " + res.message);
   return true;
 }
 
@@ -522,11 +543,7 @@ bool RangerNode::on_park(std_srvs::SetBool::Request& req, std_srvs::SetBool::Res
                     ? std::string(req.data ? "park" : "release") + " not confirmed in time (" +
                           std::string(ranger::to_string(outcome.state)) + ")"
                     : outcome.message;
-  if (res.success) {
-    ROS_INFO("park: %s", res.message.c_str());
-  } else {
-    ROS_WARN("park: %s", res.message.c_str());
-  }
+  log_service(res.success, "park", "park: " + res.message);
   return true;
 }
 
@@ -747,6 +764,7 @@ void RangerNode::log_state_changes(const ranger::DriverSnapshot& s) {
         ROS_INFO("chassis accepts motion commands");
         break;
       case R::kLinkLost:  // the link messages above say it (and the start-up log the listening)
+      case R::kInvalidCommand:  // on_cmd_vel logs it (at most once a second, naming the field)
         break;
       case R::kCmdTimeout:
       case R::kModeUnknown:
@@ -798,9 +816,12 @@ void RangerNode::log_state_changes(const ranger::DriverSnapshot& s) {
              "leading bytes, the rest ignored",
              id.id, std::string(protocol::frame_name(id.id)).c_str());
   }
-  if (c.last_solution && c.last_solution->flags != ranger::kKinematicsExact) {
-    ROS_WARN_THROTTLE(5.0, "cmd_vel adjusted to what the chassis can do: %s",
-                      ranger::kinematics_flags_to_string(c.last_solution->flags).c_str());
+  // What the command driven now differs from the request by (nothing while it is not driven).
+  if (c.adjustments != ranger::kKinematicsExact && c.last_solution) {
+    ROS_WARN_THROTTLE(
+        5.0, "cmd_vel adjusted to what the chassis can do: %s",
+        ranger::describe_adjustments(c.adjustments, c.requested.twist, c.last_solution->achieved)
+            .c_str());
   }
 }
 
@@ -837,7 +858,7 @@ void RangerNode::log_protocol_changes(const ranger::DriverSnapshot& s) {
         const ranger::IdentifiedSetting& d = id.decided[i];
         ROS_WARN(
             "learned while driving: %s = %s (%s); protocol settings now %s. The robot stopped: "
-            "send a zero cmd_vel or call resume to drive again",
+            "call resume to drive again",
             d.name.c_str(), d.value.c_str(), d.evidence.c_str(),
             ranger::describe(s.profile).c_str());
       }

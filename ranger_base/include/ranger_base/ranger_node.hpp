@@ -40,7 +40,9 @@
 
 #include <array>
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -103,6 +105,9 @@ class RangerNode {
   bool on_park(std_srvs::SetBool::Request& req, std_srvs::SetBool::Response& res);
   // The outcome of request `id` once answered or failed, after `timeout`, or at shutdown.
   ranger::RequestOutcome wait_for(std::uint64_t id, std::chrono::nanoseconds timeout);
+  // A service's answer for the log (INFO, WARN when refused or failed): an answer like the
+  // service's last logged one is counted, not logged, for kRepeatedLogPeriod.
+  void log_service(bool ok, const std::string& service, const std::string& text);
 
   // ---- the publication thread ----
   void publication_loop();
@@ -149,6 +154,13 @@ class RangerNode {
   std::unique_ptr<ros::AsyncSpinner> service_spinner_;
 
   std::atomic<bool> stopping_{false};   // services stop waiting
+  struct LoggedOutcome {
+    std::string text;
+    std::chrono::steady_clock::time_point at;
+    int repeated = 0;  // identical answers since, not logged
+  };
+  std::mutex service_log_mutex_;
+  std::map<std::string, LoggedOutcome> service_log_;  // per service
   std::atomic<bool> stop_sent_{false};  // the driver's shutdown stop was observed
 
   // The publication thread and what wakes it (the driver's observers write to the eventfd; the
