@@ -63,6 +63,25 @@ class Adversarial : public ::testing::TestWithParam<const char*> {
   static double moved(const Pose2D& a, const Pose2D& b) { return std::hypot(a.x - b.x, a.y - b.y); }
 };
 
+// The ground truth of a chassis asked only to go forward (and to turn): the worst backwards and
+// sideways speed seen, and whether it ever rolled (faster than the standstill a switch waits for)
+// while switching mode.
+struct ForwardOnly {
+  double backwards = 0.0;
+  double sideways = 0.0;
+  bool rolled_while_switching = false;
+  void watch(const sim::ChassisSnapshot& t) {
+    backwards = std::max(backwards, -t.twist.vx);
+    sideways = std::max(sideways, std::fabs(t.twist.vy));
+    rolled_while_switching |= t.switching && t.speed > kStandstill;
+  }
+  void expect_held() const {
+    EXPECT_LE(backwards, 1e-6);
+    EXPECT_LE(sideways, 1e-6);
+    EXPECT_FALSE(rolled_while_switching);
+  }
+};
+
 // An involuntary stop, how it ends on the chassis, and the cause the driver latches.
 struct Stop {
   const char* cause;
@@ -180,19 +199,15 @@ TEST_P(Adversarial, TwoPublishersFightingNeverDriveADirectionNeitherAsked) {
   auto rig = ready_rig();
   rig->silence();
   const std::size_t sent_before = rig->sent().size();
-  double backwards = 0.0, sideways = 0.0;
+  ForwardOnly truth;
   // Forward at 20 Hz and a spin at 20 Hz, 25 ms apart, for 10 s: the latest one wins each time.
   for (int ms = 0; ms < 10000; ++ms) {
     if (ms % 50 == 0) ASSERT_TRUE(rig->driver().command(MotionRequest{BodyTwist{0.4, 0, 0}}).ok());
     if (ms % 50 == 25) ASSERT_TRUE(rig->driver().command(MotionRequest{BodyTwist{0, 0, 0.5}}).ok());
     rig->step();
-    const auto t = rig->truth();
-    backwards = std::max(backwards, -t.twist.vx);
-    sideways = std::max(sideways, std::fabs(t.twist.vy));
-    if (t.switching) ASSERT_LE(t.speed, kStandstill) << "moved while switching";
+    truth.watch(rig->truth());
   }
-  EXPECT_LE(backwards, 1e-6);
-  EXPECT_LE(sideways, 1e-6);
+  truth.expect_held();
   EXPECT_TRUE(rig->snapshot()->controller.faults.empty());
   // The selector's dwell bounds the mode switches (min_dwell 1 s).
   EXPECT_LE(sent_with_id(*rig, protocol::kMotionModeCommandId, sent_before), 11u);
@@ -204,20 +219,16 @@ TEST_P(Adversarial, ModeThrashEveryHundredMillisecondsNeverDrivesWhileSwitching)
   auto rig = ready_rig();
   rig->command({0.3, 0, 0});
   const std::size_t sent_before = rig->sent().size();
-  double backwards = 0.0, sideways = 0.0;
+  ForwardOnly truth;
   for (int i = 0; i < 200; ++i) {  // 20 s
     ASSERT_TRUE(
         rig->driver().set_motion_mode(i % 2 ? MotionMode::kOblique : MotionMode::kAckermann).ok());
     for (int ms = 0; ms < 100; ++ms) {
       rig->step();
-      const auto t = rig->truth();
-      backwards = std::max(backwards, -t.twist.vx);
-      sideways = std::max(sideways, std::fabs(t.twist.vy));
-      if (t.switching) ASSERT_LE(t.speed, kStandstill) << "moved while switching";
+      truth.watch(rig->truth());
     }
   }
-  EXPECT_LE(backwards, 1e-6);
-  EXPECT_LE(sideways, 1e-6);
+  truth.expect_held();
   EXPECT_TRUE(rig->snapshot()->controller.faults.empty());
   EXPECT_GT(sent_with_id(*rig, protocol::kMotionModeCommandId, sent_before), 20u)
       << "the thrash did reach the chassis";

@@ -818,10 +818,14 @@ void RangerNode::log_state_changes(const ranger::DriverSnapshot& s) {
   }
   // What the command driven now differs from the request by (nothing while it is not driven).
   if (c.adjustments != ranger::kKinematicsExact && c.last_solution) {
+    // While steering first, the driven speed is held back on top (describe_refusal says it).
+    const std::string steering =
+        c.steer_first_factor < 1.0 ? " (held back while the wheels turn: steer first)" : "";
     ROS_WARN_THROTTLE(
-        5.0, "cmd_vel adjusted to what the chassis can do: %s",
+        5.0, "cmd_vel adjusted to what the chassis can do: %s%s",
         ranger::describe_adjustments(c.adjustments, c.requested.twist, c.last_solution->achieved)
-            .c_str());
+            .c_str(),
+        steering.c_str());
   }
 }
 

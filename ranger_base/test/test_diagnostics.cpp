@@ -109,6 +109,28 @@ TEST(Diagnostics, SteerFirstAndBelowMinimumAreShown) {
   EXPECT_NE(below.message.find("below_minimum"), std::string::npos) << below.message;
 }
 
+TEST(Diagnostics, AnInvalidCommandIsAWarningNamingTheField) {
+  auto s = healthy();
+  s.controller.refusal = ranger::MotionRefusal::kInvalidCommand;
+  s.controller.invalid_command = "linear.z is NaN";
+  s.controller.counters.invalid_commands = 12;
+  DiagnosticStatusWrapper d;
+  diagnose_control(s, d);
+  EXPECT_EQ(d.level, DiagnosticStatus::WARN);
+  EXPECT_NE(d.message.find("linear.z is NaN"), std::string::npos) << d.message;
+  EXPECT_EQ(value(d, "cmd_vel refused (NaN or inf)"), "12");
+}
+
+TEST(Diagnostics, TheOdometrysGapIsShown) {
+  auto s = healthy();
+  s.odometry.gaps = 2;
+  s.odometry.last_gap = 2040ms;
+  DiagnosticStatusWrapper d;
+  diagnose_link(s, d);
+  EXPECT_EQ(value(d, "Odometry gaps"), "2");
+  EXPECT_EQ(value(d, "Last odometry gap (s)"), "2.04");
+}
+
 TEST(Diagnostics, IdleAfterCmdVelTimeoutIsOk) {
   auto s = healthy();
   s.controller.refusal = ranger::MotionRefusal::kCmdTimeout;

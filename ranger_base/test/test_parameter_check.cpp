@@ -1,5 +1,5 @@
 // `ranger_base_node --check-parameters`: the parameters as one XML-RPC struct (what
-// ranger_bringup's scripts/check_launch sends), checked by the node's own rules.
+// ranger_bringup's scripts/check_launch.py sends), checked by the node's own rules.
 #include <gtest/gtest.h>
 
 #include <sstream>

@@ -1,7 +1,8 @@
 // `ranger_base_node --check-parameters`: the node's parameters checked before anything starts.
-// ranger_bringup's launch files run it (through scripts/check_launch) while roslaunch reads them,
-// so that parameters the node would refuse fail the launch itself: a non-zero exit status and
-// every reason on the console, instead of a node that exits FATAL under a roslaunch that exits 0.
+// ranger_bringup's launch files run it (through scripts/check_launch.py) while roslaunch reads
+// them, so that parameters the node would refuse fail the launch itself: a non-zero exit status
+// and every reason on the console, instead of a node that exits FATAL under a roslaunch that
+// exits 0.
 #pragma once
 
 #include <iosfwd>

@@ -1,9 +1,11 @@
-#!/usr/bin/python3
 """Checks a launch of ranger_base_node while roslaunch reads the launch file, before anything
 starts: ranger_minimal.launch runs it as a command parameter (its output is the node's port_name),
 and a non-zero exit status makes roslaunch itself fail, with the reasons on the console.
 
-    check_launch [--rosparam FILE | NAME:=VALUE]...
+    /usr/bin/python3 check_launch.py [--rosparam FILE | NAME:=VALUE]...
+
+(Run by the ROS Python, not executable itself: installed beside the launch files, in the share
+directory `$(find ranger_bringup)` names.)
 
   * The node's parameters, as the launch file gives them: NAME:=VALUE (typed as roslaunch types a
     <param value>) and --rosparam FILE (a YAML file loaded into the node's private namespace), in
