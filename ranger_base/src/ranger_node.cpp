@@ -344,7 +344,10 @@ void RangerNode::on_sim_inject(const std_msgs::String::ConstPtr& msg) {
            said.empty() ? "" : ": ", said.c_str());
 }
 
-void RangerNode::log_service(bool ok, const std::string& service, const std::string& text) {
+void RangerNode::log_service(bool ok, const std::string& service, const std::string& message) {
+  // Named by the service, unless the message names it already ("park: unsupported ...").
+  const std::string text =
+      message.rfind(service, 0) == 0 ? message : service + ": " + message;
   const auto now = std::chrono::steady_clock::now();
   int repeated = 0;
   {
@@ -399,7 +402,7 @@ bool RangerNode::on_resume(std_srvs::Trigger::Request&, std_srvs::Trigger::Respo
                       ? "resume not applied (" + std::string(ranger::to_string(outcome.state)) + ")"
                       : outcome.message;
   }
-  log_service(res.success, "resume", "resume: " + res.message);
+  log_service(res.success, "resume", res.message);
   return true;
 }
 
@@ -444,7 +447,7 @@ bool RangerNode::on_set_ultrasonic(ranger_msgs::SetUltrasonic::Request& req,
     res.message = std::string(req.enable ? "contradictory request (enable and disable both true)"
                                          : "empty request (neither enable nor disable)") +
                   ": set exactly one of them; nothing sent";
-    log_service(false, "set_ultrasonic", "set_ultrasonic: " + res.message);
+    log_service(false, "set_ultrasonic", res.message);
     return true;
   }
   const auto& c = params_.driver.controller;
@@ -455,7 +458,7 @@ bool RangerNode::on_set_ultrasonic(ranger_msgs::SetUltrasonic::Request& req,
   res.message = outcome.message.empty()
                     ? "the chassis did not confirm the ultrasonic setting in time"
                     : outcome.message;
-  log_service(res.success, "set_ultrasonic", "set_ultrasonic: " + res.message);
+  log_service(res.success, "set_ultrasonic", res.message);
   return true;
 }
 
@@ -477,17 +480,18 @@ bool RangerNode::on_set_motion_mode(ranger_msgs::SetMotionMode::Request& req,
   if (!mode && req.mode != Req::AUTOMATIC) {
     // The valid values are the ones valid on this chassis (the settings in use).
     const auto profile = driver_->snapshot()->profile;
-    std::string valid;
+    std::vector<std::string> valid;
     for (const auto& m : kModes) {
       if (ranger::can_drive_in(m.mode, profile)) {
-        valid += std::to_string(m.number) + " (" + std::string(protocol::to_string(m.mode)) + "), ";
+        valid.push_back(std::to_string(m.number) + " (" +
+                        std::string(protocol::to_string(m.mode)) + ")");
       }
     }
     res.success = false;
     res.message = "mode " + std::to_string(req.mode) + " unknown: under protocol " +
-                  profile.revision + " use " + valid + "or " + std::to_string(Req::AUTOMATIC) +
-                  " (automatic)";
-    log_service(false, "set_motion_mode", "set_motion_mode: " + res.message);
+                  profile.revision + " use " + join(valid) + " or " +
+                  std::to_string(Req::AUTOMATIC) + " (automatic)";
+    log_service(false, "set_motion_mode", res.message);
     return true;
   }
   const ranger::Status st = driver_->set_motion_mode(mode);
@@ -499,7 +503,7 @@ bool RangerNode::on_set_motion_mode(ranger_msgs::SetMotionMode::Request& req,
                              " (the switch happens at standstill)"
                        : "automatic motion-mode selection";
   }
-  log_service(res.success, "set_motion_mode", "set_motion_mode: " + res.message);
+  log_service(res.success, "set_motion_mode", res.message);
   return true;
 }
 
@@ -510,13 +514,13 @@ bool RangerNode::on_set_lights(ranger_msgs::SetLights::Request& req,
   if (!wanted) {
     res.message = wanted.error().message + ": nothing sent";
     fill_lights_response(driver_->snapshot()->lights, res);
-    log_service(false, "set_lights", "set_lights: " + res.message);
+    log_service(false, "set_lights", res.message);
     return true;
   }
   const auto posted = driver_->set_lights(*wanted);
   if (!posted) {
     res.message = posted.error().message;
-    log_service(false, "set_lights", "set_lights: " + res.message);
+    log_service(false, "set_lights", res.message);
     return true;
   }
   // The vendor frames may still be being listened for: their wait, then the answer's.
@@ -528,7 +532,7 @@ bool RangerNode::on_set_lights(ranger_msgs::SetLights::Request& req,
                                               std::string(ranger::to_string(outcome.state)) + ")"
                                         : outcome.message;
   fill_lights_response(driver_->snapshot()->lights, res);
-  log_service(res.success, "set_lights", "set_lights: " + res.message);
+  log_service(res.success, "set_lights", res.message);
   return true;
 }
 
@@ -543,7 +547,7 @@ bool RangerNode::on_park(std_srvs::SetBool::Request& req, std_srvs::SetBool::Res
                     ? std::string(req.data ? "park" : "release") + " not confirmed in time (" +
                           std::string(ranger::to_string(outcome.state)) + ")"
                     : outcome.message;
-  log_service(res.success, "park", "park: " + res.message);
+  log_service(res.success, "park", res.message);
   return true;
 }
 

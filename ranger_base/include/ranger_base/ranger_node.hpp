@@ -105,9 +105,9 @@ class RangerNode {
   bool on_park(std_srvs::SetBool::Request& req, std_srvs::SetBool::Response& res);
   // The outcome of request `id` once answered or failed, after `timeout`, or at shutdown.
   ranger::RequestOutcome wait_for(std::uint64_t id, std::chrono::nanoseconds timeout);
-  // A service's answer for the log (INFO, WARN when refused or failed): an answer like the
-  // service's last logged one is counted, not logged, for kRepeatedLogPeriod.
-  void log_service(bool ok, const std::string& service, const std::string& text);
+  // A service's answer for the log (INFO, WARN when refused or failed), named by the service: an
+  // answer like the service's last logged one is counted, not logged, for kRepeatedLogPeriod.
+  void log_service(bool ok, const std::string& service, const std::string& message);
 
   // ---- the publication thread ----
   void publication_loop();
