@@ -42,7 +42,7 @@ int check_parameters(std::istream& in, std::ostream& err) {
     return 2;
   }
   bool ok = true;
-  for (const auto& name : unknown_parameter_names(*source)) {
+  for (const auto& name : ranger::unknown_parameter_names(*source, kAlsoRead)) {
     err << "parameter " << source->display_name(name)
         << " is not one ranger_base_node reads (ranger_base/README.md lists them)\n";
     ok = false;

@@ -1146,7 +1146,7 @@ TEST_F(Adversarial, BadServiceArgumentsAreRefusedAndRepeatedOnesDoNotFloodTheLog
   ASSERT_TRUE(logged("set_motion_mode: automatic", marker));  // everything before it is here
   EXPECT_LE(log_lines("the chassis answered with error word", start, rosgraph_msgs::Log::INFO), 1)
       << calls << " identical calls";
-  EXPECT_TRUE(logged("more answered like the last one", start)) << "the count is said";
+  EXPECT_TRUE(logged("more answered alike since the last report", start)) << "the count is said";
   stop_and_settle();
 }
 
@@ -1264,9 +1264,9 @@ class FaultBits : public Faults {
   static std::string diagnostic_value(const std::string& key) {
     std::lock_guard<std::mutex> lock(commands_mutex_);
     for (const auto& [name, status] : diagnostics_) {
-      if (name.size() < std::strlen(ranger_base::kDiagErrors) ||
-          name.compare(name.size() - std::strlen(ranger_base::kDiagErrors), std::string::npos,
-                       ranger_base::kDiagErrors) != 0) {
+      const std::string errors(ranger::kDiagErrors);
+      if (name.size() < errors.size() ||
+          name.compare(name.size() - errors.size(), std::string::npos, errors) != 0) {
         continue;
       }
       for (const auto& kv : status.values) {

@@ -696,6 +696,18 @@ struct ScenarioRunner::Impl {
     sim->step(clock.now());
     driver->step(clock.now());
     if (!pending.empty()) report_requests(output);
+    if (output.event && driver->last_event_sequence() > events_seen) report_events(output);
+  }
+
+  std::uint64_t events_seen = 0;  // read after every step: none is missed
+  std::vector<DriverEvent> events;
+  void report_events(const ScenarioOutput& output) {
+    events.clear();
+    driver->events_since(events_seen, events);
+    for (const DriverEvent& e : events) {
+      events_seen = e.sequence;
+      output.event(e);
+    }
   }
 
   void publish() { (void)driver->command(MotionRequest{*publishing, std::nullopt}); }
@@ -884,6 +896,7 @@ ScenarioResult ScenarioRunner::run(const Scenario& scenario, const ScenarioOutpu
     }
   };
 
+  if (output.event) m.report_events(output);  // those of t = 0
   for (const ScenarioAction& a : scenario.actions) {
     switch (a.kind) {
       case ScenarioAction::Kind::kCommand:
@@ -948,10 +961,17 @@ Result<ScenarioResult> run_scenario(const Scenario& scenario, const ScenarioOpti
   if (!runner) return runner.error();
   std::size_t failures_shown = 0;
   std::string line;
+  std::string events;  // the driver's events since the last sample: ,{...},{...}
   ScenarioOutput output;
+  output.event = [&](const DriverEvent& e) { events += "," + to_json(e, kEpoch); };
+  // A sample carries the events since the one before ("events":[...], only when there are).
+  const auto with_events = [&](std::string json) {
+    if (!events.empty()) json.insert(json.size() - 1, ",\"events\":[" + events.substr(1) + "]");
+    events.clear();
+    return json + '\n';
+  };
   output.sample = [&](const ScenarioSample& s) {
-    line = to_json(s);
-    line += '\n';
+    line = with_events(to_json(s));
     out << line;
   };
   output.failure = [&](const std::string& text) {
@@ -960,6 +980,8 @@ Result<ScenarioResult> run_scenario(const Scenario& scenario, const ScenarioOpti
   };
   output.note = [&](const std::string& text) { err << prefix << text << "\n"; };
   const ScenarioResult result = (*runner)->run(scenario, output);
+  // Events after the last sample (a script that ends between samples).
+  if (!events.empty()) out << with_events("{\"t\":" + seconds_text((*runner)->now()) + "}");
   out.flush();
   if (result.failures > kMaxReportedErrors) {
     err << prefix << (result.failures - kMaxReportedErrors)

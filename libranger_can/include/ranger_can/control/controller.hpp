@@ -309,6 +309,11 @@ struct ControllerState {
   bool rearm_required() const { return latched_causes != 0; }
 };
 
+// Whether a twist can be driven in `mode` under `profile`: ackermann, oblique, spin, and side slip
+// where the profile's mode numbering has it (MINI V1, agx_v2); never park. The controller's rule
+// (ChassisController::can_drive_in), for a front end to refuse a mode by name before asking.
+bool can_drive_in(protocol::MotionMode mode, const ProtocolProfile& profile);
+
 // A frame the controller has just sent (for cmd_vel_out, latency figures and wire audits).
 struct SentFrame {
   CanFrame frame;   // as on the wire (stamp = the controller's `now`)
@@ -316,12 +321,13 @@ struct SentFrame {
   // 0x111 only: the twist it realises (REP-103; zero for a stop) and the solution behind it.
   BodyTwist achieved;
   std::optional<KinematicsSolution> solution;
+  // 0x111 only: how the command differs from the request (ControllerState::adjustments at the
+  // send: KinematicsFlag bits, none for a mode switch's stopgap) and the request's twist.
+  std::uint32_t adjustments = 0;
+  BodyTwist requested;
   bool shutdown = false;  // the stop sent by shutdown()
 };
 
-// Whether a twist can be driven in `mode` under `profile`: ackermann, oblique, spin, and side
-// slip where the mode numbering has it (MINI V1, agx_v2); never park.
-bool can_drive_in(protocol::MotionMode mode, const ProtocolProfile& profile);
 // The modes can_drive_in allows under `profile`, in protocol::MotionMode's order.
 std::vector<protocol::MotionMode> drivable_modes(const ProtocolProfile& profile);
 // kInvalidArgument unless can_drive_in(mode, profile), naming the mode, the profile's revision
@@ -446,7 +452,19 @@ class ChassisController {
   std::uint32_t adjustments(const KinematicsSolution& solution) const;
   void run_control_mode(Timestamp now);
   void run_ultrasonic(Timestamp now);
+  // run_motion's numbered steps (controller.cpp).
+  struct MotionGate;
   void run_motion(Timestamp now);
+  void check_command_timeout(Timestamp now);
+  MotionGate gate_motion() const;
+  protocol::MotionMode wanted_mode(const MotionGate& gate, protocol::MotionMode current,
+                                   Timestamp now);
+  std::optional<protocol::MotionMode> switch_mode(const MotionGate& gate, Timestamp now);
+  MotionRefusal settle_refusal(MotionRefusal refusal);
+  const KinematicsSolution* motion_command(MotionRefusal refusal, bool probing, Timestamp now,
+                                           MotionCommand& command);
+  void steer_first(KinematicsSolution& solved, Timestamp now);
+  void keep_alive(const MotionCommand& command, const KinematicsSolution* solution, Timestamp now);
 
   Bus& bus_;
   ControllerConfig config_;
