@@ -67,7 +67,7 @@ bool can_drive_in(MotionMode mode, const ProtocolProfile& profile) {
 
 std::vector<MotionMode> drivable_modes(const ProtocolProfile& profile) {
   std::vector<MotionMode> out;
-  for (MotionMode m : protocol::kAllMotionModes) {
+  for (MotionMode m : protocol::kMotionModeNames.values()) {
     if (can_drive_in(m, profile)) out.push_back(m);
   }
   return out;
@@ -81,80 +81,6 @@ Status check_drivable(MotionMode mode, const ProtocolProfile& profile) {
   return Error{Errc::kInvalidArgument, std::string(protocol::to_string(mode)) +
                                            ": unsupported by protocol " + profile.revision +
                                            " (it drives " + modes + ")"};
-}
-
-std::string_view to_string(MotionRefusal r) {
-  switch (r) {
-    case MotionRefusal::kNone:
-      return "none";
-    case MotionRefusal::kLinkLost:
-      return "link_lost";
-    case MotionRefusal::kRemote:
-      return "remote";
-    case MotionRefusal::kEstop:
-      return "estop";
-    case MotionRefusal::kCriticalError:
-      return "critical_error";
-    case MotionRefusal::kLowBattery:
-      return "low_battery";
-    case MotionRefusal::kModeSwitchFailed:
-      return "mode_switch_failed";
-    case MotionRefusal::kImplausible:
-      return "implausible_feedback";
-    case MotionRefusal::kRearmRequired:
-      return "rearm_required";
-    case MotionRefusal::kStandby:
-      return "standby";
-    case MotionRefusal::kModeUnknown:
-      return "mode_unknown";
-    case MotionRefusal::kSwitching:
-      return "switching";
-    case MotionRefusal::kCmdTimeout:
-      return "cmd_timeout";
-    case MotionRefusal::kInvalidCommand:
-      return "invalid_command";
-    case MotionRefusal::kBelowMinimum:
-      return "below_minimum";
-    case MotionRefusal::kIdentifying:
-      return "identifying";
-    case MotionRefusal::kParked:
-      return "parked";
-  }
-  return "unknown";
-}
-
-std::string_view to_string(ControllerFault f) {
-  switch (f) {
-    case ControllerFault::kLinkLost:
-      return "link_lost";
-    case ControllerFault::kEmergencyStop:
-      return "emergency_stop";
-    case ControllerFault::kVehicleAbnormal:
-      return "vehicle_abnormal";
-    case ControllerFault::kVehicleStatusUnknown:
-      return "vehicle_status_unknown";
-    case ControllerFault::kLowBattery:
-      return "low_battery";
-    case ControllerFault::kModeSwitchFailed:
-      return "motion_mode_switch_failed";
-    case ControllerFault::kImplausibleFeedback:
-      return "implausible_feedback";
-    case ControllerFault::kUltrasonicUnconfirmed:
-      return "ultrasonic_setting_unconfirmed";
-  }
-  return "unknown";
-}
-
-std::string_view to_string(LinkState s) {
-  switch (s) {
-    case LinkState::kNeverConnected:
-      return "never_connected";
-    case LinkState::kConnected:
-      return "connected";
-    case LinkState::kStale:
-      return "stale";
-  }
-  return "unknown";
 }
 
 Status ControllerConfig::validate() const {

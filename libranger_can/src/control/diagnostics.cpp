@@ -145,20 +145,6 @@ std::string add_identification(const IdentificationStatus& id, const DriverSnaps
 
 }  // namespace
 
-std::string_view to_string(DiagnosticLevel level) {
-  switch (level) {
-    case L::kOk:
-      return "OK";
-    case L::kWarn:
-      return "WARN";
-    case L::kError:
-      return "ERROR";
-    case L::kStale:
-      return "STALE";
-  }
-  return "UNKNOWN";
-}
-
 void DiagnosticGroup::merge_summary(DiagnosticLevel l, const std::string& m) {
   if (l != L::kOk && level != L::kOk) {
     if (!message.empty()) message += "; ";

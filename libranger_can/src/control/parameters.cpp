@@ -174,7 +174,7 @@ std::string range_text(const ParameterRange& r, const std::string& unit) {
 std::string range_problem(const Parameter& p) {
   std::string out = valid_text(p);
   if (p.unit == "rad" && p.valid_note.empty() && p.range.hi > 0.0 && std::isfinite(p.range.hi)) {
-    out += " (" + number_text(std::round(p.range.hi * 180.0 / M_PI)) + " deg)";
+    out += " (" + number_text(std::round(rad_to_deg(p.range.hi))) + " deg)";
   }
   return out;
 }
@@ -285,28 +285,6 @@ std::string default_text(const Parameter& p) {
 
 }  // namespace
 
-std::string_view to_string(ParameterType t) {
-  switch (t) {
-    case ParameterType::kBool:
-      return "bool";
-    case ParameterType::kInteger:
-      return "int";
-    case ParameterType::kNumber:
-      return "double";
-    case ParameterType::kSeconds:
-      return "seconds";
-    case ParameterType::kText:
-      return "string";
-    case ParameterType::kChoice:
-      return "choice";
-    case ParameterType::kNumberList:
-      return "double[]";
-    case ParameterType::kTextList:
-      return "string[]";
-  }
-  return "unknown";
-}
-
 bool ParameterRange::contains(double v) const {
   return (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi);
 }
@@ -393,7 +371,7 @@ std::string value_text(const Parameter& p, double value) {
   if (p.type == T::kBool) return value != 0.0 ? "true" : "false";
   std::string out = number_text(value);
   if (p.unit == "rad" && value != 0.0) {
-    out += " (" + number_text(std::round(value * 180.0 / M_PI * 100.0) / 100.0) + "°)";
+    out += " (" + number_text(std::round(rad_to_deg(value) * 100.0) / 100.0) + "°)";
   }
   return out;
 }

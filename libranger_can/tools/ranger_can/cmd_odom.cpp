@@ -12,10 +12,10 @@
 
 #include "cli_commands.hpp"
 #include "cli_input.hpp"
-#include "cli_json.hpp"
 #include "cli_options.hpp"
 #include "cli_profile.hpp"
 #include "ranger_can/control/odometry.hpp"
+#include "ranger_can/json.hpp"
 #include "ranger_can/parse.hpp"
 #include "ranger_can/wire/candump_log.hpp"
 

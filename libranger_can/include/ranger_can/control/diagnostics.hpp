@@ -17,12 +17,21 @@
 #include <vector>
 
 #include "ranger_can/control/driver.hpp"
+#include "ranger_can/text.hpp"
 
 namespace ranger {
 
 // diagnostic_msgs/DiagnosticStatus's levels, with its numbers.
 enum class DiagnosticLevel : std::uint8_t { kOk = 0, kWarn = 1, kError = 2, kStale = 3 };
-std::string_view to_string(DiagnosticLevel level);  // "OK", "WARN", "ERROR", "STALE"
+inline constexpr auto kDiagnosticLevelNames = text::enum_names<DiagnosticLevel>({
+    {DiagnosticLevel::kOk, "OK"},
+    {DiagnosticLevel::kWarn, "WARN"},
+    {DiagnosticLevel::kError, "ERROR"},
+    {DiagnosticLevel::kStale, "STALE"},
+});
+inline std::string_view to_string(DiagnosticLevel level) {
+  return kDiagnosticLevelNames.name(level);
+}
 
 struct DiagnosticGroup {
   std::string name;  // "CAN link" (a ROS front end prefixes its node name)

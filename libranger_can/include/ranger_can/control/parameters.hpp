@@ -22,6 +22,7 @@
 
 #include "ranger_can/control/driver.hpp"
 #include "ranger_can/result.hpp"
+#include "ranger_can/text.hpp"
 
 namespace ranger {
 
@@ -35,8 +36,19 @@ enum class ParameterType {
   kNumberList,  // `size` numbers, each in the range
   kTextList,    // strings
 };
-// "bool", "int", "double", "seconds", "string", "choice", "double[]", "string[]"
-std::string_view to_string(ParameterType t);
+inline constexpr auto kParameterTypeNames = text::enum_names<ParameterType>({
+    {ParameterType::kBool, "bool"},
+    {ParameterType::kInteger, "int"},
+    {ParameterType::kNumber, "double"},
+    {ParameterType::kSeconds, "seconds"},
+    {ParameterType::kText, "string"},
+    {ParameterType::kChoice, "choice"},
+    {ParameterType::kNumberList, "double[]"},
+    {ParameterType::kTextList, "string[]"},
+});
+inline std::string_view to_string(ParameterType t) {
+  return kParameterTypeNames.name(t);
+}
 
 struct ParameterRange {
   double lo = 0.0;
