@@ -678,10 +678,9 @@ ChassisController::MotionGate ChassisController::gate_motion() const {
               state_.motion_mode.has_value() && !state_.quiet;
   g.parking = r == MotionRefusal::kParked && state_.chassis_mode.has_value();
   const bool drivable = r == MotionRefusal::kNone || r == MotionRefusal::kModeSwitchFailed;
-  g.leaving_park =
-      leave_park_ && state_.parked() &&
-      (drivable || r == MotionRefusal::kCmdTimeout || r == MotionRefusal::kBelowMinimum ||
-       r == MotionRefusal::kInvalidCommand);
+  g.leaving_park = leave_park_ && state_.parked() &&
+                   (drivable || r == MotionRefusal::kCmdTimeout ||
+                    r == MotionRefusal::kBelowMinimum || r == MotionRefusal::kInvalidCommand);
   g.may_drive = (drivable && state_.has_command) || (g.probing && probe_mode_.has_value()) ||
                 g.parking || g.leaving_park;
   return g;
