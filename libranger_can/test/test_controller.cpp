@@ -279,8 +279,11 @@ TEST(ControllerHandshake, RemoteHandingBackWithSwbStillNeedsTheRearm) {
   EXPECT_EQ(rig.state().refusal, MotionRefusal::kRearmRequired);
   for (const CanFrame& f : rig.motion_frames())
     EXPECT_TRUE(is_zero(motion_of(f))) << "moved before the re-arm";
-  // The commander sends a zero twist: re-armed; the next twist drives.
+  // A zero twist is no re-arm; resume is: the next twist drives.
   ASSERT_TRUE(rig.ctl->set_command(BodyTwist{}, rig.now).ok());
+  rig.run(20ms);
+  EXPECT_EQ(rig.state().refusal, MotionRefusal::kRearmRequired);
+  ASSERT_TRUE(rig.ctl->resume(rig.now).ok());
   rig.run(20ms);
   EXPECT_EQ(rig.state().refusal, MotionRefusal::kNone);
   ASSERT_TRUE(rig.ctl->set_command(BodyTwist{0.3, 0, 0}, rig.now).ok());
@@ -320,7 +323,7 @@ TEST(ControllerLink, StaleAfterTimeoutAndReconnectsByItself) {
   EXPECT_EQ(rig.state().link, LinkState::kConnected);
   EXPECT_EQ(rig.state().refusal, MotionRefusal::kRearmRequired);
   EXPECT_TRUE(is_zero(motion_of(rig.motion_frames().back())));
-  ASSERT_TRUE(rig.ctl->set_command(BodyTwist{}, rig.now).ok());  // the re-arm
+  ASSERT_TRUE(rig.ctl->resume(rig.now).ok());  // the re-arm
   rig.run(20ms);
   ASSERT_TRUE(rig.ctl->set_command(BodyTwist{0.5, 0, 0}, rig.now).ok());
   rig.run(40ms);
@@ -695,7 +698,7 @@ TEST(ControllerFaults, EstopAbnormalAndCriticalBitsAreNamedAndStop) {
   EXPECT_TRUE(rig.state().faults.empty());
   EXPECT_TRUE(is_zero(motion_of(rig.motion_frames().back())));
   EXPECT_EQ(describe(rig.state().latched_causes), "emergency_stop,critical_error");
-  ASSERT_TRUE(rig.ctl->set_command(BodyTwist{}, rig.now).ok());
+  ASSERT_TRUE(rig.ctl->resume(rig.now).ok());
   drive();
   EXPECT_EQ(rig.state().refusal, MotionRefusal::kNone);
   EXPECT_TRUE(is_moving(rig.motion_frames().back()));
@@ -863,6 +866,99 @@ TEST(ControllerRearm, TheCommandTimeoutIsTheCommandersOwnStopAndNeedsNoRearm) {
   rig.run(20ms);
   EXPECT_EQ(rig.state().refusal, MotionRefusal::kNone);
   EXPECT_TRUE(is_moving(rig.motion_frames().back()));
+}
+
+// A zero twist is no re-arm (a navigation stack publishes them by itself): only resume, unless
+// the owner opted in with rearm_on_zero_twist.
+TEST(ControllerRearm, AZeroTwistRearmsOnlyWhereTheOwnerOptedIn) {
+  for (const bool opted_in : {false, true}) {
+    ControllerConfig cfg;
+    cfg.rearm_on_zero_twist = opted_in;
+    Rig rig(cfg);
+    rig.connect_in_can_mode();
+    EXPECT_EQ(rig.state().zero_twist_rearms, opted_in);
+    rig.vehicle = 0x01;  // e-stop
+    rig.run(40ms);
+    rig.vehicle = 0x00;  // released
+    rig.run(40ms);
+    ASSERT_EQ(rig.state().refusal, MotionRefusal::kRearmRequired);
+    for (int i = 0; i < 10; ++i) {
+      ASSERT_TRUE(rig.ctl->set_command(BodyTwist{}, rig.now).ok());
+      rig.run(20ms);
+    }
+    rig.bus.clear_sent();
+    for (int i = 0; i < 10; ++i) {
+      ASSERT_TRUE(rig.ctl->set_command(BodyTwist{0.5, 0, 0}, rig.now).ok());
+      rig.run(20ms);
+    }
+    EXPECT_EQ(rig.state().refusal, opted_in ? MotionRefusal::kNone : MotionRefusal::kRearmRequired)
+        << "opted in: " << opted_in;
+    EXPECT_EQ(is_moving(rig.motion_frames().back()), opted_in) << "opted in: " << opted_in;
+    EXPECT_EQ(rig.state().counters.rearms, opted_in ? 1u : 0u);
+  }
+}
+
+TEST(ControllerCommand, ANonFiniteComponentInAnyOfTheSixIsRefusedByNameWhileItLasts) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  struct Case {
+    MotionRequest request;
+    const char* named;
+  };
+  const Case cases[] = {
+      {MotionRequest{BodyTwist{nan, 0, 0}}, "linear.x is NaN"},
+      {MotionRequest{BodyTwist{0.3, -inf, 0}}, "linear.y is infinite"},
+      {MotionRequest{BodyTwist{0.3, 0, 0}, std::nullopt, OutOfPlaneTwist{nan, 0, 0}},
+       "linear.z is NaN"},
+      {MotionRequest{BodyTwist{0.3, 0, 0}, std::nullopt, OutOfPlaneTwist{0, inf, 0}},
+       "angular.x is infinite"},
+      {MotionRequest{BodyTwist{0.3, 0, 0}, std::nullopt, OutOfPlaneTwist{0, 0, nan}},
+       "angular.y is NaN"},
+      {MotionRequest{BodyTwist{0.3, 0, inf}}, "angular.z is infinite"},
+  };
+  for (const Case& c : cases) {
+    Rig rig;
+    rig.connect_in_can_mode();
+    ASSERT_TRUE(rig.ctl->set_command(BodyTwist{0.3, 0, 0}, rig.now).ok());
+    rig.run(40ms);
+    ASSERT_TRUE(is_moving(rig.motion_frames().back()));
+    // A stream of the bad twist, 1 s: refused, named, stopped the whole time.
+    for (int i = 0; i < 20; ++i) {
+      const Status st = rig.ctl->set_command(c.request, rig.now);
+      ASSERT_FALSE(st.ok());
+      EXPECT_EQ(st.error().code, Errc::kNotFinite);
+      EXPECT_NE(st.error().message.find(c.named), std::string::npos) << st.error().message;
+      rig.run(50ms);
+      EXPECT_EQ(rig.state().refusal, MotionRefusal::kInvalidCommand) << c.named;
+      EXPECT_EQ(rig.state().invalid_command, c.named);
+      EXPECT_TRUE(is_zero(motion_of(rig.motion_frames().back()))) << c.named;
+    }
+    EXPECT_EQ(rig.state().counters.invalid_commands, 20u);
+    // The next valid twist drives again (the commander's own mistake: no re-arm).
+    ASSERT_TRUE(rig.ctl->set_command(BodyTwist{0.3, 0, 0}, rig.now).ok());
+    rig.run(40ms);
+    EXPECT_EQ(rig.state().refusal, MotionRefusal::kNone);
+    EXPECT_TRUE(rig.state().invalid_command.empty());
+    EXPECT_TRUE(is_moving(rig.motion_frames().back()));
+    // A bad stream that stops: the command timeout takes over the naming.
+    ASSERT_FALSE(rig.ctl->set_command(c.request, rig.now).ok());
+    rig.run(600ms);
+    EXPECT_EQ(rig.state().refusal, MotionRefusal::kCmdTimeout);
+  }
+}
+
+TEST(ControllerCommand, TheModesADriverCanForceAreTheProfilesOwn) {
+  using M = MotionMode;
+  EXPECT_EQ(drivable_modes(manual_profile()),
+            (std::vector<M>{M::kAckermann, M::kOblique, M::kSpin}));
+  EXPECT_EQ(drivable_modes(*protocol_preset("agx_v2")),
+            (std::vector<M>{M::kAckermann, M::kOblique, M::kSpin, M::kSideSlip}));
+  const Status st = check_drivable(M::kSideSlip, manual_profile());
+  ASSERT_FALSE(st.ok());
+  EXPECT_EQ(st.error().message,
+            "side_slip: unsupported by protocol manual (it drives ackermann, oblique, spin)");
+  EXPECT_FALSE(check_drivable(M::kPark, *protocol_preset("agx_v2")).ok());
+  EXPECT_TRUE(check_drivable(M::kSideSlip, *protocol_preset("agx_v2")).ok());
 }
 
 TEST(ControllerRearm, StartUpInStandbyIsNotAnInvoluntaryStop) {
@@ -1036,7 +1132,7 @@ TEST(ControllerProfile, SendsAndReadsTheProfilesWire) {
   // Park mode (agx_v2 mode 3) is known to the protocol but cannot be driven in: no motion.
   st.error_bits = 0;
   feed(st);
-  ASSERT_TRUE(ctl.set_command(BodyTwist{}, now).ok());  // the re-arm after the critical error
+  ASSERT_TRUE(ctl.resume(now).ok());  // the re-arm after the critical error
   ASSERT_TRUE(ctl.set_command(BodyTwist{0.3, 0, 0.1}, now).ok());
   mm.mode = MotionMode::kPark;
   feed(mm);

@@ -98,6 +98,26 @@ TEST(Diagnostics, SteerFirstAndBelowMinimumAreShown) {
   EXPECT_NE(below.message.find("below_minimum"), std::string::npos) << below.message;
 }
 
+TEST(Diagnostics, AnInvalidCommandIsAWarningNamingTheField) {
+  auto s = healthy();
+  s.controller.refusal = MotionRefusal::kInvalidCommand;
+  s.controller.invalid_command = "linear.z is NaN";
+  s.controller.counters.invalid_commands = 12;
+  const DiagnosticGroup d = diagnose_control(s);
+  EXPECT_EQ(d.level, L::kWarn);
+  EXPECT_NE(d.message.find("linear.z is NaN"), std::string::npos) << d.message;
+  EXPECT_EQ(value(d, "cmd_vel refused (NaN or inf)"), "12");
+}
+
+TEST(Diagnostics, TheOdometrysGapIsShown) {
+  auto s = healthy();
+  s.odometry.gaps = 2;
+  s.odometry.last_gap = 2040ms;
+  const DiagnosticGroup d = diagnose_link(s);
+  EXPECT_EQ(value(d, "Odometry gaps"), "2");
+  EXPECT_EQ(value(d, "Last odometry gap (s)"), "2.04");
+}
+
 TEST(Diagnostics, IdleAfterCmdVelTimeoutIsOk) {
   auto s = healthy();
   s.controller.refusal = MotionRefusal::kCmdTimeout;

@@ -305,8 +305,11 @@ TEST(Driver, ResumeIsRefusedWhileTheEstopIsPressedAndRearmsAfter) {
   EXPECT_GT(rig.sim().snapshot().speed, 0.4);
 }
 
+// Where the owner opted in to the zero twist's re-arm (rearm_on_zero_twist).
 TEST(Driver, AZeroTwistInTheSameBatchAsAMovingOneStillRearms) {
-  DriverRig rig;
+  DriverConfig config;
+  config.controller.rearm_on_zero_twist = true;
+  DriverRig rig(config);
   ASSERT_TRUE(rig.run_until([&] { return ready(*rig.snapshot()); }, 2s));
   rig.sim().with_chassis([](sim::VirtualChassis& c) {
     c.set_emergency_stop(true);

@@ -79,10 +79,20 @@ void inject(IdentifyRig& rig, const std::string& line) {
 
 // A driver ready to drive the manual chassis (forced settings), its events recorded.
 struct Ready {
-  IdentifyRig rig{"sim", test::forced_config(preset("manual"))};
+  explicit Ready(DriverConfig config = test::forced_config(preset("manual")))
+      : rig{"sim", std::move(config)} {
+    EXPECT_TRUE(rig.wait_ready());
+  }
+  IdentifyRig rig;
   Recorder events{rig.driver()};
-  Ready() { EXPECT_TRUE(rig.wait_ready()); }
 };
+
+// The owner's opt-in: a zero twist re-arms too (ControllerConfig::rearm_on_zero_twist).
+DriverConfig zero_twist_rearms() {
+  DriverConfig c = test::forced_config(preset("manual"));
+  c.controller.rearm_on_zero_twist = true;
+  return c;
+}
 
 // ---- names, words, the ring -------------------------------------------------------------------
 
@@ -225,8 +235,9 @@ TEST(DriverEvents, StartingUpSaysTheBusTheLinkTheControlModeAndWhenMotionIsAccep
   }
 }
 
+// (With the opt-in: a zero twist is the re-arm here; without it only resume is, below.)
 TEST(DriverEvents, ASilentChassisIsSaidThenHeardAgainAndTheLatchNeedsARearm) {
-  Ready r;
+  Ready r(zero_twist_rearms());
   r.rig.command({0.3, 0.0, 0.0});
   r.rig.run_for(300ms);
   const std::size_t before = r.events.size();
@@ -303,6 +314,49 @@ TEST(DriverEvents, AnEmergencyStopIsRefusedLatchedAndResumeIsAnswered) {
   EXPECT_TRUE(r.events.find(EventKind::kRefusalChanged, "chassis accepts motion", released));
 }
 
+TEST(DriverEvents, ByDefaultAZeroTwistClearsNoLatchAndResumeSaysItDid) {
+  Ready r;
+  r.rig.command({0.3, 0.0, 0.0});
+  r.rig.run_for(300ms);
+  inject(r.rig, "silent 0.5");
+  r.rig.run_for(1s);
+  const std::size_t heard = r.events.size();
+  ASSERT_TRUE(r.events.find(EventKind::kRefusalChanged, "rearm_required after link_lost", 0))
+      << r.events.dump();
+  r.rig.command({0.0, 0.0, 0.0});
+  r.rig.run_for(200ms);
+  r.rig.command({0.3, 0.0, 0.0});
+  r.rig.run_for(500ms);
+  EXPECT_FALSE(r.events.find(EventKind::kRearmCleared, "", heard)) << r.events.dump();
+  r.rig.driver().resume();
+  r.rig.run_for(200ms);
+  const DriverEvent* cleared = r.events.find(EventKind::kRearmCleared, "", heard);
+  ASSERT_TRUE(cleared) << r.events.dump();
+  EXPECT_TRUE(cleared->as<RearmEvent>()->by_resume);
+  EXPECT_EQ(describe(*cleared), "re-armed (resume) after link_lost");
+}
+
+// A client calling clear_errors at 20 Hz: the first answer is reported, the identical ones after
+// it are counted, and the next report (after repeated_request_interval) says how many.
+TEST(DriverEvents, RequestsAnsweredAlikeAreReportedOnceThenCounted) {
+  Ready r;
+  const std::size_t settled_before = r.events.of(EventKind::kRequestSettled).size();
+  for (int i = 0; i < 30; ++i) {
+    ASSERT_TRUE(r.rig.driver().clear_errors(0x00).ok());
+    r.rig.run_for(50ms);
+  }
+  r.rig.run_for(100ms);
+  EXPECT_EQ(r.events.of(EventKind::kRequestSettled).size(), settled_before + 1) << r.events.dump();
+  r.rig.run_for(10s);
+  ASSERT_TRUE(r.rig.driver().clear_errors(0x00).ok());
+  r.rig.run_for(100ms);
+  const auto settled = r.events.of(EventKind::kRequestSettled);
+  ASSERT_EQ(settled.size(), settled_before + 2) << r.events.dump();
+  EXPECT_EQ(settled.back().as<RequestEvent>()->repeated, 29u);
+  EXPECT_TRUE(contains(describe(settled.back()), "(29 more answered alike since the last report)"))
+      << describe(settled.back());
+}
+
 TEST(DriverEvents, TheControlModeUnderTheRemoteControl) {
   Ready r;
   const std::size_t before = r.events.size();
@@ -357,8 +411,8 @@ TEST(DriverEvents, NonFiniteCommandsAreReportedAtMostOnceASecondWithTheCount) {
   ASSERT_EQ(refused.size(), 3u) << r.events.dump();
   EXPECT_EQ(refused[0].severity, Severity::kError);
   EXPECT_EQ(describe(refused[0]),
-            "cmd_vel refused, chassis stopped: command refused (NaN or infinite component): the "
-            "chassis is commanded to stop");
+            "cmd_vel refused, chassis stopped: command refused (linear.x is NaN): the chassis is "
+            "commanded to stop");
   EXPECT_EQ(refused[1].as<CommandRefusedEvent>()->count, 20u);
   EXPECT_TRUE(contains(describe(refused[1]), "(20 refused since the last report)"));
   EXPECT_GE(refused[1].time - refused[0].time, 1s);

@@ -167,6 +167,10 @@ TEST(DriverPark, RefusedByNameWhereTheModeNumberingHasNoPark) {
     EXPECT_EQ(r.state, RequestOutcome::State::kFailed) << variant;
     EXPECT_NE(r.message.find("park: unsupported by protocol"), std::string::npos) << r.message;
     EXPECT_FALSE(rig.snap()->controller.park_requested);
+    // Releasing a park the chassis does not have is refused all the same, never a success.
+    const RequestOutcome off = rig.outcome(rig.driver().set_park(false));
+    EXPECT_EQ(off.state, RequestOutcome::State::kFailed) << variant;
+    EXPECT_NE(off.message.find("park: unsupported by protocol"), std::string::npos) << off.message;
     rig.drive({0.3, 0, 0}, 1s);
     EXPECT_EQ(rig.snap()->controller.refusal, MotionRefusal::kNone) << variant;
   }

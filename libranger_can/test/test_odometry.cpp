@@ -259,6 +259,40 @@ TEST(OdometryTime, FirstFrameBackwardsJumpsAndLongGapsAreNotIntegrated) {
   EXPECT_NEAR(odom.state().pose.x, 0.04, 1e-9);
 }
 
+// A gap in the feedback (longer than max_step) is not integrated, but not forgotten either: the
+// pose variance grows by what the chassis could have moved in it at its limits, and the state
+// says how long it was. An interval up to max_step is integrated and is no gap.
+TEST(OdometryTime, AGapGrowsTheCovarianceByWhatTheChassisCouldHaveMovedAndIsSaid) {
+  OdometryConfig cfg;
+  cfg.limits.max_linear_speed = 1.2;
+  Odometry odom(cfg);
+  Chassis chassis;
+  Timestamp t = chassis.drive(odom, {0.5, 0, 0}, Timestamp{5s}, 1s);
+  t = chassis.drive(odom, {0.5, 0, 0}, t + 400ms, 100ms);  // 400 ms: integrated
+  EXPECT_EQ(odom.state().gaps, 0u);
+  EXPECT_EQ(odom.state().last_gap, 0ns);
+  const OdometryState before = odom.state();
+  chassis.feed(odom, {0.5, 0, 0}, t + 2s);
+  const OdometryState& after = odom.state();
+  EXPECT_EQ(after.gaps, 1u);
+  EXPECT_EQ(after.last_gap, 2s);
+  EXPECT_EQ(after.last_gap_end, t + 2s);
+  EXPECT_DOUBLE_EQ(after.pose.x, before.pose.x) << "a gap is not integrated";
+  const double reach = 1.2 * 2.0;
+  EXPECT_NEAR(after.pose_variance[0] - before.pose_variance[0], reach * reach, 1e-9);
+  EXPECT_NEAR(after.pose_variance[1] - before.pose_variance[1], reach * reach, 1e-9);
+  const double turn = std::min(max_yaw_rate(cfg.limits, cfg.geometry) * 2.0, M_PI);
+  EXPECT_NEAR(after.pose_variance[2] - before.pose_variance[2], turn * turn, 1e-9);
+  // The fastest turn is a spin at the wheel-speed limit or full lock at full speed.
+  const double spin = interp::spin_yaw_rate_from_wheel_speed(
+      cfg.limits.max_spin_wheel_speed, cfg.geometry.wheelbase, cfg.geometry.track);
+  EXPECT_GE(max_yaw_rate(cfg.limits, cfg.geometry), spin);
+  // Integration goes on after it.
+  chassis.drive(odom, {0.5, 0, 0}, t + 2s, 1s);
+  EXPECT_NEAR(odom.state().pose.x - before.pose.x, 0.5, 0.01);
+  EXPECT_EQ(odom.state().gaps, 1u);
+}
+
 TEST(OdometryRobustness, AbsurdSteeringOnTheWireNeverPoisonsThePose) {
   // 0x221 steering of 120 deg in Ackermann mode is outside the protocol but encodable.
   Odometry odom(OdometryConfig{{}, OdometrySource::kMotion});

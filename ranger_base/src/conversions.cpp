@@ -53,6 +53,12 @@ ranger::BodyTwist to_body_twist(const geometry_msgs::Twist& twist) {
   return {twist.linear.x, twist.linear.y, twist.angular.z};
 }
 
+ranger::MotionRequest to_motion_request(const geometry_msgs::Twist& twist) {
+  return ranger::MotionRequest{
+      to_body_twist(twist), std::nullopt,
+      ranger::OutOfPlaneTwist{twist.linear.z, twist.angular.x, twist.angular.y}};
+}
+
 bool has_non_planar_components(const geometry_msgs::Twist& twist) {
   return twist.linear.z != 0.0 || twist.angular.x != 0.0 || twist.angular.y != 0.0;
 }
@@ -244,6 +250,9 @@ ranger_msgs::SystemState to_system_state(const ranger::DriverSnapshot& snapshot,
   out.header.stamp = stamp;
   out.link_up = state.link == ranger::LinkState::kConnected;
   out.motion_known = snapshot.motion_known;
+  out.odometry_gap = ranger::seconds(snapshot.odometry.last_gap);
+  out.odometry_gap_end = to_ros_time(snapshot.odometry.last_gap_end);
+  out.odometry_gaps = static_cast<std::uint32_t>(snapshot.odometry.gaps);
   if (const auto& s = feedback.system_status) {
     out.vehicle_status = s->value.vehicle_status_raw;
     out.vehicle_status_name = std::string(ranger::to_string(s->value.vehicle_status));

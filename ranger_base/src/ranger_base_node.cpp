@@ -1,7 +1,8 @@
 // ranger_base_node: the RANGER driver as an executable (ranger_nodelet.cpp: the same as a
 // nodelet; both run ranger_base::RangerNode). Reads and checks its parameters (exit status 2 naming
-// every bad one), runs until SIGINT/SIGTERM or `rosnode kill`, and stops the chassis (a zero
-// motion command, logged and published on cmd_vel_out) before ROS goes down.
+// every bad one; `ranger_base_node --check-parameters` checks them alone, parameter_check.hpp),
+// runs until SIGINT/SIGTERM or `rosnode kill`, and stops the chassis (a zero motion command,
+// logged and published on cmd_vel_out) before ROS goes down.
 //
 // Shutdown is prompt: SIGINT, SIGTERM and the master's shutdown request (`rosnode kill`) only
 // write to a pipe the main thread waits on; the main thread then stops the chassis while ROS is
@@ -23,11 +24,13 @@
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
+#include <iostream>
 #include <mutex>
 #include <sstream>
 #include <string>
 #include <thread>
 
+#include "ranger_base/parameter_check.hpp"
 #include "ranger_base/ranger_node.hpp"
 
 namespace ros {
@@ -103,6 +106,11 @@ void wait_for_stop_request() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // ranger_bringup's launch files check the parameters before anything starts
+  // (parameter_check.hpp).
+  if (argc == 2 && std::strcmp(argv[1], "--check-parameters") == 0) {
+    return ranger_base::check_parameters(std::cin, std::cerr);
+  }
   ros::init(argc, argv, "ranger_base_node", ros::init_options::NoSigintHandler);
   if (::pipe2(g_wake, O_CLOEXEC | O_NONBLOCK) != 0) {
     ROS_FATAL("ranger_base_node: cannot create its wake-up pipe: %s", std::strerror(errno));

@@ -260,12 +260,12 @@ void RangerNode::shutdown() {
 // -----------------------------------------------------------------------------------
 
 void RangerNode::on_cmd_vel(const geometry_msgs::Twist::ConstPtr& msg) {
-  const ranger::BodyTwist twist = to_body_twist(*msg);
-  if (has_non_planar_components(*msg)) {
+  // All six fields go to the driver: the library refuses a NaN or an infinity in any of them. A
+  // refusal (NaN, not connected) is the driver's event, logged with the others.
+  const ranger::Status st = driver_->command(to_motion_request(*msg));
+  if (st && has_non_planar_components(*msg)) {
     ROS_WARN_THROTTLE(5.0, "cmd_vel: linear.z, angular.x and angular.y are ignored (planar base)");
   }
-  // A refusal (NaN, not connected) is the driver's event, logged with the others.
-  (void)driver_->command(ranger::MotionRequest{twist, std::nullopt});
 }
 
 void RangerNode::on_sent(const ranger::SentEvent& e) {
@@ -382,25 +382,28 @@ bool RangerNode::on_set_motion_mode(ranger_msgs::SetMotionMode::Request& req,
                                                                   {Req::AUTOMATIC, std::nullopt}};
   const auto known = kModes.find(req.mode);
   if (known == kModes.end()) {
+    // The valid values are the ones valid on this chassis (the settings in use).
+    const auto profile = driver_->snapshot()->profile;
+    std::vector<std::string> valid;
+    for (const auto& [number, m] : kModes) {
+      if (m && ranger::can_drive_in(*m, profile)) {
+        valid.push_back(std::to_string(number) + " (" + std::string(ranger::to_string(*m)) + ")");
+      }
+    }
     res.success = false;
-    res.message = "mode " + std::to_string(req.mode) +
-                  " unknown: use 0 (Ackermann), 1 (oblique), 2 (spin), 4 (side slip) or 255 "
-                  "(automatic)";
+    res.message = "mode " + std::to_string(req.mode) + " unknown: under protocol " +
+                  profile.revision + " use " + join(valid) + " or " +
+                  std::to_string(Req::AUTOMATIC) + " (automatic)";
+    ROS_WARN("set_motion_mode: %s", res.message.c_str());
     return true;
   }
   const std::optional<M> mode = known->second;
-  if (mode) {
-    const auto s = driver_->snapshot();
-    if (!ranger::can_drive_in(*mode, s->profile)) {
-      res.success = false;
-      res.message = std::string(ranger::to_string(*mode)) + ": unsupported by protocol " +
-                    s->profile.revision + " (its motion-mode numbering has no " +
-                    std::string(ranger::to_string(*mode)) + " mode; side slip is the MINI V1's)";
-      ROS_WARN("set_motion_mode: %s", res.message.c_str());
-      return true;
-    }
+  if (const ranger::Status st = driver_->set_motion_mode(mode); !st) {
+    res.success = false;
+    res.message = st.error().message;
+    ROS_WARN("set_motion_mode: %s", res.message.c_str());
+    return true;
   }
-  driver_->set_motion_mode(mode);
   res.success = true;
   res.message = mode ? "motion mode pinned to " + std::string(ranger::to_string(*mode)) +
                            " (the switch happens at standstill)"

@@ -3,7 +3,9 @@
 
 #include <tf2/utils.h>
 
+#include <chrono>
 #include <cmath>
+#include <limits>
 #include <set>
 
 #include <ranger_can/control/geometry.hpp>
@@ -581,6 +583,58 @@ TEST(Actuators, EightMotorsWithTheirJoints) {
 TEST(Time, BusStampsAreRosTime) {
   EXPECT_NEAR(to_ros_time(std::chrono::seconds(1700000000) + 500ms).toSec(), 1700000000.5, 1e-6);
   EXPECT_TRUE(to_ros_time(ranger::Timestamp{0}).isZero());
+}
+
+TEST(CmdVel, EverySixFieldsReachTheLibrarysCheck) {
+  geometry_msgs::Twist t;
+  t.linear.x = 0.3;
+  t.linear.z = std::numeric_limits<double>::quiet_NaN();
+  const ranger::MotionRequest r = to_motion_request(t);
+  EXPECT_DOUBLE_EQ(r.twist.vx, 0.3);
+  EXPECT_FALSE(r.mode.has_value());
+  const ranger::Status st = ranger::check_finite(r);
+  ASSERT_FALSE(st.ok());
+  EXPECT_EQ(st.error().message, "linear.z is NaN");
+  t.linear.z = 0.0;
+  t.angular.x = 1.0;
+  t.angular.y = -std::numeric_limits<double>::infinity();
+  EXPECT_EQ(ranger::check_finite(to_motion_request(t)).error().message, "angular.y is infinite");
+  t.angular.y = 0.5;
+  EXPECT_TRUE(ranger::check_finite(to_motion_request(t)).ok());
+  EXPECT_DOUBLE_EQ(to_motion_request(t).out_of_plane.wx, 1.0);
+}
+
+TEST(SystemState, AnInvalidCommandAndTheOdometrysGapAreSaid) {
+  ranger::DriverSnapshot snap;
+  auto& c = snap.controller;
+  c.link = ranger::LinkState::kConnected;
+  c.refusal = ranger::MotionRefusal::kInvalidCommand;
+  c.invalid_command = "linear.z is NaN";
+  snap.odometry.last_gap = std::chrono::milliseconds(2040);
+  snap.odometry.last_gap_end = std::chrono::seconds(1700000000);
+  snap.odometry.gaps = 3;
+  const auto m = to_system_state(snap, ros::Time(1.0));
+  EXPECT_EQ(m.motion_inhibited_reason, "invalid_command");
+  EXPECT_NE(m.motion_inhibited_detail.find("linear.z is NaN"), std::string::npos)
+      << m.motion_inhibited_detail;
+  EXPECT_NEAR(m.odometry_gap, 2.04, 1e-9);
+  EXPECT_EQ(m.odometry_gap_end, ros::Time(1700000000.0));
+  EXPECT_EQ(m.odometry_gaps, 3u);
+}
+
+// Only resume re-arms; the words name the zero twist only where the owner opted in to it.
+TEST(SystemState, TheRearmWordsFollowTheOptIn) {
+  ranger::DriverSnapshot snap;
+  auto& c = snap.controller;
+  c.link = ranger::LinkState::kConnected;
+  c.refusal = ranger::MotionRefusal::kRearmRequired;
+  c.latched_causes = 0u | ranger::StopCause::kEstop;
+  EXPECT_EQ(describe_refusal(snap),
+            "rearm_required after emergency_stop: call resume to drive again");
+  c.zero_twist_rearms = true;
+  EXPECT_EQ(describe_refusal(snap),
+            "rearm_required after emergency_stop: call resume (or send a zero cmd_vel: "
+            "rearm_on_zero_twist) to drive again");
 }
 
 TEST(CmdVel, PlanarComponentsOnly) {

@@ -163,6 +163,11 @@ class NodeSim : public ::testing::Test {
              settings_decided(*s) && cmd_pub_.getNumSubscribers() > 0 &&
              inject_pub_.getNumSubscribers() > 0 && truth_.get() && odom_.get();
     })) << "the node never reached CAN command mode with its protocol settings decided";
+    // A test that ended latched (link loss, an e-stop) is re-armed: only resume does that.
+    if (state_.get()->rearm_required) {
+      const auto resumed = call_resume();
+      ASSERT_TRUE(resumed.success) << resumed.message;
+    }
     stop_and_settle();
   }
 
@@ -872,14 +877,16 @@ TEST_F(Safety, RemoteControlIsFinalUntilResume) {
   ASSERT_TRUE(drive_for_states(twist(0.3, 0, 0), 15));
   EXPECT_EQ(state_.get()->control_mode, SystemState::CONTROL_MODE_STANDBY);
   EXPECT_LT(speed(*truth_.get()), 1e-3);
-  // A zero cmd_vel re-arms the latch, but only resume asks for CAN control again.
-  cmd_pub_.publish(twist(0, 0, 0));
-  ASSERT_TRUE(wait_for([] {
+  // A zero cmd_vel changes nothing: neither the re-arm nor CAN control; resume does both.
+  ASSERT_TRUE(drive_for_states(twist(0, 0, 0), 5));
+  {
     const auto s = state_.get();
-    return !s->rearm_required && s->reclaim_blocked;
-  }));
-  EXPECT_EQ(state_.get()->motion_inhibited_detail,
-            "remote control had the chassis: call resume to take CAN control");
+    EXPECT_TRUE(s->rearm_required);
+    EXPECT_TRUE(s->reclaim_blocked);
+    EXPECT_EQ(s->control_mode, SystemState::CONTROL_MODE_STANDBY);
+    EXPECT_EQ(s->motion_inhibited_detail,
+              "rearm_required after remote: call resume to drive again");
+  }
   const auto resumed = call_resume();
   EXPECT_TRUE(resumed.success) << resumed.message;
   ASSERT_TRUE(wait_for([] {
@@ -960,9 +967,238 @@ TEST_F(Safety, OdometryOnlyWhileTheChassisIsHeardAndItResumesFromTheLastPose) {
   EXPECT_GT(after.header.stamp, before.header.stamp);
   EXPECT_TRUE(logged("chassis heard again", t));
   EXPECT_EQ(odom_stamp_regressions_, 0);
-  // The link loss latched: a zero cmd_vel (stop_and_settle in SetUp) or resume re-arms.
+  // The link loss latched: resume re-arms (the next test's SetUp calls it).
   EXPECT_TRUE(wait_for([] { return state_.get()->rearm_required; }));
   EXPECT_TRUE(contains(state_.get()->latched_causes, "link_lost"));
+}
+
+// ---- the adversarial trial through ROS (node_sim.test on sim, node_sim_adversarial_agx.test on
+// sim:agx_v2): what only the ROS edge can get wrong, judged by the virtual chassis's ground truth
+// (sim/ground_truth) and what the node says (system_state, /diagnostics, /rosout). The rest of
+// the trial runs in lock-step in libranger_can/test/test_adversarial.cpp.
+
+class Adversarial : public Safety {
+ protected:
+  static geometry_msgs::Point position() { return truth_.get()->pose.pose.position; }
+  static double moved_since(const geometry_msgs::Point& p) {
+    const auto q = position();
+    return std::hypot(q.x - p.x, q.y - p.y);
+  }
+  // The system_state messages received since index `from`.
+  static std::vector<SystemState> states_since(std::size_t from) {
+    std::lock_guard<std::mutex> lock(commands_mutex_);
+    return std::vector<SystemState>(states_.begin() + static_cast<std::ptrdiff_t>(from),
+                                    states_.end());
+  }
+  static std::size_t states_seen() {
+    std::lock_guard<std::mutex> lock(commands_mutex_);
+    return states_.size();
+  }
+  // The node's log lines at `level` or above after `since` that contain `text`.
+  static int log_lines(const std::string& text, const ros::Time& since, std::uint8_t level) {
+    std::lock_guard<std::mutex> lock(commands_mutex_);
+    return static_cast<int>(std::count_if(logs_.begin(), logs_.end(), [&](const auto& l) {
+      return l.header.stamp >= since && l.level >= level && l.msg.find(text) != std::string::npos;
+    }));
+  }
+};
+
+// e-stop, a remote takeover handed back with SWB, link loss: each followed by a zero cmd_vel and
+// then 0.5 m/s for 4 s (40 of the node's 10 Hz states) moves nothing; resume drives.
+TEST_F(Adversarial, AfterAStopAZeroCmdVelAndFourSecondsOfMotionMoveNothingUntilResume) {
+  struct Stop {
+    const char* cause;
+    const char* begin;
+    const char* end;
+  };
+  for (const Stop& stop :
+       {Stop{"emergency_stop", "estop on", "estop off"}, Stop{"remote", "remote on", "remote can"},
+        Stop{"link_lost", "silent on", "silent off"}}) {
+    SCOPED_TRACE(stop.cause);
+    ASSERT_TRUE(
+        drive_until(twist(0.5, 0, 0), [] { return truth_.get()->twist.twist.linear.x > 0.4; }));
+    const Injected undo{{stop.end}};
+    inject(stop.begin);
+    ASSERT_TRUE(drive_until(twist(0.5, 0, 0), [] {
+      return speed(*truth_.get()) < 1e-3 && state_.get()->rearm_required;
+    }));
+    inject(stop.end);
+    ASSERT_TRUE(drive_until(twist(0.5, 0, 0), [&] {
+      const auto s = state_.get();
+      return s->link_up && s->control_mode == SystemState::CONTROL_MODE_CAN &&
+             s->active_causes.empty() && s->motion_inhibited_reason == "rearm_required" &&
+             contains(s->latched_causes, stop.cause);
+    }));
+    ASSERT_TRUE(drive_for_states(twist(0, 0, 0), 3));  // what a planner at its goal publishes
+    const auto at = position();
+    const std::size_t from = states_seen();
+    ASSERT_TRUE(drive_for_states(twist(0.5, 0, 0), 40));
+    EXPECT_EQ(moved_since(at), 0.0) << "moved without resume";
+    EXPECT_LT(speed(*truth_.get()), 1e-3);
+    for (const auto& s : states_since(from)) {
+      EXPECT_EQ(s.motion_inhibited_reason, "rearm_required");
+      EXPECT_NE(s.motion_inhibited_detail.find("call resume"), std::string::npos)
+          << s.motion_inhibited_detail;
+      EXPECT_EQ(s.motion_inhibited_detail.find("zero"), std::string::npos)
+          << "a zero cmd_vel is no re-arm: " << s.motion_inhibited_detail;
+    }
+    const auto resumed = call_resume();
+    EXPECT_TRUE(resumed.success) << resumed.message;
+    EXPECT_TRUE(
+        drive_until(twist(0.5, 0, 0), [] { return truth_.get()->twist.twist.linear.x > 0.4; }));
+    stop_and_settle();
+  }
+}
+
+// A NaN or an infinity in any of the six fields ({linear: {x: 0.3, z: .nan}} and the like):
+// nothing moves, and system_state (and /diagnostics) name the refusal for as long as it lasts.
+TEST_F(Adversarial, ANonFiniteFieldMovesNothingAndIsNamedWhileItLasts) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  struct Field {
+    const char* name;
+    double geometry_msgs::Vector3::*axis;
+    bool angular;
+  };
+  const Field fields[] = {{"linear.x", &geometry_msgs::Vector3::x, false},
+                          {"linear.y", &geometry_msgs::Vector3::y, false},
+                          {"linear.z", &geometry_msgs::Vector3::z, false},
+                          {"angular.x", &geometry_msgs::Vector3::x, true},
+                          {"angular.y", &geometry_msgs::Vector3::y, true},
+                          {"angular.z", &geometry_msgs::Vector3::z, true}};
+  int i = 0;
+  for (const Field& f : fields) {
+    const double bad = i++ % 2 ? inf : nan;
+    const std::string named = std::string(f.name) + (std::isnan(bad) ? " is NaN" : " is infinite");
+    SCOPED_TRACE(named);
+    geometry_msgs::Twist t = twist(0.3, 0, 0);
+    geometry_msgs::Vector3& vector = f.angular ? t.angular : t.linear;
+    vector.*(f.axis) = bad;
+    const auto at = position();
+    ASSERT_TRUE(drive_for_states(t, 2));
+    const std::size_t from = states_seen();
+    ASSERT_TRUE(drive_for_states(t, 8));
+    for (const auto& s : states_since(from)) {
+      EXPECT_EQ(s.motion_inhibited_reason, "invalid_command");
+      EXPECT_NE(s.motion_inhibited_detail.find(named), std::string::npos)
+          << s.motion_inhibited_detail;
+    }
+    if (std::string(f.name) == "linear.z") {  // the issue's {x: 0.3, z: .nan}: diagnostics too
+      ASSERT_TRUE(drive_until(t, [&] {
+        const auto d = diagnostic("Control mode");
+        return d && d->message.find(named) != std::string::npos;
+      }));
+    }
+    EXPECT_EQ(moved_since(at), 0.0);
+    ASSERT_TRUE(drive_for_states(twist(0, 0, 0), 3));  // a valid twist ends it
+    EXPECT_EQ(state_.get()->motion_inhibited_reason, "");
+  }
+}
+
+// Service requests the chassis cannot honour are refused, listing only what is valid here; a
+// request repeated at a high rate does not fill the log.
+TEST_F(Adversarial, BadServiceArgumentsAreRefusedAndRepeatedOnesDoNotFloodTheLog) {
+  const bool manual = state_.get()->protocol_profile.rfind("manual", 0) == 0;
+  ros::ServiceClient modes = nh_->serviceClient<ranger_msgs::SetMotionMode>("set_motion_mode");
+  ranger_msgs::SetMotionMode m;
+  m.request.mode = 7;
+  ASSERT_TRUE(modes.call(m));
+  EXPECT_FALSE(m.response.success);
+  EXPECT_NE(m.response.message.find("0 (ackermann), 1 (oblique), 2 (spin)"), std::string::npos)
+      << m.response.message;
+  EXPECT_EQ(m.response.message.find("side_slip") != std::string::npos, !manual)
+      << "side slip is valid only where the chassis has it: " << m.response.message;
+  ros::ServiceClient park = nh_->serviceClient<std_srvs::SetBool>("park");
+  std_srvs::SetBool p;
+  p.request.data = false;
+  ASSERT_TRUE(park.call(p));
+  if (manual) {
+    EXPECT_FALSE(p.response.success) << "no park to release: " << p.response.message;
+    EXPECT_NE(p.response.message.find("park: unsupported by protocol manual"), std::string::npos)
+        << p.response.message;
+  } else {
+    EXPECT_TRUE(p.response.success) << p.response.message;
+  }
+
+  // clear_errors as fast as it answers, for 2 s of the node's states: a line, then a count.
+  ros::ServiceClient clear = nh_->serviceClient<ranger_msgs::ClearErrors>("clear_errors");
+  const ros::Time start = ros::Time::now();
+  const std::size_t from = states_seen();
+  int calls = 0;
+  while (states_seen() < from + 20) {
+    ranger_msgs::ClearErrors c;
+    c.request.code = ranger_msgs::ClearErrors::Request::ALL_NON_CRITICAL;
+    ASSERT_TRUE(clear.call(c));
+    ASSERT_TRUE(c.response.success) << c.response.message;
+    ++calls;
+  }
+  ASSERT_GT(calls, 10);
+  // Another request of the kind ends the run of identical answers; its line counts them.
+  ranger_msgs::ClearErrors other;
+  other.request.code = ranger_msgs::ClearErrors::Request::MOTOR1_COMMUNICATION;
+  ASSERT_TRUE(clear.call(other));
+  EXPECT_TRUE(other.response.success) << other.response.message;
+  const ros::Time marker = ros::Time::now();
+  ros::ServiceClient modes2 = nh_->serviceClient<ranger_msgs::SetMotionMode>("set_motion_mode");
+  ranger_msgs::SetMotionMode automatic;
+  automatic.request.mode = ranger_msgs::SetMotionMode::Request::AUTOMATIC;
+  ASSERT_TRUE(modes2.call(automatic));
+  ASSERT_TRUE(logged("set_motion_mode: automatic", marker));  // everything before it is here
+  EXPECT_LE(log_lines("clear_errors 0x00", start, rosgraph_msgs::Log::INFO), 1)
+      << calls << " identical calls";
+  EXPECT_TRUE(logged("more answered alike since the last report", start)) << "the count is said";
+  stop_and_settle();
+}
+
+// 1e6 rad/s at standstill is a saturated rotation (spin at its limit): the warning says so, and
+// never that a translation or a rotation was dropped.
+TEST_F(Adversarial, AHugeRotationAtStandstillIsWarnedAsASaturatedRotation) {
+  const ros::Time start = ros::Time::now();
+  ASSERT_TRUE(drive_until(twist(0, 0, 1e6), [] {
+    return state_.get()->motion_mode == SystemState::MOTION_MODE_SPIN &&
+           std::abs(truth_.get()->twist.twist.angular.z) > 0.5;
+  }));
+  ASSERT_TRUE(drive_for_states(twist(0, 0, 1e6), 10));
+  EXPECT_TRUE(
+      logged("cmd_vel adjusted to what the chassis can do: spin_saturated: asked (vx, vy, "
+             "wz) = (0 m/s, 0 m/s, 1e+06 rad/s)",
+             start, rosgraph_msgs::Log::WARN));
+  EXPECT_EQ(log_lines("dropped", start, rosgraph_msgs::Log::WARN), 0);
+  stop_and_settle();
+}
+
+// Silent for 2 s while driving: system_state and /diagnostics say how long the gap was, and the
+// odometry's covariance grew by what the chassis could have moved in it (its speed limit, 1 m/s
+// in node_sim.test, times the gap).
+TEST_F(Adversarial, OdometryAcrossASilenceSaysTheGapAndGrowsTheCovariance) {
+  ASSERT_TRUE(
+      drive_until(twist(0.5, 0, 0), [] { return truth_.get()->twist.twist.linear.x > 0.4; }));
+  const auto gaps = state_.get()->odometry_gaps;
+  const double variance = odom_.get()->pose.covariance[0];
+  inject("silent 2");
+  ASSERT_TRUE(drive_until(twist(0.5, 0, 0), [] { return !state_.get()->link_up; }));
+  ASSERT_TRUE(drive_until(twist(0.5, 0, 0), [&] {
+    const auto s = state_.get();
+    return s->link_up && s->motion_known && s->odometry_gaps > gaps;
+  }));
+  const auto s = *state_.get();
+  EXPECT_EQ(s.odometry_gaps, gaps + 1);
+  EXPECT_GE(s.odometry_gap, 1.95);
+  EXPECT_GT(s.odometry_gap_end, ros::Time());
+  ASSERT_TRUE(wait_for([&] {
+    const auto o = odom_.get();
+    return o->header.stamp >= s.odometry_gap_end;
+  }));
+  const double reach = kMaxLinearSpeed * s.odometry_gap;
+  EXPECT_GE(odom_.get()->pose.covariance[0], variance + reach * reach - 1e-6);
+  EXPECT_GE(odom_.get()->pose.covariance[7], reach * reach - 1e-6);
+  ASSERT_TRUE(wait_for([&] {
+    const auto d = diagnostic("CAN link");
+    const std::string gap = d ? value_of(*d, "Last odometry gap (s)") : "";
+    return !gap.empty() && gap != "<missing>" &&
+           std::abs(std::atof(gap.c_str()) - s.odometry_gap) < 1e-3;
+  }));
+  stop_and_settle();
 }
 
 // ---- node_sim_faults.test: the virtual chassis boots with motor driver 1's communication fault.

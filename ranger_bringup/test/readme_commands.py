@@ -513,6 +513,15 @@ def call_resume(session, cmd, match):
          "equals": False}])
 
 
+def launch_refused(session, cmd, match):
+    """A launch with an argument the driver refuses: roslaunch exits non-zero, with the driver's
+    reason on the console, before anything starts (nothing is left running)."""
+    rc, out = session.run(cmd.text, timeout=120)
+    assert rc != 0, f"`{cmd.text}` exited 0:\n{out[-3000:]}"
+    assert "the launch is refused before anything starts" in out, out[-3000:]
+    assert f"parameter ~{match.group('name')} = \"{match.group('value')}\"" in out, out[-3000:]
+
+
 def run_ok(session, cmd, match, timeout=120, check=None):
     rc, out = session.run(cmd.text, timeout=timeout)
     assert rc == 0, f"`{cmd.text}` exited {rc}:\n{out[-3000:]}"
@@ -670,6 +679,9 @@ class Rule:
 RULES = [
     Rule(r"rosrun ranger_bringup bringup_can2usb\.bash", can_adapter,
          "run against stand-ins for sudo/ip/modprobe and a fake /sys/class/net with can0"),
+    Rule(r"roslaunch ranger_bringup ranger_minimal\.launch sim:=true (?P<name>protocol):=(?P<value>xyz)",
+         launch_refused, "runs; exits non-zero before anything starts, with the driver's reason "
+         "naming the parameter"),
     Rule(r"roslaunch ranger_bringup (?P<file>ranger_minimal|ranger_sim)\.launch( .*)?",
          launch_robot, "runs until its nodes are up (sim: in CAN command mode with the protocol "
          "settings decided; can0: reporting the missing adapter), in its namespace only"),

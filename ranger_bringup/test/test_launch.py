@@ -60,6 +60,11 @@ ROBOT_LAUNCH_FILES = ["display.launch", "ranger_minimal.launch", "ranger_sim.lau
 @pytest.mark.parametrize("launch", all_launch_files())
 @pytest.mark.parametrize("ns", [[], ["namespace:=r1"]])
 def test_every_launch_file_resolves(launch, ns):
+    if ns and launch == "ranger_sim_two.launch":
+        # Its robots have namespaces of their own (robot1, robot2): an argument it does not
+        # declare is refused, not ignored.
+        assert "unknown argument namespace:=r1" in refused(launch, *ns)
+        return
     assert nodes(launch, *ns)
 
 
@@ -112,12 +117,15 @@ def test_minimal_arguments_reach_the_node():
         "/ranger_base_node/port_name"] == "sim"
 
 
-def test_model_protocol_and_commissioning_file_reach_the_node():
+def test_model_protocol_and_commissioning_file_reach_the_node(tmp_path):
+    # A file the node loads (one that does not exist fails the launch: see below).
+    commissioned = tmp_path / "commissioned.yaml"
+    commissioned.write_text("protocol: agx_v2\n")
     p = params("ranger_minimal.launch", "model:=ranger_mini_v3", "protocol:=agx_v2",
-               "commissioning_file:=/etc/ranger/commissioned.yaml")
+               f"commissioning_file:={commissioned}")
     assert p["/ranger_base_node/model"] == "ranger_mini_v3"
     assert p["/ranger_base_node/protocol"] == "agx_v2"
-    assert p["/ranger_base_node/commissioning_file"] == "/etc/ranger/commissioned.yaml"
+    assert p["/ranger_base_node/commissioning_file"] == str(commissioned)
 
 
 def test_nodelet_manager_loads_the_driver_as_a_nodelet_with_the_same_parameters():
@@ -309,3 +317,60 @@ def test_teleop_is_not_required():
     config = roslaunch.config.load_config_default(
         [os.path.join(LAUNCH_DIR, "ranger_teleop_keyboard.launch")], None, verbose=False)
     assert [(n.name, n.required) for n in config.nodes] == [("ranger_teleop_keyboard", False)]
+
+
+# ---- failures look like failures: checked before anything starts ------------------------------
+
+def refused(launch, *args, option="--nodes"):
+    """`roslaunch [OPTION] FILE ARGS...` must fail; returns its console output."""
+    command = ["roslaunch"] + ([option] if option else []) + [os.path.join(LAUNCH_DIR, launch)]
+    # A master nobody runs: a refused launch must not need (or start) one.
+    env = dict(ENV, ROS_MASTER_URI="http://localhost:1")
+    result = subprocess.run(command + list(args), capture_output=True, text=True, env=env,
+                            timeout=120)
+    assert result.returncode != 0, result.stdout + result.stderr
+    return result.stdout + result.stderr
+
+
+@pytest.mark.parametrize("option", ["--nodes", None])
+def test_an_unusable_argument_fails_the_launch_with_the_drivers_reason(option):
+    """protocol:=xyz: the node would exit FATAL under a roslaunch that exits 0; the launch's check
+    (the node's own) refuses it while roslaunch reads the file: exit status 1, nothing started."""
+    out = refused("ranger_minimal.launch", "sim:=true", "protocol:=xyz", option=option)
+    assert "the launch is refused before anything starts" in out, out
+    assert 'parameter ~protocol = "xyz": expected one of auto, manual, agx_v2' in out, out
+    assert "REQUIRED process" not in out, "nothing may have been started"
+
+
+@pytest.mark.parametrize("launch", ["ranger_minimal.launch", "ranger_sim.launch"])
+def test_an_unknown_argument_fails_the_launch_naming_it(launch):
+    out = refused(launch, "publish_rate:=abc")
+    assert "unknown argument publish_rate:=abc" in out, out
+    assert "params_file:=FILE" in out, out
+
+
+def test_a_missing_commissioning_file_fails_the_launch():
+    out = refused("ranger_minimal.launch", "sim:=true", "commissioning_file:=/no/such/file.yaml")
+    assert "/no/such/file.yaml" in out, out
+
+
+def test_a_parameter_file_reaches_the_node_and_is_checked_like_the_arguments(tmp_path):
+    good = tmp_path / "driver.yaml"
+    good.write_text("publish_rate: 20\ncmd_vel_timeout: 0.3\nport_name: sim\n"
+                    "linear:\n  x:\n    has_velocity_limits: true\n    max_velocity: 1.0\n")
+    p = params("ranger_minimal.launch", f"params_file:={good}")
+    assert p["/ranger_base_node/publish_rate"] == 20
+    assert p["/ranger_base_node/cmd_vel_timeout"] == 0.3
+    assert p["/ranger_base_node/linear/x/max_velocity"] == 1.0
+    assert p["/ranger_base_node/port_name"] == "sim", "the file's values win over the arguments"
+    # Through ranger_sim.launch and to both robots of ranger_sim_two.launch.
+    assert params("ranger_sim.launch", f"params_file:={good}")[
+        "/ranger_base_node/publish_rate"] == 20
+    two = params("ranger_sim_two.launch", f"params_file:={good}")
+    assert two["/robot1/ranger_base_node/cmd_vel_timeout"] == 0.3
+    assert two["/robot2/ranger_base_node/cmd_vel_timeout"] == 0.3
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("publish_rate: abc\nodom_frame_id: odom\n")
+    out = refused("ranger_minimal.launch", "sim:=true", f"params_file:={bad}")
+    assert 'parameter ~publish_rate = "abc": expected a number in (0, 50] Hz' in out, out
+    assert "parameter ~odom_frame_id is not one ranger_base_node reads" in out, out

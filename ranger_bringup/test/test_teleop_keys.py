@@ -164,3 +164,13 @@ def test_arrow_keys_do_not_move_or_quit(teleop):
     for key in split_keys("\x1b[A\x1b[D"):
         assert teleop.on_key(key, 0.0) is Event.IGNORED
     assert teleop.command(0.0) == STOP
+
+
+def test_the_rearm_key_asks_for_the_rearm_and_moves_nothing(teleop):
+    assert teleop.on_key("r", 0.0) is Event.REARM
+    assert teleop.command(0.01) == STOP
+    # While moving, it changes nothing of the motion (the shell calls resume).
+    teleop.on_key("w", 1.0)
+    assert teleop.on_key("r", 1.1) is Event.REARM
+    assert teleop.command(1.2).mode is Mode.ACKERMANN
+    assert "r : re-arm" in teleop.help_text()

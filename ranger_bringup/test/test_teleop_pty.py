@@ -103,6 +103,30 @@ def test_held_key_publishes_its_mode_then_a_stop_when_released(teleop, cmd_vel, 
     assert f"mode: {mode}" in teleop.text()
 
 
+def test_the_rearm_key_calls_resume_and_shows_its_answer(teleop, cmd_vel):
+    import rospy
+    from std_srvs.srv import Trigger, TriggerResponse
+
+    calls = []
+
+    def resume(request):
+        calls.append(request)
+        return TriggerResponse(success=False,
+                               message="resume refused: still active: emergency_stop")
+
+    service = rospy.Service("/teleop_test/resume", Trigger, resume)
+    try:
+        n = cmd_vel.count()
+        teleop.type("r")
+        assert wait_for(lambda: calls, timeout=10), teleop.text()[-2000:]
+        assert wait_for(lambda: "resume refused: still active: emergency_stop" in teleop.text(),
+                        timeout=10), teleop.text()[-2000:]
+        assert len(calls) == 1
+        assert not moving(cmd_vel.since(n))
+    finally:
+        service.shutdown()
+
+
 def test_moving_messages_keep_coming_while_the_key_is_held(teleop, cmd_vel):
     n = cmd_vel.count()
     teleop.hold("w", 1.5)

@@ -161,23 +161,30 @@ class E2e : public ::testing::Test {
     rig_.run_for(300ms);
   }
   // After an involuntary stop whose cause has cleared: the driver holds the chassis at rest
-  // (kRearmRequired) although the caller still asks for `twist`; a zero twist re-arms, and then
+  // (kRearmRequired) although the caller still asks for `twist`, and a zero twist followed by
+  // `twist` does not restart it either (a zero twist is no re-arm); resume() re-arms, and then
   // `twist` drives again (speed above `min_speed`).
-  void expect_latched_then_rearm_by_zero_twist(const BodyTwist& twist, double min_speed) {
+  void expect_latched_then_rearm_by_resume(const BodyTwist& twist, double min_speed) {
     rig_.command(twist);
     ASSERT_TRUE(
         eventually([&] { return rig_.state().refusal == MotionRefusal::kRearmRequired; }, 3s))
         << "refusal " << to_string(rig_.state().refusal);
-    const Timestamp until = rig_.now() + 1s;
-    while (rig_.now() < until) {
-      rig_.run_for(100ms);
-      ASSERT_EQ(rig_.chassis().speed, 0.0) << "restarted without a re-arm";
-      ASSERT_EQ(rig_.state().refusal, MotionRefusal::kRearmRequired);
-    }
-    rig_.command(BodyTwist{});  // the commander has seen the stop
+    const auto hold = [&](std::chrono::nanoseconds d) {
+      const Timestamp until = rig_.now() + d;
+      while (rig_.now() < until) {
+        rig_.run_for(100ms);
+        ASSERT_EQ(rig_.chassis().speed, 0.0) << "restarted without a re-arm";
+        ASSERT_EQ(rig_.state().refusal, MotionRefusal::kRearmRequired);
+      }
+    };
+    hold(1s);
+    rig_.command(BodyTwist{});  // a zero twist: no re-arm
+    hold(300ms);
+    rig_.command(twist);
+    hold(500ms);
+    ASSERT_TRUE(rig_.controller().resume(rig_.now()).ok());
     ASSERT_TRUE(
         eventually([&] { return rig_.state().refusal != MotionRefusal::kRearmRequired; }, 2s));
-    rig_.command(twist);
     ASSERT_TRUE(eventually([&] { return std::fabs(rig_.chassis().speed) > min_speed; }, 5s));
   }
 
@@ -349,7 +356,7 @@ TYPED_TEST_P(E2e, RemoteTakeoverAndHandBack) {
 
   // SWB back up: the chassis is in CAN mode again, but the stale twist does not restart it.
   rig.with_chassis([](sim::VirtualChassis& c) { c.remote_hand_back(); });
-  this->expect_latched_then_rearm_by_zero_twist({0.6, 0.0, 0.0}, 0.5);
+  this->expect_latched_then_rearm_by_resume({0.6, 0.0, 0.0}, 0.5);
 
   // The remote takes over again and is switched off: standby. Remote control is final: the
   // driver does not ask for CAN mode by itself; resume() does (and re-arms).
@@ -378,7 +385,7 @@ TYPED_TEST_P(E2e, EmergencyStopAndRelease) {
   EXPECT_TRUE(rig.state().estop());
   // The e-stop is released: resetting it must not restart the chassis (ISO 13850).
   rig.with_chassis([](sim::VirtualChassis& c) { c.set_emergency_stop(false); });
-  this->expect_latched_then_rearm_by_zero_twist({1.0, 0.0, 0.0}, 0.5);
+  this->expect_latched_then_rearm_by_resume({1.0, 0.0, 0.0}, 0.5);
   EXPECT_FALSE(rig.state().estop());
 }
 
@@ -399,7 +406,7 @@ TYPED_TEST_P(E2e, CriticalErrorIsReportedAndClearedThroughTheController) {
   rig.run_for(200ms);
   EXPECT_NE(rig.chassis().error_bits, 0u);
   ASSERT_TRUE(rig.controller().clear_errors(0x0F, rig.now()).ok());
-  this->expect_latched_then_rearm_by_zero_twist({0.5, 0.0, 0.0}, 0.4);
+  this->expect_latched_then_rearm_by_resume({0.5, 0.0, 0.0}, 0.4);
   EXPECT_EQ(rig.chassis().error_bits, 0u);
   EXPECT_EQ(rig.state().refusal, MotionRefusal::kNone);
 }
@@ -419,7 +426,7 @@ TYPED_TEST_P(E2e, LowBatteryRefusesMotionUntilChargedAndCleared) {
   EXPECT_TRUE(rig.state().low_battery() || rig.state().critical_error());
   rig.with_chassis([](sim::VirtualChassis& c) { c.set_battery_soc(80.0); });
   ASSERT_TRUE(rig.controller().clear_errors(0x09, rig.now()).ok());
-  this->expect_latched_then_rearm_by_zero_twist({0.5, 0.0, 0.0}, 0.4);
+  this->expect_latched_then_rearm_by_resume({0.5, 0.0, 0.0}, 0.4);
   EXPECT_EQ(rig.chassis().error_bits, 0u);
 }
 
@@ -432,7 +439,7 @@ TYPED_TEST_P(E2e, SilentChassisIsDetectedAndRecovered) {
       this->eventually([&] { return rig.state().refusal == MotionRefusal::kLinkLost; }, 2s));
   EXPECT_EQ(rig.state().link, LinkState::kStale);
   ASSERT_TRUE(this->eventually([&] { return rig.state().link == LinkState::kConnected; }, 6s));
-  this->expect_latched_then_rearm_by_zero_twist({0.5, 0.0, 0.0}, 0.4);
+  this->expect_latched_then_rearm_by_resume({0.5, 0.0, 0.0}, 0.4);
   EXPECT_GE(rig.state().counters.link_losses, 1u);
 }
 

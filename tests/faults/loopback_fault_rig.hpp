@@ -66,8 +66,6 @@ class LoopbackFaultRig {
       if (request_ && t >= next_request_) {
         last_request_status_ = controller_->set_command(*request_, t);
         next_request_ = t + kCallerPeriod;
-        const BodyTwist& w = request_->twist;
-        if (w.vx == 0.0 && w.vy == 0.0 && w.wz == 0.0) audit_.on_rearm_attempt(t);
       }
       controller_->tick(t);
     }
@@ -150,23 +148,33 @@ class LoopbackFaultRig {
            << "no CAN command mode after 3 s; refusal " << to_string(state().refusal);
   }
   // After an involuntary stop whose cause has cleared: the chassis stays at rest although the
-  // caller still asks for `twist` (kRearmRequired, for a whole second); a zero twist re-arms and
-  // `twist` then drives it up to `speed` again.
-  ::testing::AssertionResult latched_then_rearmed_by_zero_twist(const BodyTwist& twist,
-                                                                double speed) {
+  // caller still asks for `twist` (kRearmRequired, for a whole second), and after a zero twist
+  // and `twist` again (a zero twist is no re-arm); resume re-arms and `twist` then drives it up
+  // to `speed` again.
+  ::testing::AssertionResult latched_then_rearmed_by_resume(const BodyTwist& twist, double speed) {
     command(twist);
     if (!run_until([&] { return state().refusal == MotionRefusal::kRearmRequired; }, 3s)) {
       return ::testing::AssertionFailure()
              << "no kRearmRequired; refusal " << to_string(state().refusal);
     }
-    const Timestamp until = now() + std::chrono::seconds(1);
-    while (now() < until) {
-      step();
-      if (snapshot().speed != 0.0) return ::testing::AssertionFailure() << "moved unasked";
+    for (const BodyTwist& asked : {twist, BodyTwist{}, twist}) {
+      command(asked);
+      const Timestamp until = now() + std::chrono::milliseconds(500);
+      while (now() < until) {
+        step();
+        if (snapshot().speed != 0.0) return ::testing::AssertionFailure() << "moved unasked";
+        if (state().refusal != MotionRefusal::kRearmRequired) {
+          return ::testing::AssertionFailure()
+                 << "re-armed without resume; refusal " << to_string(state().refusal);
+        }
+      }
     }
-    command(BodyTwist{});
-    if (!run_until([&] { return state().refusal != MotionRefusal::kRearmRequired; }, 1s)) {
-      return ::testing::AssertionFailure() << "the zero twist did not re-arm";
+    if (Status st = resume(); !st) {
+      return ::testing::AssertionFailure() << "resume refused: " << st.error().message;
+    }
+    step();
+    if (state().refusal == MotionRefusal::kRearmRequired) {
+      return ::testing::AssertionFailure() << "resume did not re-arm";
     }
     command(twist);
     if (run_until([&] { return std::abs(snapshot().speed - speed) < 1e-9; }, 10s)) {

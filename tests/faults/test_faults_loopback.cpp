@@ -95,7 +95,7 @@ TEST_F(Faults, BusOffStopsTheChassisAndRestartResumesWithEveryFrameAccountedFor)
   const Timestamp t_restart = rig_.now();
   ASSERT_TRUE(rig_.run_until([&] { return rig_.state().link == LinkState::kConnected; }, 2s));
   EXPECT_LE(rig_.now() - t_restart, 2s);
-  ASSERT_TRUE(rig_.latched_then_rearmed_by_zero_twist({kCruise, 0, 0}, kCruise));
+  ASSERT_TRUE(rig_.latched_then_rearmed_by_resume({kCruise, 0, 0}, kCruise));
   EXPECT_EQ(rig_.driver_bus().status().state, BusState::kActive);
   EXPECT_EQ(rig_.driver_bus().status().stats.restarts - before.restarts, 1u);
   EXPECT_EQ(rig_.state().refusal, MotionRefusal::kNone);
@@ -126,7 +126,7 @@ TEST_F(Faults, InterfaceDownAndUpStopsTheChassisThenReopensAndResumes) {
   EXPECT_LE(rig_.now() - t_up, 1s + 50ms);
   EXPECT_GE(rig_.driver_bus().status().stats.reopens - before.reopens, 1u);
   EXPECT_EQ(rig_.driver_bus().status().state, BusState::kActive);
-  ASSERT_TRUE(rig_.latched_then_rearmed_by_zero_twist({kCruise, 0, 0}, kCruise));
+  ASSERT_TRUE(rig_.latched_then_rearmed_by_resume({kCruise, 0, 0}, kCruise));
   EXPECT_FALSE(rig_.snapshot().host_link_lost);
 }
 
@@ -213,7 +213,7 @@ TEST_F(Faults, ChassisSilentForOneSecondIsDetectedAfterLinkTimeoutAndResumesWith
 
   // Back: held at rest until the re-arm, then the new command, never the old one.
   ASSERT_TRUE(rig_.run_until([&] { return rig_.state().link == LinkState::kConnected; }, 3s));
-  ASSERT_TRUE(rig_.latched_then_rearmed_by_zero_twist({0.3, 0, 0}, 0.3));
+  ASSERT_TRUE(rig_.latched_then_rearmed_by_resume({0.3, 0, 0}, 0.3));
   rig_.run_for(1s);
   EXPECT_LE(rig_.snapshot().speed, 0.3 + 1e-9);
   EXPECT_EQ(rig_.state().counters.link_losses, 1u);
@@ -281,7 +281,7 @@ TEST_P(RefusingFaults, StopsMotionOnTheWireAtOnceAndResumesOnlyAfterTheRearm) {
     ASSERT_TRUE(rig_.run_until([&] { return rig_.snapshot().speed > kCruise - 0.05; }, 5s))
         << "refusal " << to_string(rig_.state().refusal);
   } else {
-    ASSERT_TRUE(rig_.latched_then_rearmed_by_zero_twist({kCruise, 0, 0}, kCruise));
+    ASSERT_TRUE(rig_.latched_then_rearmed_by_resume({kCruise, 0, 0}, kCruise));
   }
   EXPECT_EQ(rig_.state().refusal, MotionRefusal::kNone);
   if (fault.fault) {
@@ -381,7 +381,7 @@ TEST_F(Faults, ErrorBitsSetAndClearedByTheChassisAreReportedAndOnlyCriticalOnesS
   EXPECT_EQ(rig_.state().refusal, MotionRefusal::kCriticalError);
   EXPECT_EQ(rig_.snapshot().speed, 0.0);
   rig_.chassis().set_error_bit(over_current, false);
-  ASSERT_TRUE(rig_.latched_then_rearmed_by_zero_twist({kCruise, 0, 0}, kCruise));
+  ASSERT_TRUE(rig_.latched_then_rearmed_by_resume({kCruise, 0, 0}, kCruise));
   EXPECT_TRUE(rig_.state().faults.empty());
 }
 
@@ -432,6 +432,9 @@ TEST_F(Faults, NonFiniteCommandsAreRefusedAndStopTheVehicleOnTheNextFrame) {
     const ControllerState& s = rig_.state();
     EXPECT_TRUE(std::isfinite(s.limited.vx) && std::isfinite(s.limited.vy) &&
                 std::isfinite(s.limited.wz));
+    // Named while it lasts; the caller's next valid twist ends it.
+    EXPECT_EQ(s.refusal, MotionRefusal::kInvalidCommand);
+    rig_.command(BodyTwist{});
   }
 }
 

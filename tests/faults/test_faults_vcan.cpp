@@ -170,18 +170,25 @@ class VcanFaultRig {
   const WireAudit& audit() const { return audit_; }
 
   // After an involuntary stop whose cause has cleared: held at rest (kRearmRequired) while the
-  // caller asks for `twist`; a zero twist re-arms; then `twist` drives above `min_speed`.
-  ::testing::AssertionResult rearm_by_zero_twist_then_drive(const BodyTwist& twist,
-                                                            double min_speed) {
+  // caller asks for `twist`, and after a zero twist (no re-arm); resume re-arms; then `twist`
+  // drives above `min_speed`.
+  ::testing::AssertionResult rearm_by_resume_then_drive(const BodyTwist& twist, double min_speed) {
     command(twist);
     if (!run_until([&] { return state().refusal == MotionRefusal::kRearmRequired; }, 2s)) {
       return ::testing::AssertionFailure() << "refusal " << to_string(state().refusal);
     }
     run_for(500ms);
-    if (snapshot().speed != 0.0) return ::testing::AssertionFailure() << "moved before the re-arm";
     command(BodyTwist{});
-    if (!run_until([&] { return state().refusal != MotionRefusal::kRearmRequired; }, 2s)) {
-      return ::testing::AssertionFailure() << "the zero twist did not re-arm";
+    run_for(200ms);
+    command(twist);
+    run_for(300ms);
+    if (snapshot().speed != 0.0) return ::testing::AssertionFailure() << "moved before the re-arm";
+    if (state().refusal != MotionRefusal::kRearmRequired) {
+      return ::testing::AssertionFailure() << "re-armed without resume";
+    }
+    audit_.on_rearm_attempt(clock_.now());
+    if (Status st = controller_->resume(clock_.now()); !st) {
+      return ::testing::AssertionFailure() << "resume refused: " << st.error().message;
     }
     return drive(twist, min_speed);
   }
@@ -202,9 +209,6 @@ class VcanFaultRig {
     if (request_ && now >= next_request_) {
       EXPECT_TRUE(controller_->set_command(*request_, now).ok());
       next_request_ = now + 20ms;
-      if (request_->vx == 0.0 && request_->vy == 0.0 && request_->wz == 0.0) {
-        audit_.on_rearm_attempt(now);
-      }
     }
     controller_->tick(now);
     const auto wait =
@@ -272,7 +276,7 @@ TEST_F(VcanFaults, BusOffFromAnErrorFrameStopsTheChassisAndRestartResumes) {
       rig_.run_until([&] { return rig_.driver_bus().status().state == BusState::kActive; }, 2s))
       << "bus " << to_string(rig_.driver_bus().status().state) << " ("
       << rig_.driver_bus().status().detail << ")";
-  ASSERT_TRUE(rig_.rearm_by_zero_twist_then_drive({0.5, 0, 0}, 0.45));
+  ASSERT_TRUE(rig_.rearm_by_resume_then_drive({0.5, 0, 0}, 0.45));
   const BusStatistics after = rig_.driver_bus().status().stats;
   EXPECT_EQ(after.restarts - before.restarts, 1u);
   EXPECT_GE(after.error_frames - before.error_frames, 2u);
@@ -298,7 +302,7 @@ TEST_F(VcanFaults, InterfaceDownAndUpStopsTheChassisThenReopensAndResumes) {
   ASSERT_TRUE(rig_.run("ip link set dev " + interface_name() + " up"));
   ASSERT_TRUE(rig_.run_until([&] { return rig_.state().link == LinkState::kConnected; }, 5s))
       << "refusal " << to_string(rig_.state().refusal);
-  ASSERT_TRUE(rig_.rearm_by_zero_twist_then_drive({0.5, 0, 0}, 0.45));
+  ASSERT_TRUE(rig_.rearm_by_resume_then_drive({0.5, 0, 0}, 0.45));
   EXPECT_EQ(rig_.driver_bus().status().state, BusState::kActive);
   EXPECT_GE(rig_.driver_bus().status().stats.reopens - before.reopens, 1u);
   EXPECT_FALSE(rig_.snapshot().host_link_lost);

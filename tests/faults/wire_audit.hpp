@@ -13,9 +13,9 @@
 //  3. Every host frame (0x111, 0x141, 0x421, 0x441, 0x451) decodes: no wrong DLC, no NaN field.
 //  4. No moving 0x111 after an involuntary stop until a re-arm: once the wire showed an e-stop,
 //     remote control, a critical error bit, a low battery or a silent chassis (no 0x211 for
-//     longer than link_timeout), motion is a violation until the caller re-armed (a zero twist or
-//     resume, reported by the rig through on_rearm_attempt) at a time the wire showed none of
-//     those any more.
+//     longer than link_timeout), motion is a violation until the caller re-armed (resume,
+//     reported by the rig through on_rearm_attempt: a zero twist is no re-arm) at a time the wire
+//     showed none of those any more.
 #pragma once
 
 #include <chrono>
@@ -74,8 +74,8 @@ class WireAudit {
     }
   }
 
-  // The caller asked for a re-arm at `t` (a zero twist, or resume): it counts if the wire shows
-  // no involuntary-stop cause at that time.
+  // The caller asked for a re-arm at `t` (resume): it counts if the wire shows no
+  // involuntary-stop cause at that time.
   void on_rearm_attempt(Timestamp t) {
     if (!cause_active() && !(status_ && t - status_stamp_ > config_.link_timeout + slack_)) {
       latched_ = false;

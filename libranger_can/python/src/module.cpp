@@ -551,16 +551,9 @@ PYBIND11_MODULE(_ranger_can, m) {
           "set_motion_mode",
           [](PySession& p, std::optional<std::string> mode) {
             std::optional<protocol::MotionMode> m;
-            if (mode) {
-              m = parse_mode(*mode);
-              const auto s = p.s().snapshot();
-              if (!protocol::motion_mode_to_wire(*m, s->profile.mode_numbering)) {
-                invalid(*mode + ": unsupported by protocol " + s->profile.revision +
-                        " (its motion-mode numbering has no " + *mode +
-                        " mode; side slip is the MINI V1's)");
-              }
-            }
-            p.s().driver().set_motion_mode(m);
+            if (mode) m = parse_mode(*mode);
+            // The driver refuses a mode the settings in use cannot drive, naming the ones they do.
+            check(p.s().driver().set_motion_mode(m));
           },
           py::arg("mode"))
       .def("clear_errors",

@@ -44,6 +44,45 @@ Status check_duration(const char* name, std::chrono::nanoseconds d) {
 
 }  // namespace
 
+Status check_finite(const MotionRequest& request) {
+  const struct {
+    const char* name;
+    double value;
+  } components[] = {{"linear.x", request.twist.vx},         {"linear.y", request.twist.vy},
+                    {"linear.z", request.out_of_plane.vz},  {"angular.x", request.out_of_plane.wx},
+                    {"angular.y", request.out_of_plane.wy}, {"angular.z", request.twist.wz}};
+  for (const auto& c : components) {
+    if (!std::isfinite(c.value)) {
+      return Error{Errc::kNotFinite,
+                   std::string(c.name) + " is " + (std::isnan(c.value) ? "NaN" : "infinite")};
+    }
+  }
+  return ok_status();
+}
+
+bool can_drive_in(MotionMode mode, const ProtocolProfile& profile) {
+  return drivable_mode(mode) &&
+         protocol::motion_mode_to_wire(mode, profile.mode_numbering).has_value();
+}
+
+std::vector<MotionMode> drivable_modes(const ProtocolProfile& profile) {
+  std::vector<MotionMode> out;
+  for (MotionMode m : protocol::kMotionModeNames.values()) {
+    if (can_drive_in(m, profile)) out.push_back(m);
+  }
+  return out;
+}
+
+Status check_drivable(MotionMode mode, const ProtocolProfile& profile) {
+  if (can_drive_in(mode, profile)) return ok_status();
+  std::string modes;
+  for (MotionMode m : drivable_modes(profile))
+    modes += (modes.empty() ? "" : ", ") + std::string(protocol::to_string(m));
+  return Error{Errc::kInvalidArgument, std::string(protocol::to_string(mode)) +
+                                           ": unsupported by protocol " + profile.revision +
+                                           " (it drives " + modes + ")"};
+}
+
 Status ControllerConfig::validate() const {
   if (Status st = geometry.validate(); !st) return st;
   if (Status st = limits.validate(); !st) return st;
@@ -94,6 +133,7 @@ ChassisController::ChassisController(Bus& bus, ControllerConfig config)
       limiter_vx_(config_.limit_vx),
       limiter_vy_(config_.limit_vy),
       limiter_wz_(config_.limit_wz) {
+  state_.zero_twist_rearms = config_.rearm_on_zero_twist;
   update_faults();
 }
 
@@ -208,47 +248,40 @@ Status ChassisController::set_command(const MotionRequest& request, Timestamp no
   if (state_.shut_down) {
     return Error{Errc::kInvalidArgument, "controller: set_command after shutdown"};
   }
-  const struct {
-    const char* name;
-    double value;
-  } components[] = {{"vx", request.twist.vx}, {"vy", request.twist.vy}, {"wz", request.twist.wz}};
-  for (const auto& c : components) {
-    if (!std::isfinite(c.value)) {
-      // A NaN is a caller bug, not a wish to keep driving the previous command: stop.
-      state_.requested = MotionRequest{};
-      state_.has_command = true;
-      state_.last_command_time = now;
-      state_.cmd_timed_out = false;
-      command_changed_ = true;
-      return Error{Errc::kNotFinite, std::string("controller: command ") + c.name + " is " +
-                                         (std::isnan(c.value) ? "NaN" : "infinite") + "; stopping"};
+  if (Status st = check_finite(request); !st) {
+    // A NaN is a caller bug, not a wish to keep driving the previous command: stop, and say so
+    // (kInvalidCommand) until a valid request comes.
+    state_.requested = MotionRequest{};
+    state_.has_command = true;
+    state_.last_command_time = now;
+    state_.cmd_timed_out = false;
+    state_.invalid_command = st.error().message;
+    ++state_.counters.invalid_commands;
+    command_changed_ = true;
+    return Error{Errc::kNotFinite, "controller: command " + st.error().message + "; stopping"};
+  }
+  if (request.mode) {
+    if (Status st = check_drivable(*request.mode, config_.profile); !st) {
+      return Error{Errc::kInvalidArgument, "controller: motion mode " + st.error().message};
     }
   }
-  if (request.mode && !can_drive_in(*request.mode)) {
-    return Error{Errc::kInvalidArgument,
-                 "controller: motion mode " + std::string(protocol::to_string(*request.mode)) +
-                     " cannot be driven under protocol " + config_.profile.revision +
-                     " (ackermann, oblique, spin; side_slip where the mode numbering has it)"};
-  }
   if (is_zero(request.twist)) {
-    // A zero twist abandons a switch that never completed, and re-arms once every cause of an
-    // involuntary stop has cleared: the commander has seen the stop and asks for rest.
+    // A zero twist abandons a switch that never completed. It re-arms only where the owner opted
+    // in (rearm_on_zero_twist), once every cause of an involuntary stop has cleared.
     if (mode_switch_.status().failed) mode_switch_.cancel();
     update_causes();
-    if (latch_.on_zero_command(state_.active_causes)) ++state_.counters.rearms;
+    if (config_.rearm_on_zero_twist && latch_.on_zero_command(state_.active_causes)) {
+      ++state_.counters.rearms;
+    }
     state_.latched_causes = latch_.causes();
   }
+  state_.invalid_command.clear();
   state_.requested = request;
   state_.has_command = true;
   state_.last_command_time = now;
   state_.cmd_timed_out = false;
   command_changed_ = true;
   return ok_status();
-}
-
-bool can_drive_in(MotionMode mode, const ProtocolProfile& profile) {
-  return drivable_mode(mode) &&
-         protocol::motion_mode_to_wire(mode, profile.mode_numbering).has_value();
 }
 
 bool ChassisController::can_drive_in(MotionMode mode) const {
@@ -300,7 +333,7 @@ Status ChassisController::set_ultrasonic(bool enable, Timestamp now) {
 
 Status ChassisController::request_park(bool on, Timestamp now) {
   state_.now = now;
-  if (on && !protocol::motion_mode_to_wire(MotionMode::kPark, config_.profile.mode_numbering)) {
+  if (!protocol::motion_mode_to_wire(MotionMode::kPark, config_.profile.mode_numbering)) {
     return Error{Errc::kInvalidArgument, "park: unsupported by protocol " +
                                              config_.profile.revision +
                                              " (its motion-mode numbering has no park mode)"};
@@ -554,6 +587,7 @@ MotionRefusal ChassisController::evaluate_refusal() const {
   if (!state_.motion_mode && !(leave_park_ && state_.parked())) return MotionRefusal::kModeUnknown;
   if (identifying) return MotionRefusal::kIdentifying;
   if (state_.cmd_timed_out) return MotionRefusal::kCmdTimeout;
+  if (!state_.invalid_command.empty()) return MotionRefusal::kInvalidCommand;
   if (selector_.below_minimum(state_.requested.twist)) return MotionRefusal::kBelowMinimum;
   return MotionRefusal::kNone;
 }
@@ -569,6 +603,18 @@ bool ChassisController::at_standstill(Timestamp now) const {
     return std::fabs(fb.motion->value.speed) <= config_.standstill_speed;
   }
   return false;  // no fresh feedback: standstill cannot be confirmed
+}
+
+std::uint32_t ChassisController::adjustments(const KinematicsSolution& solution) const {
+  // Automatic selection with a switch to come (the selector waits for confirm_time and the dwell
+  // before it hands the request to the mode that expresses it): the current mode's solution is a
+  // stopgap of a few hundred milliseconds (a rotation asked at standstill turns the wheels to
+  // full lock until spin), not what becomes of the request.
+  const bool automatic = !state_.requested.mode && !state_.mode_override;
+  if (automatic && selector_.classify(state_.requested.twist, solution.mode) != solution.mode) {
+    return kKinematicsExact;
+  }
+  return solution.flags;
 }
 
 double ChassisController::steer_first_factor(const KinematicsSolution& solution,
@@ -632,9 +678,9 @@ ChassisController::MotionGate ChassisController::gate_motion() const {
               state_.motion_mode.has_value() && !state_.quiet;
   g.parking = r == MotionRefusal::kParked && state_.chassis_mode.has_value();
   const bool drivable = r == MotionRefusal::kNone || r == MotionRefusal::kModeSwitchFailed;
-  g.leaving_park =
-      leave_park_ && state_.parked() &&
-      (drivable || r == MotionRefusal::kCmdTimeout || r == MotionRefusal::kBelowMinimum);
+  g.leaving_park = leave_park_ && state_.parked() &&
+                   (drivable || r == MotionRefusal::kCmdTimeout ||
+                    r == MotionRefusal::kBelowMinimum || r == MotionRefusal::kInvalidCommand);
   g.may_drive = (drivable && state_.has_command) || (g.probing && probe_mode_.has_value()) ||
                 g.parking || g.leaving_park;
   return g;
@@ -703,6 +749,7 @@ const KinematicsSolution* ChassisController::motion_command(MotionRefusal refusa
                                                             Timestamp now, MotionCommand& command) {
   const KinematicsSolution* solution = nullptr;
   state_.steer_first_factor = 1.0;
+  state_.adjustments = 0;
   if (refusal == MotionRefusal::kNone && state_.has_command && state_.motion_mode) {
     const double dt = limiter_started_ ? seconds(now - last_limit_time_) : 0.0;
     const BodyTwist& target = state_.requested.twist;
@@ -714,6 +761,7 @@ const KinematicsSolution* ChassisController::motion_command(MotionRefusal refusa
         state_.limited, *state_.motion_mode, config_.geometry, config_.limits, config_.profile);
     if (solved) {
       steer_first(*solved, now);
+      state_.adjustments = adjustments(*solved);
       command = solved->command;
       state_.last_solution = *solved;
       solution = &*state_.last_solution;
@@ -786,10 +834,15 @@ bool ChassisController::send(const Message& message, Timestamp now,
   }
   ++state_.counters.frames_sent;
   if (observer_) {
-    SentFrame sent{*frame, message, BodyTwist{}, std::nullopt, shutdown};
+    SentFrame sent;
+    sent.frame = *frame;
+    sent.message = message;
+    sent.shutdown = shutdown;
     if (solution) {
       sent.solution = *solution;
       sent.achieved = solution->achieved;
+      sent.adjustments = state_.adjustments;
+      sent.requested = state_.requested.twist;
     }
     observer_(sent);
   }

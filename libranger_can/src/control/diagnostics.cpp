@@ -200,6 +200,10 @@ DiagnosticGroup diagnose_link(const DriverSnapshot& s) {
                                   : "unknown (" + std::string(to_string(s.firmware.state)) + ")");
   out.add("Vendor frames (0x231, 0x241)", std::string(to_string(s.vendor_frames)));
   out.add("Odometry published", s.motion_known ? "yes" : "no (chassis not heard)");
+  // A silence the odometry could not integrate: its pose covariance grew by what the chassis
+  // could have moved in it.
+  out.add("Odometry gaps", s.odometry.gaps);
+  out.add("Last odometry gap (s)", seconds(s.odometry.last_gap));
   out.add("Undecodable frames", c.counters.decode_errors);
   out.add("Send failures", c.counters.send_failures);
   if (!c.last_error.empty()) out.add("Last error", c.last_error);
@@ -227,6 +231,7 @@ DiagnosticGroup diagnose_control(const DriverSnapshot& s) {
   out.add("CAN control blocked after remote", c.reclaim_blocked ? "yes (call resume)" : "no");
   out.add("Steer-first speed factor", c.steer_first_factor);
   out.add("cmd_vel timeouts", c.counters.cmd_timeouts);
+  out.add("cmd_vel refused (NaN or inf)", c.counters.invalid_commands);
   out.add("Re-arms", c.counters.rearms);
   out.add("Motion commands sent", c.counters.motion_commands_sent);
   out.add("Control mode requests", c.counters.control_mode_requests);

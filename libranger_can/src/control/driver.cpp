@@ -19,10 +19,12 @@ bool is_zero(const BodyTwist& t) {
   return t.vx == 0.0 && t.vy == 0.0 && t.wz == 0.0;
 }
 
-// The odometry shares the controller's geometry and protocol profile: one vehicle, one reading.
+// The odometry shares the controller's geometry, limits and protocol profile: one vehicle, one
+// reading.
 OdometryConfig odometry_config(const DriverConfig& config) {
   OdometryConfig c = config.odometry;
   c.geometry = config.controller.geometry;
+  c.limits = config.controller.limits;
   c.profile = config.controller.profile;
   return c;
 }
@@ -133,9 +135,13 @@ Status Driver::command(const MotionRequest& request) {
   return st;
 }
 
-void Driver::set_motion_mode(std::optional<protocol::MotionMode> mode) {
+Status Driver::set_motion_mode(std::optional<protocol::MotionMode> mode) {
+  if (mode) {
+    if (Status st = check_drivable(*mode, snapshot()->profile); !st) return st;
+  }
   mailbox_.post([&](DriverMail& m) { m.mode = mode; });
   waker_.wake();
+  return ok_status();
 }
 
 std::uint64_t Driver::post(RequestOutcome::Kind kind, std::string what, bool on,

@@ -127,7 +127,8 @@ std::string text_of(const DriverEvent&, const CommandRefusedEvent& c) {
 }
 
 std::string text_of(const DriverEvent&, const CommandAdjustedEvent& c) {
-  return "cmd_vel adjusted to what the chassis can do: " + kinematics_flags_to_string(c.flags);
+  return "cmd_vel adjusted to what the chassis can do: " +
+         describe_adjustments(c.flags, c.asked, c.driven);
 }
 
 std::string text_of(const DriverEvent&, const MotionModeEvent& m) {
@@ -161,6 +162,9 @@ std::string text_of(const DriverEvent&, const RequestEvent& r) {
   std::string out = o.what;
   if (o.state == RequestOutcome::State::kFailed) out += " failed";
   if (!o.message.empty()) out += ": " + o.message;
+  if (r.repeated > 0) {
+    out += " (" + std::to_string(r.repeated) + " more answered alike since the last report)";
+  }
   return out;
 }
 
@@ -234,6 +238,7 @@ void fields_of(JsonWriter& j, const LightsEvent& l) {
 }
 void fields_of(JsonWriter& j, const RequestEvent& r) {
   j.key("id").unsigned_integer(r.outcome.id);
+  if (r.repeated > 0) j.key("repeated").unsigned_integer(r.repeated);
   j.key("request").string(to_string(r.outcome.kind));
   j.key("state").string(to_string(r.outcome.state));
 }
@@ -294,7 +299,8 @@ std::string stop_words(const ControllerState& c) {
     case MotionRefusal::kLowBattery:
       return "battery below low_battery_soc: the chassis cuts the drives";
     case MotionRefusal::kModeSwitchFailed:
-      return "motion-mode switch not confirmed by the chassis: send a zero cmd_vel or call resume";
+      return "motion-mode switch not confirmed by the chassis: send a zero cmd_vel (it abandons "
+             "the switch), then call resume";
     case MotionRefusal::kImplausible:
       return "the chassis's feedback contradicts the protocol settings: " +
              (c.implausible_reason.empty() ? std::string("(no reason given)")
@@ -302,7 +308,9 @@ std::string stop_words(const ControllerState& c) {
              ". Set that parameter (or load a commissioning file), or call resume to try again";
     case MotionRefusal::kRearmRequired:
       return "rearm_required after " + causes_text(c.latched_causes) +
-             ": call resume (or send a zero cmd_vel) to drive again";
+             (c.zero_twist_rearms ? ": call resume (or send a zero cmd_vel: rearm_on_zero_twist)"
+                                  : ": call resume") +
+             " to drive again";
     default:
       return "";
   }
@@ -349,6 +357,10 @@ std::string describe_refusal(const ControllerState& c, const IdentificationStatu
                  : "chassis silent (link lost): motion stopped";
     case MotionRefusal::kCmdTimeout:
       return "no recent cmd_vel (cmd_vel_timeout): chassis commanded to stop";
+    case MotionRefusal::kInvalidCommand:
+      return "invalid_command: cmd_vel refused, " + c.invalid_command +
+             " (a NaN or an infinity in any of its six fields refuses the whole twist): chassis "
+             "commanded to stop until a valid cmd_vel comes";
     case MotionRefusal::kBelowMinimum:
       return "below_minimum: cmd_vel is below what the chassis can express (mode_selection/"
              "min_linear_speed, min_yaw_rate): not driven";

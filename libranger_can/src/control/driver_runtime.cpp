@@ -29,9 +29,6 @@ constexpr bool kReuseSnapshots = false;
 constexpr bool kReuseSnapshots = true;
 #endif
 
-bool finite(const BodyTwist& t) {
-  return std::isfinite(t.vx) && std::isfinite(t.vy) && std::isfinite(t.wz);
-}
 bool is_zero(const BodyTwist& t) {
   return t.vx == 0.0 && t.vy == 0.0 && t.wz == 0.0;
 }
@@ -56,10 +53,9 @@ Status DriverMailbox::post_command(const MotionRequest& request, const std::stri
   if (!opened_once_) {
     refused = Error{Errc::kInterfaceDown, "not connected to " + (bus.empty() ? "a bus" : bus) +
                                               (open_error_.empty() ? "" : ": " + open_error_)};
-  } else if (!finite(request.twist)) {
-    refused =
-        Error{Errc::kNotFinite,
-              "command refused (NaN or infinite component): the chassis is commanded to stop"};
+  } else if (Status finite = check_finite(request); !finite) {
+    refused = Error{Errc::kNotFinite, "command refused (" + finite.error().message +
+                                          "): the chassis is commanded to stop"};
   }
   if (refused) {
     ++mail_.refused;

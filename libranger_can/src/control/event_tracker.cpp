@@ -258,10 +258,11 @@ void DriverEventTracker::frame_sent(const SentFrame& sent, Timestamp now,
          ShutdownEvent{true, sent.frame.id, {}});
     return;
   }
-  if (!sent.solution || sent.solution->flags == kKinematicsExact || now < next_adjusted_) return;
+  // What the command driven now differs from the request by (a mode switch's stopgap is none).
+  if (!sent.solution || sent.adjustments == kKinematicsExact || now < next_adjusted_) return;
   next_adjusted_ = now + config_.adjusted_interval;
   emit(out, now, EventKind::kCommandAdjusted, Severity::kWarn,
-       CommandAdjustedEvent{sent.solution->flags});
+       CommandAdjustedEvent{sent.adjustments, sent.requested, sent.achieved});
 }
 
 void DriverEventTracker::no_stop_sent(std::string why, Timestamp now,
@@ -272,9 +273,17 @@ void DriverEventTracker::no_stop_sent(std::string why, Timestamp now,
 
 void DriverEventTracker::request_settled(const RequestOutcome& outcome, Timestamp now,
                                          std::vector<DriverEvent>& out) {
+  ReportedRequest& last = requests_[outcome.kind];
+  std::string answer =
+      outcome.what + '|' + std::string(to_string(outcome.state)) + '|' + outcome.message;
+  if (answer == last.answer && now < last.until) {
+    ++last.repeated;
+    return;
+  }
   emit(out, now, EventKind::kRequestSettled,
        outcome.state == RequestOutcome::State::kFailed ? Severity::kWarn : Severity::kInfo,
-       RequestEvent{outcome});
+       RequestEvent{outcome, last.repeated});
+  last = ReportedRequest{std::move(answer), now + config_.repeated_request_interval, 0};
 }
 
 void DriverEventTracker::motion_mode_requested(std::optional<protocol::MotionMode> mode,

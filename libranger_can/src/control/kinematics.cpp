@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "ranger_can/parse.hpp"
 #include "ranger_can/wire/interpretation.hpp"
 
 namespace ranger {
@@ -200,6 +201,16 @@ std::string kinematics_flags_to_string(std::uint32_t flags) {
     }
   }
   return out.empty() ? "unknown_flags" : out;
+}
+
+std::string describe_adjustments(std::uint32_t flags, const BodyTwist& asked,
+                                 const BodyTwist& driven) {
+  const auto twist = [](const BodyTwist& t) {
+    return "(" + number_text(t.vx) + " m/s, " + number_text(t.vy) + " m/s, " + number_text(t.wz) +
+           " rad/s)";
+  };
+  return kinematics_flags_to_string(flags) + ": asked (vx, vy, wz) = " + twist(asked) +
+         ", driven " + twist(driven);
 }
 
 double max_ackermann_curvature(double max_steering, const VehicleGeometry& geometry,

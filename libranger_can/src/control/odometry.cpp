@@ -1,5 +1,6 @@
 #include "ranger_can/control/odometry.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <type_traits>
@@ -90,6 +91,15 @@ BodyTwist twist_from_motion_feedback(const MotionFeedback& feedback, MotionMode 
       break;
   }
   return BodyTwist{};
+}
+
+double max_yaw_rate(const KinematicsLimits& limits, const VehicleGeometry& geometry,
+                    const ProtocolProfile& profile) {
+  const double spin = std::fabs(interp::spin_yaw_rate_from_wheel_speed(
+      limits.max_spin_wheel_speed, geometry.wheelbase, geometry.track));
+  const double turn = limits.max_linear_speed *
+                      max_ackermann_curvature(limits.max_ackermann_steering, geometry, profile);
+  return std::max(spin, turn);
 }
 
 Pose2D integrate_pose(const Pose2D& pose, const BodyTwist& twist, double dt) {
@@ -203,6 +213,23 @@ bool Odometry::on_motion_feedback(const MotionFeedback& m, Timestamp stamp) {
   return advanced;
 }
 
+void Odometry::account_gap(std::chrono::nanoseconds gap, Timestamp end) {
+  // Nothing was heard for `gap`: the chassis may have moved as far as its limits allow. (Where a
+  // chassis reports its own odometer in a known unit, e.g. the RANGER MINI 3.0's 0x311/0x312
+  // reading once it is decoded, the distance it reports for the gap belongs here: the pose would
+  // advance by it, and only what it does not tell would widen the variance.)
+  const double g = seconds(gap);
+  const double reach = config_.limits.max_linear_speed * g;
+  const double turn =
+      std::min(max_yaw_rate(config_.limits, config_.geometry, config_.profile) * g, M_PI);
+  state_.pose_variance[0] += reach * reach;
+  state_.pose_variance[1] += reach * reach;
+  state_.pose_variance[2] += turn * turn;
+  state_.last_gap = gap;
+  state_.last_gap_end = end;
+  ++state_.gaps;
+}
+
 bool Odometry::step(const BodyTwist& twist, Timestamp stamp, OdometrySource source) {
   if (!std::isfinite(twist.vx) || !std::isfinite(twist.vy) || !std::isfinite(twist.wz)) {
     ++state_.skipped_steps;  // never let one bad estimate poison the pose
@@ -220,6 +247,7 @@ bool Odometry::step(const BodyTwist& twist, Timestamp stamp, OdometrySource sour
   if (stamp.count() == 0 || !anchored_) return reanchor();
   const auto elapsed = stamp - state_.stamp;
   if (elapsed.count() == 0) return false;  // a second frame of the same instant: nothing to add
+  if (elapsed > config_.max_step) account_gap(elapsed, stamp);
   if (elapsed.count() < 0 || elapsed > config_.max_step) return reanchor();
 
   const double dt = seconds(elapsed);

@@ -77,6 +77,13 @@ const std::vector<Parameter> kParameters = {
         "true: request CAN command mode again by itself after the remote control had the "
         "chassis; false: only after `resume` (motion needs the re-arm either way)",
         RANGER_FLAG(controller.auto_reclaim_after_remote)),
+    row("rearm_on_zero_twist", T::kBool, "", kFlag,
+        "true: a zero `cmd_vel` re-arms too after a stop the commander did not ask for, once its "
+        "cause has cleared, as `resume` does. Hazard: a navigation stack publishes zero twists by "
+        "itself (at a goal, in recovery), so a released e-stop would restart the robot without "
+        "anyone deciding to; only for a teleop-only robot whose operator sees it. false: only "
+        "`resume` re-arms",
+        RANGER_FLAG(controller.rearm_on_zero_twist)),
     row("link_timeout", T::kSeconds, "s", closed(0.02, 10.0),
         "chassis considered silent after this long without 0x211",
         RANGER_SECONDS(controller.link_timeout)),

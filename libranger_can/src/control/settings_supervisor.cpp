@@ -75,12 +75,14 @@ ProtocolProfile SettingsSupervisor::with_configured_settings(const Identificatio
   return p;
 }
 
-void SettingsSupervisor::hold_probe_for(MotionRefusal refusal) {
+void SettingsSupervisor::hold_probe_for(MotionRefusal refusal, bool zero_twist_rearms) {
   // The probe is motion the controller would refuse for a cause of the commander's (a re-arm
   // after the remote control or a stop, an e-stop): it waits for that, not for the chassis.
   switch (refusal) {
     case MotionRefusal::kRearmRequired:
-      identifier_->hold_probe("motion needs the re-arm (call resume, or send a zero twist)");
+      identifier_->hold_probe(zero_twist_rearms
+                                  ? "motion needs the re-arm (call resume, or send a zero twist)"
+                                  : "motion needs the re-arm (call resume)");
       break;
     case MotionRefusal::kRemote:  // (as of the last tick: the hand-back is being heard now)
     case MotionRefusal::kEstop:
@@ -98,7 +100,7 @@ void SettingsSupervisor::hold_probe_for(MotionRefusal refusal) {
 void SettingsSupervisor::run_identification(Timestamp now, ChassisController& controller,
                                             bool odometry_fed) {
   if (!identifying()) return;
-  hold_probe_for(controller.state().refusal);
+  hold_probe_for(controller.state().refusal, controller.state().zero_twist_rearms);
   identifier_->tick(now);
   const IdentificationStatus& st = identifier_->status();
   if (st.decided_ok()) {
@@ -146,7 +148,7 @@ void SettingsSupervisor::run_plausibility(Timestamp now, ChassisController& cont
   applied_stop_ = stop->text();
   controller.set_implausible(applied_stop_);  // the stop, latched
   // Auto: a setting the identification could not decide at rest is learned here. The stop stays
-  // latched (a zero twist or resume re-arms); the cause itself is gone with the setting.
+  // latched (resume re-arms); the cause itself is gone with the setting.
   if (identifier_) status_changed_ = true;  // adopt() records the stop either way
   if (identifier_ && identifier_->adopt(stop->setting, stop->try_value, stop->detail)) {
     use_profile_(with_configured_settings(identifier_->status()), /*reset_odometry=*/false);

@@ -249,7 +249,8 @@ void add_connection(std::vector<Binding>& out) {
 
 void add_control(std::vector<Binding>& out) {
   for (const char* name :
-       {"cmd_vel_timeout", "auto_command_mode", "auto_reclaim_after_remote", "link_timeout",
+       {"cmd_vel_timeout", "auto_command_mode", "auto_reclaim_after_remote", "rearm_on_zero_twist",
+        "link_timeout",
         "min_command_interval", "mode_switch_timeout", "mode_switch_max_attempts",
         "standstill_speed", "steer_first_threshold", "low_battery_soc"}) {
     out.push_back(driver_row(name));
@@ -447,7 +448,11 @@ void add_odometry(std::vector<Binding>& out) {
   out.push_back(Row("pose_covariance_diagonal", T::kNumberList, "", kVariance,
                     numbers(d.pose_covariance_diagonal),
                     "x, y, z, roll, pitch, yaw: the floor of the pose covariance; the odometry "
-                    "adds its growing x/y/yaw variance")
+                    "adds its growing x/y/yaw variance, and after a gap in the chassis's feedback "
+                    "(a silence longer than 0.5 s the odometry cannot integrate) what the chassis "
+                    "could have moved in it: (`max_linear_speed` × gap)² on x and y, (its fastest "
+                    "turn × gap)² on yaw (at most π²); `system_state.odometry_gap` says how long "
+                    "it was")
                     .size(6)
                     .apply(diagonal(&NodeParameters::pose_covariance_diagonal)));
   out.push_back(Row("twist_covariance_diagonal", T::kNumberList, "", kVariance,

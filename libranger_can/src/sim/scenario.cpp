@@ -26,7 +26,9 @@ const char* const kActionsHelp =
     "  cmd VX VY WZ             from now on publish this REP-103 body twist (m/s, m/s, rad/s)\n"
     "                           every 50 ms of simulated time, the first at once\n"
     "  cmd none                 stop publishing (the driver's cmd_timeout then stops the chassis)\n"
-    "  resume                   the explicit re-arm (refused while a stop cause is active)\n"
+    "  resume                   the re-arm after a stop the commander did not ask for (the only\n"
+    "                           one: a zero twist re-arms only with --param\n"
+    "                           rearm_on_zero_twist=true); refused while a stop cause is active\n"
     "  mode auto|ackermann|oblique|spin|side_slip\n"
     "                           force the motion mode of later commands (auto: chosen per twist;\n"
     "                           side_slip where the mode numbering has it: mini_v1, agx_v2)\n"
@@ -905,7 +907,7 @@ ScenarioResult ScenarioRunner::run(const Scenario& scenario, const ScenarioOutpu
         m.pending.push_back({m.driver->resume(), a.line});
         break;
       case ScenarioAction::Kind::kMode:
-        m.driver->set_motion_mode(a.mode);
+        if (Status st = m.driver->set_motion_mode(a.mode); !st) note(a.line, st.error().message);
         break;
       case ScenarioAction::Kind::kPark:
         m.pending.push_back({m.driver->set_park(a.enable), a.line});

@@ -44,7 +44,7 @@ void IdentifyRig::step() {
   const Timestamp now = clock_.now();
   const MotionRefusal before = driver_->snapshot()->controller.refusal;
   if (rearm_ && before == MotionRefusal::kRearmRequired && !rearming_) {
-    (void)driver_->command(MotionRequest{});  // the commander has seen the stop
+    (void)driver_->resume();  // the operator has seen the stop
     rearming_ = true;
     ++rearms_;
     next_publish_ = now + 50ms;
@@ -75,7 +75,11 @@ bool IdentifyRig::run_until(const std::function<bool()>& done, std::chrono::nano
 }
 
 void IdentifyRig::command(const BodyTwist& twist, std::optional<MotionMode> mode) {
-  request_ = MotionRequest{twist, mode};
+  command(MotionRequest{twist, mode});
+}
+
+void IdentifyRig::command(const MotionRequest& request) {
+  request_ = request;
   next_publish_ = clock_.now();
 }
 

@@ -29,6 +29,7 @@ class IdentifyRig {
   bool run_until(const std::function<bool()>& done, std::chrono::nanoseconds timeout);
   // The commander wants `twist` (in `mode`) from now on (nullopt: stops publishing).
   void command(const BodyTwist& twist, std::optional<protocol::MotionMode> mode = std::nullopt);
+  void command(const MotionRequest& request);  // the same with every field of the request
   void silence() { request_.reset(); }
   // CAN mode, a known motion mode, and (auto) the identification decided.
   bool wait_ready(bool allow_any_refusal = false);
@@ -38,8 +39,8 @@ class IdentifyRig {
   bool drive_until_stopped(const BodyTwist& twist, std::optional<protocol::MotionMode> mode,
                            std::chrono::nanoseconds timeout);
   std::chrono::nanoseconds stopped_after() const { return stopped_after_; }
-  // The commander answers a latched stop (kRearmRequired) with a zero twist, as a teleop does,
-  // then goes on with its twist; counted.
+  // The operator answers a latched stop (kRearmRequired) with resume (the teleop's re-arm key),
+  // then the commander goes on with its twist; counted.
   void set_rearm(bool on) { rearm_ = on; }
   int rearms() const { return rearms_; }
   // Drives the route and checks the odometry against the ground truth (<= 1 % of the distance,

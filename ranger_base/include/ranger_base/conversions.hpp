@@ -45,6 +45,9 @@ ros::Time to_ros_time(ranger::Timestamp bus_stamp);
 // The planar part of a Twist (linear.x, linear.y, angular.z) as a REP-103 body twist. The other
 // components cannot be commanded on a ground vehicle and are ignored.
 ranger::BodyTwist to_body_twist(const geometry_msgs::Twist& twist);
+// The whole Twist as the driver's request: the planar part, and the other three for the library's
+// check (a NaN or an infinity in any of the six refuses the request: ranger::check_finite).
+ranger::MotionRequest to_motion_request(const geometry_msgs::Twist& twist);
 // True if a component the chassis ignores (linear.z, angular.x, angular.y) is non-zero.
 bool has_non_planar_components(const geometry_msgs::Twist& twist);
 geometry_msgs::TwistStamped to_twist_stamped(const ranger::BodyTwist& twist, const ros::Time& stamp,

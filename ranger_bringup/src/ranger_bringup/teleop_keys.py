@@ -58,6 +58,9 @@ STOP_KEYS = {"s", "k", " "}
 FASTER_KEYS = {"+", "="}
 SLOWER_KEYS = {"-", "_"}
 HELP_KEYS = {"h", "?"}
+# The deliberate re-arm after a stop the teleop did not ask for (an e-stop, the remote control, a
+# fault, link loss): the shell calls the driver's `resume` service. The robot does not move.
+REARM_KEYS = {"r"}
 QUIT_KEYS = {"\x03", "\x04", "\x1b"}  # Ctrl-C, Ctrl-D, Esc (the terminal's signals are off)
 
 HELP = """\
@@ -68,6 +71,7 @@ RANGER keyboard teleop -- hold a key to move, release it to stop
      z   x   c
   w/x forward/back, q/e z/c forward/back along a left/right arc
   s, k or space : stop      + / - : speed up / down by 10 %%
+  r : re-arm after a stop (the driver's resume service; a zero twist never re-arms)
   h : this help             Ctrl-C, Ctrl-D or Esc : stop and quit
   arc radius %.2f m; limits: %.2f m/s, %.2f rad/s"""
 
@@ -77,6 +81,7 @@ class Event(enum.Enum):
     STOP = "stop"
     SPEED = "speed"
     HELP = "help"
+    REARM = "rearm"
     QUIT = "quit"
     IGNORED = "ignored"
 
@@ -141,6 +146,8 @@ class Teleop:
             return Event.SPEED
         if key in HELP_KEYS:
             return Event.HELP
+        if key in REARM_KEYS:
+            return Event.REARM
         if key in QUIT_KEYS:
             self._release()
             return Event.QUIT

@@ -18,8 +18,9 @@
 //    auto_reclaim_after_remote); control comes back by resume(), or when the operator hands back
 //    with SWB (the chassis reports CAN mode itself) — and motion then still needs the re-arm.
 //  * Re-arm (rearm.hpp): after any stop the commander did not ask for (e-stop, remote takeover,
-//    a critical error, the low-battery cut-off, link loss, a failed mode switch) motion stays
-//    refused (kRearmRequired) until a zero twist or resume() after the cause has cleared.
+//    a critical error, the low-battery cut-off, link loss, a failed mode switch, implausible
+//    feedback) motion stays refused (kRearmRequired) until resume() after the cause has cleared
+//    (a zero twist too only with the opt-in rearm_on_zero_twist).
 //  * Keep-alive: while the chassis is in CAN command mode, 0x111 goes out every
 //    `keep_alive_period` (zero whenever motion is refused), on a fixed-rate schedule. A changed
 //    command goes out at once, at most one per `min_command_interval` (keep-alives do not count).
@@ -31,7 +32,8 @@
 //    zero at twice the threshold) and the new steering is commanded: a sideways request never
 //    rolls the chassis forwards while its wheels turn.
 //  * A twist below the chassis's resolution is refused by name (kBelowMinimum), never dropped
-//    silently.
+//    silently; a twist with a NaN or an infinity in any of its six components is refused by name
+//    (kInvalidCommand) and stops the chassis, for as long as such twists keep coming.
 //  * Faults: named in state().faults; those that stop the chassis are the refusal reason.
 //  * Shutdown (or destruction): a zero 0x111 before the bus is released.
 #pragma once
@@ -64,11 +66,30 @@
 
 namespace ranger {
 
+// The three components of a full twist a planar base cannot drive (a ROS Twist's linear.z,
+// angular.x, angular.y): ignored, except that a NaN or an infinity in one of them refuses the
+// whole request like one in the planar twist (the caller's bug all the same).
+struct OutOfPlaneTwist {
+  double vz = 0.0;  // m/s (linear.z)
+  double wx = 0.0;  // rad/s (angular.x)
+  double wy = 0.0;  // rad/s (angular.y)
+};
+
 // What the caller wants: a REP-103 body twist, optionally in a forced motion mode.
 struct MotionRequest {
+  MotionRequest() = default;
+  MotionRequest(const BodyTwist& twist_, std::optional<protocol::MotionMode> mode_ = std::nullopt,
+                const OutOfPlaneTwist& out_of_plane_ = {})
+      : twist(twist_), mode(mode_), out_of_plane(out_of_plane_) {}
+
   BodyTwist twist;
   std::optional<protocol::MotionMode> mode;  // nullopt: automatic (ModeSelector)
+  OutOfPlaneTwist out_of_plane;              // checked for NaN/inf only
 };
+
+// kNotFinite naming the first component (by its twist name, "linear.z", "angular.x", ...) that
+// is NaN or infinite, in the order linear x, y, z, angular x, y, z; ok otherwise.
+Status check_finite(const MotionRequest& request);
 
 // Why the chassis is not being commanded the requested motion, most fundamental first.
 enum class MotionRefusal {
@@ -80,13 +101,16 @@ enum class MotionRefusal {
   kLowBattery,        // BMS SOC below low_battery_soc: the chassis cuts the drives
   kModeSwitchFailed,  // a motion-mode switch was never confirmed
   kImplausible,       // the chassis's feedback contradicts the protocol settings
-  kRearmRequired,     // an involuntary stop happened: a zero twist or resume() re-arms
+  kRearmRequired,     // an involuntary stop happened: resume() re-arms (rearm.hpp)
   kStandby,           // not in CAN mode: standby (CAN mode requested, or auto_command_mode =
                       // false) or UART control (agx_v2)
   kModeUnknown,       // no valid 0x291 yet: the meaning of 0x111 depends on the motion mode
   kSwitching,         // motion-mode switch in progress (ours or the remote's)
   kCmdTimeout,        // no set_command within cmd_timeout
-  kBelowMinimum,      // the twist is below what the chassis can express (1 mm/s)
+  // The latest request was refused (ControllerState::invalid_command says why: a NaN or an
+  // infinity in a component): the chassis is commanded to stop until a valid one comes.
+  kInvalidCommand,
+  kBelowMinimum,  // the twist is below what the chassis can express (1 mm/s)
   // The driver holds motion for a purpose of its own: the protocol settings are not decided yet
   // (DriverConfig::identification: `auto`; ControllerState::identifying gives the phase), or the
   // commissioning's standstill probe runs (ControllerState::standstill_probe). No speed is
@@ -113,6 +137,7 @@ inline constexpr auto kMotionRefusalNames = text::enum_names<MotionRefusal>({
     {MotionRefusal::kModeUnknown, "mode_unknown"},
     {MotionRefusal::kSwitching, "switching"},
     {MotionRefusal::kCmdTimeout, "cmd_timeout"},
+    {MotionRefusal::kInvalidCommand, "invalid_command"},
     {MotionRefusal::kBelowMinimum, "below_minimum"},
     {MotionRefusal::kIdentifying, "identifying"},
     {MotionRefusal::kParked, "parked"},
@@ -169,7 +194,12 @@ struct ControllerConfig {
   bool auto_command_mode = true;  // request CAN command mode by itself (at start-up)
   // shutdown() also hands control back: 0x421 standby after the stop (`ranger_can commission`).
   bool release_control_on_shutdown = false;
-  bool auto_reclaim_after_remote = false;  // re-arm by itself when the remote hands back
+  bool auto_reclaim_after_remote = false;  // request CAN mode by itself when the remote hands back
+  // A zero twist re-arms too, once every stop cause has cleared (rearm.hpp), as resume() does.
+  // Off by default: a navigation stack publishes zero twists by itself (at a goal, in recovery),
+  // so a released e-stop would restart the robot without anyone deciding to. For teleop-only
+  // robots whose operator sees the robot.
+  bool rearm_on_zero_twist = false;
   bool listen_only = false;                // never send anything (monitoring, log replay)
   std::chrono::nanoseconds link_timeout = std::chrono::milliseconds(100);
   std::chrono::nanoseconds control_mode_retry_period = std::chrono::milliseconds(100);
@@ -205,7 +235,8 @@ struct ControllerCounters {
   std::uint64_t cmd_timeouts = 0;
   std::uint64_t error_clear_requests = 0;  // 0x441
   std::uint64_t ultrasonic_requests = 0;   // 0x451
-  std::uint64_t rearms = 0;                // latch cleared by a zero twist or resume()
+  std::uint64_t rearms = 0;  // latch cleared by resume() (or a zero twist: rearm_on_zero_twist)
+  std::uint64_t invalid_commands = 0;      // set_command refused (NaN or inf in a component)
   std::uint64_t light_commands = 0;        // 0x121
   std::uint64_t version_requests = 0;      // 0x4A1
 };
@@ -238,6 +269,7 @@ struct ControllerState {
   std::optional<double> battery_soc;  // % from BMS 0x361 (whole pack)
   StopCauses active_causes = 0;       // involuntary stop causes active now
   StopCauses latched_causes = 0;      // causes since the last re-arm (motion needs a re-arm)
+  bool zero_twist_rearms = false;     // ControllerConfig::rearm_on_zero_twist (for the words)
   // Every active fault by stable snake_case name: the controller's own (ControllerFault) and the
   // 0x211 error bits' (protocol::error_bit_names of the profile's layout).
   std::vector<std::string> faults;
@@ -247,11 +279,18 @@ struct ControllerState {
   bool cmd_timed_out = false;
   bool has_command = false;  // set_command was called at least once
   MotionRequest requested;   // the last accepted request
+  // Why the latest request was refused ("linear.z is NaN"), "" once a valid one came: the
+  // refusal kInvalidCommand while it lasts.
+  std::string invalid_command;
   Timestamp last_command_time{0};
   BodyTwist limited;  // requested twist after the speed limiters (what is driven)
   // 1 = full speed; below 1 the speed is held back until the wheels reach the commanded angle.
   double steer_first_factor = 1.0;
   std::optional<KinematicsSolution> last_solution;   // for the last motion 0x111
+  // KinematicsFlag bits of the command driven now (0 while nothing is driven): how it differs
+  // from the request. A component dropped only until the mode switch the selector is about to
+  // make (a rotation asked of Ackermann at standstill, on its way to spin) is left out.
+  std::uint32_t adjustments = 0;
   std::optional<MotionCommand> last_motion_command;  // last 0x111 sent (zero when refused)
   Timestamp last_motion_command_time{0};
 
@@ -293,8 +332,19 @@ struct SentFrame {
   // 0x111 only: the twist it realises (REP-103; zero for a stop) and the solution behind it.
   BodyTwist achieved;
   std::optional<KinematicsSolution> solution;
+  // 0x111 only: how the command differs from the request (ControllerState::adjustments at the
+  // send: KinematicsFlag bits, none for a mode switch's stopgap) and the request's twist.
+  std::uint32_t adjustments = 0;
+  BodyTwist requested;
   bool shutdown = false;  // the stop sent by shutdown()
 };
+
+// The modes can_drive_in allows under `profile`, in protocol::MotionMode's order.
+std::vector<protocol::MotionMode> drivable_modes(const ProtocolProfile& profile);
+// kInvalidArgument unless can_drive_in(mode, profile), naming the mode, the profile's revision
+// and the modes it drives ("side_slip: unsupported by protocol manual (it drives ackermann,
+// oblique, spin)").
+Status check_drivable(protocol::MotionMode mode, const ProtocolProfile& profile);
 
 class ChassisController {
  public:
@@ -323,17 +373,17 @@ class ChassisController {
   // timeouts (at most keep_alive_period away; `now` itself when something is due already).
   Timestamp next_tick_due() const;
 
-  // The motion wanted from now on; refreshes the command timeout. A non-finite component is
-  // refused with kNotFinite and the controller stops (a NaN is a caller bug, not a command to
-  // keep driving). A zero twist re-arms after an involuntary stop whose cause has cleared.
-  // Sent at the next tick().
+  // The motion wanted from now on; refreshes the command timeout. A non-finite component (any of
+  // the six: check_finite) is refused with kNotFinite, the controller stops and says so
+  // (kInvalidCommand, state().invalid_command) until a valid request comes (a NaN is a caller
+  // bug, not a command to keep driving). A zero twist re-arms after an involuntary stop whose
+  // cause has cleared only with rearm_on_zero_twist. Sent at the next tick().
   Status set_command(const MotionRequest& request, Timestamp now);
   Status set_command(const BodyTwist& twist, Timestamp now) {
     return set_command(MotionRequest{twist, std::nullopt}, now);
   }
 
-  // Whether a twist can be driven in `mode` under the profile: ackermann, oblique, spin, and side
-  // slip where the mode numbering has it (MINI V1, agx_v2); never park.
+  // Whether a twist can be driven in `mode` under the profile (the free function below).
   bool can_drive_in(protocol::MotionMode mode) const;
   // Forces every later command into `mode` (nullopt: automatic selection again); a mode
   // can_drive_in refuses is ignored.
@@ -352,7 +402,8 @@ class ChassisController {
   // Park (agx_v2: motion mode 0x03). on: motion is refused (kParked), the chassis is brought to
   // rest and switched to park; off: motion is allowed again and the chassis is switched out of
   // park (to the forced mode, else Ackermann) at once. kInvalidArgument ("unsupported by ...",
-  // nothing changes) when the profile's mode numbering has no park (manual, MINI V1).
+  // nothing changes), for on and off alike, when the profile's mode numbering has no park
+  // (manual, MINI V1): a request the chassis cannot honour is never answered with success.
   Status request_park(bool on, Timestamp now);
   // Sends 0x121 once (the counter in byte 7 is the controller's). The chassis reports what it
   // does in 0x231 (feedback().light_state); a profile without lights is the caller's to refuse.
@@ -409,6 +460,7 @@ class ChassisController {
   MotionRefusal evaluate_refusal() const;
   bool at_standstill(Timestamp now) const;
   double steer_first_factor(const KinematicsSolution& solution, Timestamp now) const;
+  std::uint32_t adjustments(const KinematicsSolution& solution) const;
   void run_control_mode(Timestamp now);
   void run_ultrasonic(Timestamp now);
   // run_motion's numbered steps (controller.cpp).

@@ -70,7 +70,7 @@ struct DriverConfig {
   IdentificationConfig identification;
   // The plausibility monitors (plausibility.hpp), whatever the settings came from. kAuto: a
   // mismatch of a setting the identification could not decide at rest (the spin sign, 0x221's
-  // speed reading, ...) stops the robot all the same (latched: a zero twist or resume re-arms),
+  // speed reading, ...) stops the robot all the same (latched: resume re-arms),
   // and the value the monitor names is adopted, so that the re-armed robot drives right.
   PlausibilityConfig plausibility;
   // Source, timeouts and covariances; its geometry and profile are the controller's (one vehicle,
@@ -140,11 +140,15 @@ class Driver {
   void stop();
 
   // ---- the mailbox (any thread; never waits for the bus) ----
-  // The motion wanted from now on. kNotFinite for NaN/inf (the driver then commands zero);
+  // The motion wanted from now on. kNotFinite for NaN/inf in any of the six components, named
+  // (the driver then commands zero and the snapshot says why: MotionRefusal::kInvalidCommand);
   // kInterfaceDown while the bus was never opened (the message says why). A refusal is also an
   // event (kCommandRefused, the reports spaced).
   Status command(const MotionRequest& request);
-  void set_motion_mode(std::optional<protocol::MotionMode> mode);
+  // Forces the motion mode of later commands (nullopt: automatic). kInvalidArgument, naming the
+  // modes it drives, for a mode the settings in use cannot drive (check_drivable): nothing is
+  // posted then.
+  Status set_motion_mode(std::optional<protocol::MotionMode> mode);
   // kInvalidArgument (nothing posted) for a code outside 0x00..0x10; else the request's id.
   Result<std::uint64_t> clear_errors(std::uint8_t code);
   std::uint64_t set_ultrasonic(bool enable);

@@ -138,7 +138,7 @@ struct RefusalEvent {
 };
 struct RearmEvent {
   StopCauses causes = 0;   // kRearmLatched: the causes that latched now; kRearmCleared: all
-  bool by_resume = false;  // kRearmCleared: resume() (else the commander's zero twist)
+  bool by_resume = false;  // kRearmCleared: resume() (else a zero twist: rearm_on_zero_twist)
 };
 struct IdentificationEvent {
   IdentificationPhase phase = IdentificationPhase::kListening;
@@ -160,7 +160,9 @@ struct CommandRefusedEvent {
   std::uint64_t count = 1;  // refused since the previous event of this kind (reports are spaced)
 };
 struct CommandAdjustedEvent {
-  std::uint32_t flags = 0;  // KinematicsFlag bits
+  std::uint32_t flags = 0;  // KinematicsFlag bits (ControllerState::adjustments)
+  BodyTwist asked;          // the request
+  BodyTwist driven;         // what the command realises
 };
 struct MotionModeEvent {
   std::optional<protocol::MotionMode> mode;  // nullopt: automatic selection
@@ -184,6 +186,9 @@ struct LightsEvent {
 };
 struct RequestEvent {
   RequestOutcome outcome;
+  // Answered like the previous report of this kind since it, not reported (a flood of identical
+  // requests: EventTrackerConfig::repeated_request_interval).
+  std::uint64_t repeated = 0;
 };
 struct PaddedFramesEvent {
   std::uint32_t id = 0;

@@ -31,7 +31,7 @@ namespace ranger {
 // What callers posted since the driver last looked.
 struct DriverMail {
   std::optional<MotionRequest> command;  // the latest twist
-  bool zero_seen = false;                // a zero twist came before the latest (it re-arms)
+  bool zero_seen = false;  // a zero twist came before the latest (it may re-arm: opt-in)
   std::optional<std::optional<protocol::MotionMode>> mode;
   std::optional<std::optional<StandstillProbe>> probe;
   struct Action {

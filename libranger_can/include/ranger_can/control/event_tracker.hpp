@@ -10,6 +10,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <optional>
 #include <set>
@@ -38,6 +39,10 @@ struct EventTrackerConfig {
   std::chrono::nanoseconds not_finite_interval = std::chrono::seconds(1);
   std::chrono::nanoseconds refused_interval = std::chrono::seconds(5);
   std::chrono::nanoseconds adjusted_interval = std::chrono::seconds(5);
+  // A request answered as the last reported one of its kind (the same request, state and answer)
+  // within this is counted, not reported: a client calling clear_errors at 100 Hz fills no log;
+  // the next report of that kind says how many there were.
+  std::chrono::nanoseconds repeated_request_interval = std::chrono::seconds(10);
 };
 
 class DriverEventTracker {
@@ -96,6 +101,12 @@ class DriverEventTracker {
   // Spacing of repeated reports.
   Timestamp next_not_finite_{0}, next_refused_{0}, next_adjusted_{0};
   std::uint64_t unreported_not_finite_ = 0, unreported_refused_ = 0;
+  struct ReportedRequest {
+    std::string answer;  // what|state|message
+    Timestamp until{0};  // identical answers before this are counted
+    std::uint64_t repeated = 0;
+  };
+  std::map<RequestOutcome::Kind, ReportedRequest> requests_;
 };
 
 }  // namespace ranger

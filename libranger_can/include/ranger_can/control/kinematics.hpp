@@ -57,6 +57,10 @@ enum KinematicsFlag : std::uint32_t {
 };
 // "speed_saturated|lateral_dropped", or "exact" for 0.
 std::string kinematics_flags_to_string(std::uint32_t flags);
+// What became of a request, for a warning: "spin_saturated: asked (vx, vy, wz) = (0 m/s, 0 m/s,
+// 1e+06 rad/s), driven (0 m/s, 0 m/s, 1.42 rad/s)".
+std::string describe_adjustments(std::uint32_t flags, const BodyTwist& asked,
+                                 const BodyTwist& driven);
 
 // The chassis command for one twist in one motion mode.
 struct KinematicsSolution {

@@ -13,7 +13,9 @@
 // Integration runs on the frames' own timestamps (CanFrame::stamp), one step per 0x281 (wheels)
 // or 0x221 (motion) frame, with the exact arc for the mean of the previous and the new twist.
 // The first frame, a timestamp going backwards and a gap longer than max_step only re-anchor the
-// time; they are not integrated (and are counted).
+// time; they are not integrated (and are counted). A gap (the chassis silent, the bus down) is
+// not forgotten: the pose variance grows by what the chassis could have moved in it, at its
+// limits, and the state says how long it was (last_gap).
 #pragma once
 
 #include <array>
@@ -67,9 +69,16 @@ struct OdometryConfig {
   double pose_variance_per_meter = 1e-3;    // m^2 per m travelled
   double yaw_variance_per_radian = 1e-3;    // rad^2 per rad turned
   double yaw_variance_per_meter = 1e-4;     // rad^2 per m travelled
+  // After a gap of g seconds (a step longer than max_step, not integrated):
+  //   var_x, var_y += (max_speed * g)^2,  var_yaw += min((max_yaw_rate * g)^2, pi^2)
+  // with max_speed = limits.max_linear_speed and max_yaw_rate the faster of a spin at
+  // limits.max_spin_wheel_speed and an Ackermann turn at full speed and full lock.
 
   // Decoding, and 0x221's readings (steering reference, speed meaning, spin field and sign).
   ProtocolProfile profile;
+  // What the chassis can do (the driver gives the controller's): the bound of what it could have
+  // moved during a gap in its feedback.
+  KinematicsLimits limits;
 
   Status validate() const;  // geometry valid, durations positive, variances finite and >= 0
 };
@@ -85,7 +94,19 @@ struct OdometryState {
   std::uint64_t steps = 0;                                 // integrated steps
   std::uint64_t skipped_steps = 0;   // first frame, backwards time, gaps > max_step, zero stamps
   std::uint64_t fallback_steps = 0;  // steps from 0x221 while the configured source was kWheels
+  // Gaps in the feedback: a step longer than max_step (the chassis silent, the bus down), not
+  // integrated; the pose variance grew by what the chassis could have moved in it. The latest
+  // one's length on the frames' clock and the frame time the feedback returned (0: none since
+  // reset), and how many there were.
+  std::chrono::nanoseconds last_gap{0};
+  Timestamp last_gap_end{0};
+  std::uint64_t gaps = 0;
 };
+
+// The fastest the chassis can turn under `limits` (rad/s): a spin at max_spin_wheel_speed or an
+// Ackermann turn at max_linear_speed and full lock, whichever is faster.
+double max_yaw_rate(const KinematicsLimits& limits, const VehicleGeometry& geometry,
+                    const ProtocolProfile& profile = manual_profile());
 
 // The forward kinematics the primary source uses, fit_body_twist (the least-squares body twist
 // of four measured wheels), sits beside the inverse ones in kinematics.hpp.
@@ -132,6 +153,7 @@ class Odometry {
 
  private:
   bool wheels_fresh(Timestamp stamp) const;
+  void account_gap(std::chrono::nanoseconds gap, Timestamp end);
   bool step(const BodyTwist& twist, Timestamp stamp, OdometrySource source);
 
   OdometryConfig config_;

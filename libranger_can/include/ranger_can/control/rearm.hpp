@@ -3,11 +3,13 @@
 //
 // A stop cause that becomes active (e-stop, remote takeover, a critical error, the low-battery
 // cut-off, link loss, a failed mode switch, an implausible chassis response) latches. The latch
-// holds after the cause has cleared, even when it cleared by itself, until an explicit act:
-//  * the commander sends a zero twist while no cause is active (it has seen the stop), or
-//  * resume() is called while no cause is active.
-// resume() while a cause is still active is refused, naming the cause. The command timeout (the
-// commander went quiet) is the commander's own stop and never latches. Pure state, no clock.
+// holds after the cause has cleared, even when it cleared by itself, until a deliberate act:
+// resume() while no cause is active. resume() while a cause is still active is refused, naming
+// the cause. A zero twist is no such act (a navigation stack publishes zero twists by itself, at a
+// goal or in recovery): it re-arms only where the owner opted in (ControllerConfig::
+// rearm_on_zero_twist, for teleop-only robots), through on_zero_command(). The command timeout
+// (the commander went quiet) is the commander's own stop and never latches. Pure state, no
+// clock.
 #pragma once
 
 #include <cstdint>
@@ -56,7 +58,9 @@ class RearmLatch {
  public:
   // The causes active now; a newly active cause latches.
   void update(StopCauses active);
-  // The commander sent a zero twist: re-arms when no cause is active. Returns true if it did.
+  // The commander sent a zero twist and the owner opted in to that re-arming
+  // (ControllerConfig::rearm_on_zero_twist): re-arms when no cause is active. Returns true if it
+  // did.
   bool on_zero_command(StopCauses active);
   // The explicit resume: re-arms when no cause is active; otherwise refused, naming the causes.
   Status resume(StopCauses active);

@@ -91,7 +91,7 @@ class SettingsSupervisor {
 
  private:
   ProtocolProfile with_configured_settings(const IdentificationStatus& st) const;
-  void hold_probe_for(MotionRefusal refusal);
+  void hold_probe_for(MotionRefusal refusal, bool zero_twist_rearms);
 
   SettingsSupervisorConfig config_;
   UseProfile use_profile_;
