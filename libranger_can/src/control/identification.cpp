@@ -296,8 +296,9 @@ Status IdentificationConfig::validate() const {
 std::string unidentified_message(const std::string& reason, std::chrono::nanoseconds timeout) {
   return "the chassis could not be identified within " + secs(timeout) +
          " (identify_timeout): " + reason +
-         ". The robot stays at rest. Set the protocol instead of `auto` (protocol: manual or "
-         "protocol: agx_v2, and single settings such as steering_unit_111: millirad), or "
+         ". The robot stays at rest. Set the protocol instead of `auto` (protocol: manual, "
+         "protocol: agx_v2 or protocol: mini_v3, and single settings such as "
+         "steering_unit_111: millirad), or "
          "commission it once with the wheels off the ground: `ranger_can commission IFACE "
          "--wheels-lifted --output FILE`, then load FILE with the parameter commissioning_file";
 }
@@ -360,17 +361,12 @@ void ChassisIdentifier::on_frame(const CanFrame& frame, Timestamp now) {
 
 void ChassisIdentifier::observe_passive(const CanFrame& frame) {
   const std::uint32_t id = frame.id;
-  // Frames only the vendor's revision defines, sent by the chassis (the frame table).
   const protocol::FrameInfo* info = protocol::find_frame(id);
   const bool chassis_frame = protocol::is_chassis_frame(frame);
-  if (chassis_frame && (info->revisions & protocol::kInManual) == 0) {
-    const std::string what = text::hex(id) + " (" + std::string(protocol::frame_name(id)) + ")";
-    if (std::find(agx_signatures_.begin(), agx_signatures_.end(), what) == agx_signatures_.end()) {
-      agx_signatures_.push_back(what);
-    }
-  }
-  // Padding: a chassis frame longer than its layout (the host's own commands do not count).
-  if (chassis_frame && protocol::extra_bytes(frame) > 0 &&
+  if (chassis_frame) observe_signatures(frame, *info);
+  // Padding: a chassis frame longer than its layout in every revision (the host's own commands
+  // do not count; 0x291 of 3 bytes is the MINI 3.0's layout, not padding).
+  if (chassis_frame && padded(frame, *info) &&
       std::find(padded_ids_.begin(), padded_ids_.end(), id) == padded_ids_.end()) {
     padded_ids_.push_back(id);
   }
@@ -464,6 +460,32 @@ void ChassisIdentifier::observe_passive(const CanFrame& frame) {
   }
 }
 
+bool ChassisIdentifier::padded(const CanFrame& frame, const protocol::FrameInfo& info) {
+  if (protocol::extra_bytes(frame, FrameLayout::kManual) == 0) return false;
+  for (const FrameLayout layout : kFrameLayoutNames.values()) {
+    if (protocol::extra_bytes(frame, layout) == 0 && info.in(layout)) return false;
+  }
+  return true;
+}
+
+void ChassisIdentifier::observe_signatures(const CanFrame& frame, const protocol::FrameInfo& info) {
+  auto add = [](std::vector<std::string>& list, std::string what) {
+    if (std::find(list.begin(), list.end(), what) == list.end()) list.push_back(std::move(what));
+  };
+  const std::string what =
+      text::hex(frame.id) + " (" + std::string(protocol::frame_name(frame.id)) + ")";
+  // Frames the manual lacks: one of the vendor's family (agx_v2, mini_v3); frames agx_v2 lacks
+  // too: the MINI 3.0's.
+  if (!info.in(FrameLayout::kManual)) add(agx_signatures_, what);
+  if (!info.in(FrameLayout::kManual) && !info.in(FrameLayout::kAgxV2)) add(mini_signatures_, what);
+  // A length only the MINI 3.0's layout has (0x291 of 3 bytes; 8 would be padding).
+  const int dlc = std::min<int>(frame.dlc, static_cast<int>(CanFrame::kMaxDlc));
+  if (info.in(FrameLayout::kMiniV3) && dlc == info.length(FrameLayout::kMiniV3) &&
+      dlc != info.length(FrameLayout::kManual) && dlc != info.length(FrameLayout::kAgxV2)) {
+    add(mini_signatures_, what + " of " + std::to_string(dlc) + " bytes");
+  }
+}
+
 void ChassisIdentifier::observe_probe(const CanFrame& frame, Timestamp now) {
   if (frame.id == protocol::kSystemStatusId) {
     Result<Message> m = decode(frame, status_.profile);
@@ -537,6 +559,7 @@ void ChassisIdentifier::tick(Timestamp now) {
       if (status_frames_ >= static_cast<std::uint64_t>(config_.min_status_frames) &&
           now - status_.started >= config_.listen_time) {
         decide_passive(now);
+        if (status_.done()) break;  // the frames fit no revision
         if (read_only_) {
           decide(now);
         } else {
@@ -794,12 +817,24 @@ void ChassisIdentifier::evaluate_steer(Timestamp now) {
 
 void ChassisIdentifier::decide_passive(Timestamp now) {
   const std::string listened = secs(now - status_.started);
+  const bool counting =
+      byte7_steps_ >= kMinByte7Steps && byte7_increments_ * 10 >= byte7_steps_ * 9;
   if (!forced_revision_) {
-    if (!agx_signatures_.empty() || uart_seen_) {
+    if (!mini_signatures_.empty() && counting) {
+      // The MINI 3.0 carries faults in 0x211 byte 7, the vendor's revision a counter: neither fits.
+      fail("the chassis sends " + text::join(mini_signatures_) +
+               ", which only the RANGER MINI 3.0 (mini_v3) has, but its 0x211 byte 7 counts up "
+               "like agx_v2's counter (the MINI 3.0 carries faults there): no revision fits",
+           now);
+      return;
+    }
+    if (!mini_signatures_.empty()) {
+      status_.revision = "mini_v3";
+      note("heard " + text::join(mini_signatures_) +
+           ": only the RANGER MINI 3.0's manual has it: preset mini_v3");
+    } else if (!agx_signatures_.empty() || uart_seen_) {
       status_.revision = "agx_v2";
-      std::string what;
-      for (const auto& s : agx_signatures_)
-        what += (what.empty() ? "" : ", ") + s;
+      std::string what = text::join(agx_signatures_);
       if (uart_seen_) what += std::string(what.empty() ? "" : ", ") + "0x211 control mode 2 (UART)";
       note("heard " + what + ": only the vendor's revision sends it: preset agx_v2");
     } else {
@@ -826,14 +861,15 @@ void ChassisIdentifier::decide_passive(Timestamp now) {
          std::to_string(status_.profile.tx_dlc));
   }
   // 0x211 byte 7.
-  if (byte7_steps_ >= kMinByte7Steps && byte7_increments_ * 10 >= byte7_steps_ * 9) {
+  if (counting) {
     set("error_word", "agx16",
         "0x211 byte 7 rose by one in " + std::to_string(byte7_increments_) + " of " +
             std::to_string(byte7_steps_) + " frames: a counter, so bytes 4-5 are the error word");
   } else if (byte7_steps_ >= kMinByte7Steps && byte7_changes_ == 0) {
     set("error_word", to_string(status_.profile.error_word),
         "0x211 byte 7 constant over " + std::to_string(byte7_steps_ + 1) +
-            " frames: no counter; the preset's layout stands");
+            " frames: no counter; the preset's layout (" +
+            std::string(to_string(status_.profile.error_word)) + ") stands");
   } else {
     note("0x211 byte 7 neither counts nor stays constant (" + std::to_string(byte7_changes_) +
          " changes in " + std::to_string(byte7_steps_) + " frames): error_word kept");
@@ -919,7 +955,7 @@ void ChassisIdentifier::finish(Timestamp now) {
     return;
   }
   decide_passive(now);
-  decide(now);
+  if (!status_.done()) decide(now);
 }
 
 bool ChassisIdentifier::adopt(std::string_view name, std::string_view value, std::string evidence) {

@@ -1,5 +1,6 @@
-// Byte-exact encoding and decoding of every RANGER frame of either revision (manual 3.2,
-// PROTOCOL.md; the vendor's agx_v2, PROTOCOL_AGX_V2.md), driven by a protocol profile.
+// Byte-exact encoding and decoding of every RANGER frame of any revision (manual 3.2,
+// PROTOCOL.md; the vendor's agx_v2, PROTOCOL_AGX_V2.md; the RANGER MINI 3.0's mini_v3,
+// PROTOCOL_MINI_V3.md), driven by a protocol profile.
 //
 // Decoding is one switch on the ID after one length check: a frame shorter than its layout is
 // refused, a longer one is read from its leading bytes, so no path reads past `dlc`; nothing on
@@ -46,6 +47,9 @@ std::int8_t saturate_i8(double scaled) {
 }
 std::uint8_t saturate_u8(double scaled) {
   return saturate<std::uint8_t>(scaled);
+}
+std::int32_t saturate_i32(double scaled) {
+  return saturate<std::int32_t>(scaled);
 }
 
 }  // namespace wire
@@ -289,6 +293,11 @@ Message decode_motion_mode_command(const std::uint8_t* d, const ProtocolProfile&
   return m;
 }
 
+// Whether the profile's frame layout gives 0x291 its third byte, the drive mode (mini_v3).
+bool has_drive_mode_byte(const ProtocolProfile& p) {
+  return protocol::layout_dlc(protocol::kMotionModeFeedbackId, p.frame_layout) >= 3;
+}
+
 Message decode_motion_mode_feedback(const std::uint8_t* d, const ProtocolProfile& p) {
   MotionModeFeedback m;
   m.mode_raw = d[0];
@@ -296,7 +305,29 @@ Message decode_motion_mode_feedback(const std::uint8_t* d, const ProtocolProfile
   m.mode_known = mode.has_value();
   m.mode = mode.value_or(MotionMode::kAckermann);
   m.switching = d[1] != 0;  // anything but "switch complete" is treated as still switching
+  if (has_drive_mode_byte(p)) m.drive_mode = d[2];
   return m;
+}
+
+Message decode_drive_mode_command(const std::uint8_t* d) {
+  DriveModeCommand m;
+  m.mode_raw = d[0];
+  const auto mode = protocol::drive_mode_from_wire(d[0]);
+  m.mode_known = mode.has_value();
+  m.mode = mode.value_or(static_cast<protocol::DriveMode>(0xFF));
+  return m;
+}
+
+Message decode_odometer(std::uint32_t id, const std::uint8_t* d, const ProtocolProfile& p) {
+  OdometerFeedback o;
+  o.left_wheel = get_i32(d);
+  o.right_wheel = get_i32(d + 4);
+  o.rear = id == protocol::kRearOdometerId;
+  if (p.odometer_unit == OdometerUnit::kMillimetre) {
+    o.left_distance = o.left_wheel / kMillis;
+    o.right_distance = o.right_wheel / kMillis;
+  }
+  return o;
 }
 
 Message decode_ultrasonic(int first_sensor, const std::uint8_t* d) {
@@ -328,15 +359,20 @@ Message decode_bms(std::uint32_t id, const std::uint8_t* d, const ProtocolProfil
   return a;
 }
 
+// 0x121 / 0x231. Under light_modes on_off (the MINI 3.0) byte 1 is the lights' on/off and the
+// other bytes are reserved (zero; 0x231 keeps its counter in byte 7): they decode as off / 0.
 template <typename Light>
-Message decode_light(const std::uint8_t* d) {
+Message decode_light(const std::uint8_t* d, const ProtocolProfile& p) {
   Light l;
   l.enable = d[0] != 0;
   l.front_mode = static_cast<protocol::LightMode>(d[1]);
-  l.front_custom = d[2];
-  l.rear_mode = static_cast<protocol::LightMode>(d[3]);
-  l.rear_custom = d[4];
-  l.counter = d[7];
+  const bool on_off = p.light_modes == LightModes::kOnOff;
+  if (!on_off) {
+    l.front_custom = d[2];
+    l.rear_mode = static_cast<protocol::LightMode>(d[3]);
+    l.rear_custom = d[4];
+  }
+  if (!on_off || std::is_same_v<Light, LightState>) l.counter = d[7];
   return l;
 }
 
@@ -372,7 +408,7 @@ Result<Message> decode(const CanFrame& f, const ProtocolProfile& p) {
     return Error{Errc::kInvalidArgument,
                  "error frame (class " + hex(f.id, 8) + ") carries no RANGER message"};
   }
-  const int layout = protocol::layout_dlc(f.id);
+  const int layout = protocol::layout_dlc(f.id, p.frame_layout);
   if (layout < 0) {
     return Error{Errc::kUnknownId, "ID " + hex(f.id) + " is not part of the RANGER protocol (DLC " +
                                        std::to_string(f.dlc) + ")"};
@@ -385,11 +421,13 @@ Result<Message> decode(const CanFrame& f, const ProtocolProfile& p) {
     case protocol::kMotionCommandId:
       return decode_motion_command(d, p);
     case protocol::kLightCommandId:
-      return decode_light<LightCommand>(d);
+      return decode_light<LightCommand>(d, p);
     case protocol::kMotionModeCommandId:
       return decode_motion_mode_command(d, p);
     case protocol::kControlModeCommandId:
       return Message{ControlModeCommand{static_cast<ControlMode>(d[0])}};
+    case protocol::kDriveModeCommandId:
+      return decode_drive_mode_command(d);
     case protocol::kErrorClearCommandId:
       return Message{ErrorClearCommand{d[0]}};
     case protocol::kUltrasonicSettingId:
@@ -401,7 +439,7 @@ Result<Message> decode(const CanFrame& f, const ProtocolProfile& p) {
     case protocol::kMotionFeedbackId:
       return decode_motion_feedback(f.id, d, p);
     case protocol::kLightStateId:
-      return decode_light<LightState>(d);
+      return decode_light<LightState>(d, p);
     case protocol::kRemoteControlStateId:
       return decode_remote_control(d);
     case kHighSpeedFirst + 0:
@@ -429,7 +467,8 @@ Result<Message> decode(const CanFrame& f, const ProtocolProfile& p) {
     case protocol::kMotionModeFeedbackId:
       return decode_motion_mode_feedback(d, p);
     case protocol::kOdometerId:
-      return Message{OdometerFeedback{get_i32(d), get_i32(d + 4)}};
+    case protocol::kRearOdometerId:
+      return decode_odometer(f.id, d, p);
     case protocol::kUltrasonic1to4Id:
       return decode_ultrasonic(1, d);
     case protocol::kUltrasonic5to8Id:
@@ -489,7 +528,7 @@ class Encoder {
   CanFrame frame_for(std::uint32_t id, int length = -1) const {
     CanFrame f;
     f.id = id;
-    const int layout = length >= 0 ? length : protocol::layout_dlc(id);
+    const int layout = length >= 0 ? length : protocol::layout_dlc(id, p_.frame_layout);
     f.dlc = static_cast<std::uint8_t>(p_.tx_dlc == 8 ? 8 : layout);
     return f;
   }
@@ -535,6 +574,23 @@ class Encoder {
     return f;
   }
 
+  Result<CanFrame> operator()(const DriveModeCommand& m) const {
+    const protocol::FrameInfo* row = protocol::find_frame(protocol::kDriveModeCommandId);
+    if (!row->in(p_.frame_layout)) {
+      return Error{Errc::kInvalidArgument,
+                   "drive_mode_command: 0x423 is not a frame of frame layout " +
+                       std::string(to_string(p_.frame_layout)) +
+                       " (drive modes: the RANGER MINI 3.0's, frame layout mini_v3)"};
+    }
+    if (!protocol::kDriveModeNames.contains(m.mode)) {
+      return invalid("drive_mode_command", "mode", static_cast<long>(m.mode),
+                     "0 current, 1 voltage");
+    }
+    CanFrame f = frame_for(protocol::kDriveModeCommandId);
+    f.data[0] = static_cast<std::uint8_t>(m.mode);
+    return f;
+  }
+
   Result<CanFrame> operator()(const ErrorClearCommand& m) const {
     if (m.code > protocol::kMaxErrorClearCode) {
       return invalid("error_clear_command", "code", m.code, "0x00..0x10");
@@ -559,6 +615,9 @@ class Encoder {
     if (static_cast<long>(m.rear_mode) > max_mode) {
       return invalid("light_command", "rear_mode", static_cast<long>(m.rear_mode),
                      "0 off, 1 on, 2 breathing, 3 custom");
+    }
+    if (p_.light_modes == LightModes::kOnOff) {
+      if (Status st = on_off_only(m); !st) return st.error();
     }
     return light(protocol::kLightCommandId, m);
   }
@@ -675,6 +734,7 @@ class Encoder {
     CanFrame f = frame_for(protocol::kMotionModeFeedbackId);
     f.data[0] = value;
     f.data[1] = m.switching ? 0x01 : 0x00;
+    if (has_drive_mode_byte(p_)) f.data[2] = m.drive_mode.value_or(0);
     return f;
   }
 
@@ -746,9 +806,24 @@ class Encoder {
   }
 
   Result<CanFrame> operator()(const OdometerFeedback& o) const {
-    CanFrame f = frame_for(protocol::kOdometerId);
-    put_u32(&f.data[0], static_cast<std::uint32_t>(o.left_wheel));
-    put_u32(&f.data[4], static_cast<std::uint32_t>(o.right_wheel));
+    std::int32_t left = o.left_wheel, right = o.right_wheel;
+    if (p_.odometer_unit == OdometerUnit::kMillimetre) {
+      if (o.left_distance) {
+        if (!std::isfinite(*o.left_distance)) {
+          return not_finite("odometer", "left_distance", *o.left_distance);
+        }
+        left = wire::saturate_i32(*o.left_distance * kMillis);
+      }
+      if (o.right_distance) {
+        if (!std::isfinite(*o.right_distance)) {
+          return not_finite("odometer", "right_distance", *o.right_distance);
+        }
+        right = wire::saturate_i32(*o.right_distance * kMillis);
+      }
+    }
+    CanFrame f = frame_for(o.rear ? protocol::kRearOdometerId : protocol::kOdometerId);
+    put_u32(&f.data[0], static_cast<std::uint32_t>(left));
+    put_u32(&f.data[4], static_cast<std::uint32_t>(right));
     return f;
   }
 
@@ -767,6 +842,28 @@ class Encoder {
   }
 
  private:
+  // Light modes on_off (the MINI 3.0): byte 1 off or on, bytes 2-7 zero.
+  static Status on_off_only(const LightCommand& m) {
+    const char* kValid = "under light_modes on_off (the lights on or off only)";
+    if (m.front_mode != protocol::LightMode::kOff && m.front_mode != protocol::LightMode::kOn) {
+      return invalid("light_command", "front_mode", static_cast<long>(m.front_mode),
+                     std::string("0 off, 1 on ") + kValid + ": no breathing, no custom brightness");
+    }
+    if (m.rear_mode != protocol::LightMode::kOff) {
+      return invalid("light_command", "rear_mode", static_cast<long>(m.rear_mode),
+                     std::string("0 ") + kValid + ": no rear light");
+    }
+    if (m.front_custom != 0 || m.rear_custom != 0) {
+      return invalid("light_command", m.front_custom != 0 ? "front_custom" : "rear_custom",
+                     m.front_custom != 0 ? m.front_custom : m.rear_custom,
+                     std::string("0 ") + kValid + ": no brightness");
+    }
+    if (m.counter != 0) {
+      return invalid("light_command", "counter", m.counter, std::string("0 ") + kValid);
+    }
+    return ok_status();
+  }
+
   template <typename Light>
   CanFrame light(std::uint32_t id, const Light& m) const {
     CanFrame f = frame_for(id);
@@ -830,7 +927,10 @@ struct IdOf {
   std::uint32_t operator()(const RemoteControlState&) const {
     return protocol::kRemoteControlStateId;
   }
-  std::uint32_t operator()(const OdometerFeedback&) const { return protocol::kOdometerId; }
+  std::uint32_t operator()(const OdometerFeedback& o) const {
+    return o.rear ? protocol::kRearOdometerId : protocol::kOdometerId;
+  }
+  std::uint32_t operator()(const DriveModeCommand&) const { return protocol::kDriveModeCommandId; }
   std::uint32_t operator()(const VersionRequest&) const { return protocol::kVersionId; }
   std::uint32_t operator()(const VersionResponse&) const { return protocol::kVersionId; }
 };
