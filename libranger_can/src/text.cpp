@@ -113,6 +113,10 @@ std::string degrees(double rad) {
   return fixed(rad_to_deg(rad), 2) + " deg";
 }
 
+std::string duration_text(std::chrono::nanoseconds d) {
+  return fixed(seconds(d), 2) + " s";
+}
+
 std::string hex(std::uint32_t value, int width) {
   return format("0x%0*X", width, static_cast<unsigned>(value));
 }

@@ -455,7 +455,7 @@ NodeParameters read_all(Reader& r) {
   const ranger::KinematicsLimits full;
   const auto degrees = [](double rad) {
     std::ostringstream out;
-    out << "rad (" << std::lround(rad * 180.0 / M_PI) << " deg)";
+    out << "rad (" << std::lround(ranger::rad_to_deg(rad)) << " deg)";
     return out.str();
   };
   const auto speed_limit = [&r](const std::string& name, double& field) {

@@ -437,28 +437,23 @@ bool RangerNode::on_set_ultrasonic(ranger_msgs::SetUltrasonic::Request& req,
 bool RangerNode::on_set_motion_mode(ranger_msgs::SetMotionMode::Request& req,
                                     ranger_msgs::SetMotionMode::Response& res) {
   using Req = ranger_msgs::SetMotionMode::Request;
-  std::optional<protocol::MotionMode> mode;
-  switch (req.mode) {
-    case Req::ACKERMANN:
-      mode = protocol::MotionMode::kAckermann;
-      break;
-    case Req::OBLIQUE:
-      mode = protocol::MotionMode::kOblique;
-      break;
-    case Req::SPIN:
-      mode = protocol::MotionMode::kSpin;
-      break;
-    case Req::SIDE_SLIP:
-      mode = protocol::MotionMode::kSideSlip;
-      break;
-    case Req::AUTOMATIC:
-      break;
-    default:
+  using protocol::MotionMode;
+  // The service's constants are the modes' values (agx_v2's numbering); park has a service of
+  // its own.
+  static_assert(Req::ACKERMANN == static_cast<int>(MotionMode::kAckermann) &&
+                Req::OBLIQUE == static_cast<int>(MotionMode::kOblique) &&
+                Req::SPIN == static_cast<int>(MotionMode::kSpin) &&
+                Req::SIDE_SLIP == static_cast<int>(MotionMode::kSideSlip));
+  std::optional<MotionMode> mode;
+  if (req.mode != Req::AUTOMATIC) {
+    mode = static_cast<MotionMode>(req.mode);
+    if (!protocol::kMotionModeNames.contains(*mode) || *mode == MotionMode::kPark) {
       res.success = false;
       res.message = "mode " + std::to_string(req.mode) +
                     " unknown: use 0 (Ackermann), 1 (oblique), 2 (spin), 4 (side slip) or 255 "
                     "(automatic)";
       return true;
+    }
   }
   if (mode) {
     const auto s = driver_->snapshot();

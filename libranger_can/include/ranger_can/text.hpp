@@ -9,6 +9,7 @@
 #pragma once
 
 #include <array>
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -143,6 +144,8 @@ std::string number_text(double v);
 std::string fixed(double v, int decimals);
 // An angle in radians as degrees with two decimals: degrees(M_PI / 4) = "45.00 deg".
 std::string degrees(double rad);
+// A duration in seconds with two decimals: duration_text(1250ms) = "1.25 s".
+std::string duration_text(std::chrono::nanoseconds d);
 
 // "0x" and `value` in upper-case hexadecimal, at least `width` digits: hex(0x211) = "0x211",
 // hex(0x5, 2) = "0x05", hex(0x200, 8) = "0x00000200".

@@ -176,7 +176,7 @@ std::string value_text(const DriverParameter& p, double value) {
   if (p.type == ParameterType::kBool) return value != 0.0 ? "true" : "false";
   std::string out = number_text(value);
   if (p.unit == "rad" && value != 0.0) {
-    out += " (" + number_text(std::round(value * 180.0 / M_PI * 100.0) / 100.0) + "°)";
+    out += " (" + number_text(std::round(rad_to_deg(value) * 100.0) / 100.0) + "°)";
   }
   return out;
 }

@@ -217,6 +217,63 @@ bool is_help(const std::string& a) {
   return a == "-h" || a == "--help";
 }
 
+// The option `a` names ("--name", "--name=value" or "-x"), and the value given inline.
+const OptionSpec* find_option(const CommandSpec& spec, const std::string& a, std::string& name,
+                              std::optional<std::string>& inline_value) {
+  name = a;
+  if (a.rfind("--", 0) == 0) {
+    const auto eq = a.find('=');
+    if (eq != std::string::npos) {
+      inline_value = a.substr(eq + 1);
+      name = a.substr(0, eq);
+    }
+    for (const auto& o : spec.options) {
+      if (o.name == name) return &o;
+    }
+  } else if (a.size() == 2) {
+    for (const auto& o : spec.options) {
+      if (o.short_name == a[1]) return &o;
+    }
+  }
+  return nullptr;
+}
+
+// The option args[i] names, with its value (inline, or the next argument: i moves past it).
+Status take_option(const CommandSpec& spec, const Args& args, std::size_t& i, ParsedArgs& parsed) {
+  std::string name;
+  std::optional<std::string> inline_value;
+  const OptionSpec* found = find_option(spec, args[i], name, inline_value);
+  if (found == nullptr) return usage(unknown_option(spec, name));
+  const OptionSpec& o = *found;
+  if (!o.repeatable && parsed.has(o.name)) return usage(o.name + " given more than once");
+  std::string value;
+  if (o.value_name.empty()) {
+    if (inline_value) return usage(o.name + " takes no value");
+  } else if (inline_value) {
+    value = *inline_value;
+  } else if (i + 1 < args.size()) {
+    value = args[++i];
+  } else {
+    return usage(o.name + " needs a value (" + o.value_name + ")");
+  }
+  if (!o.value_name.empty()) {
+    if (Status s = check_value(o.name, o.rule, value); !s) return s;
+  }
+  parsed.add(o.name, std::move(value));
+  return ok_status();
+}
+
+// The required positionals from `next` on are all given.
+Status check_required(const CommandSpec& spec, std::size_t next, const ParsedArgs& parsed) {
+  for (std::size_t k = next; k < spec.positionals.size(); ++k) {
+    const PositionalSpec& p = spec.positionals[k];
+    if (p.arity == PositionalSpec::Arity::kRequired && !parsed.has(p.name)) {
+      return usage("missing " + p.name + (p.example.empty() ? "" : " (e.g. " + p.example + ")"));
+    }
+  }
+  return ok_status();
+}
+
 }  // namespace
 
 ParseOutcome parse_command_line(const CommandSpec& spec, const Args& args) {
@@ -238,41 +295,8 @@ ParseOutcome parse_command_line(const CommandSpec& spec, const Args& args) {
       options_ended = true;
       continue;
     }
-    const bool looks_like_option =
-        !options_ended && a.size() > 1 && a[0] == '-' && !is_negative_number(a);
-    if (looks_like_option) {
-      std::string name = a;
-      std::optional<std::string> inline_value;
-      const OptionSpec* spec_option = nullptr;
-      if (a.rfind("--", 0) == 0) {
-        const auto eq = a.find('=');
-        if (eq != std::string::npos) {
-          inline_value = a.substr(eq + 1);
-          name = a.substr(0, eq);
-        }
-        for (const auto& o : spec.options)
-          if (o.name == name) spec_option = &o;
-      } else if (a.size() == 2) {
-        for (const auto& o : spec.options)
-          if (o.short_name == a[1]) spec_option = &o;
-      }
-      if (spec_option == nullptr) return fail(usage(unknown_option(spec, name)));
-      const OptionSpec& o = *spec_option;
-      if (!o.repeatable && parsed.has(o.name)) return fail(usage(o.name + " given more than once"));
-      std::string value;
-      if (o.value_name.empty()) {
-        if (inline_value) return fail(usage(o.name + " takes no value"));
-      } else if (inline_value) {
-        value = *inline_value;
-      } else if (i + 1 < args.size()) {
-        value = args[++i];
-      } else {
-        return fail(usage(o.name + " needs a value (" + o.value_name + ")"));
-      }
-      if (!o.value_name.empty()) {
-        if (Status s = check_value(o.name, o.rule, value); !s) return fail(s.error());
-      }
-      parsed.add(o.name, std::move(value));
+    if (!options_ended && a.size() > 1 && a[0] == '-' && !is_negative_number(a)) {
+      if (Status s = take_option(spec, args, i, parsed); !s) return fail(s.error());
       continue;
     }
     // A positional argument.
@@ -284,13 +308,7 @@ ParseOutcome parse_command_line(const CommandSpec& spec, const Args& args) {
     parsed.add(p.name, a);
     if (p.arity != PositionalSpec::Arity::kRest) ++next_positional;
   }
-  for (std::size_t k = next_positional; k < spec.positionals.size(); ++k) {
-    const PositionalSpec& p = spec.positionals[k];
-    if (p.arity == PositionalSpec::Arity::kRequired && !parsed.has(p.name)) {
-      return fail(
-          usage("missing " + p.name + (p.example.empty() ? "" : " (e.g. " + p.example + ")")));
-    }
-  }
+  if (Status s = check_required(spec, next_positional, parsed); !s) return fail(s.error());
   return {Kind::kRun, std::move(parsed), ""};
 }
 

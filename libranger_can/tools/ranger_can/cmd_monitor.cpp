@@ -50,8 +50,41 @@ MonitorOptions options_from(const ParsedArgs& args) {
   return o;
 }
 
-std::chrono::nanoseconds seconds(double s) {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::duration<double>(s));
+// The view as drawn: after a clear-screen on a terminal, else (text) after a blank line from the
+// second view on.
+std::string drawn(std::string view, bool clear, bool json, long views) {
+  if (clear) return "\x1b[H\x1b[2J" + view;
+  if (!json && views > 0) return "\n" + view;
+  return view;
+}
+
+// The monitor once the identification window is over: the chassis's settings read from the
+// frames heard so far (passively, as `decode` does for a log), --set over them.
+Result<ChassisMonitor> identified_monitor(const ParsedArgs& args, const Vehicle& vehicle,
+                                          const MonitorOptions& o, std::vector<CanFrame>& heard,
+                                          Timestamp now) {
+  ProtocolProfile profile = identify_log(heard, vehicle.geometry).profile;
+  if (Status st = apply_set_options(profile, args); !st) return st.error();
+  ChassisMonitor monitor(from_seconds(o.window), profile);
+  for (const CanFrame& f : heard)
+    monitor.on_frame(f, now);
+  heard.clear();
+  return monitor;
+}
+
+// A frame received (or the receive's error): to the monitor, or kept for the identification.
+void take(const Result<CanFrame>& frame, std::optional<ChassisMonitor>& monitor,
+          std::vector<CanFrame>& heard, Timestamp now) {
+  if (frame) {
+    if (monitor) {
+      monitor->on_frame(*frame, now);
+    } else {
+      heard.push_back(*frame);
+    }
+  } else if (frame.error().code != Errc::kTimeout) {
+    // The bus reports and recovers a lost interface itself; the view shows the state.
+    ::usleep(20000);
+  }
 }
 
 int monitor_main(const ParsedArgs& args, Io io) {
@@ -73,62 +106,41 @@ int monitor_main(const ParsedArgs& args, Io io) {
   SteadyClock clock;
   // With --protocol auto (the default) the first half second of frames (or the --once window)
   // identifies the chassis's settings passively, as `decode` does for a log; the view starts then.
-  const bool identify = protocol_is_auto(args);
   std::vector<CanFrame> heard;  // while identifying
   std::optional<ChassisMonitor> monitor;
-  if (!identify) monitor.emplace(seconds(o.window), vehicle->profile);
+  if (!protocol_is_auto(args)) monitor.emplace(from_seconds(o.window), vehicle->profile);
   const Timestamp start = clock.now();
-  const auto period = seconds(1.0 / o.rate);
-  Timestamp next_view = start + (o.once ? seconds(o.window) : std::max(period, seconds(0.5)));
+  const auto period = from_seconds(1.0 / o.rate);
+  Timestamp next_view =
+      start + (o.once ? from_seconds(o.window) : std::max(period, from_seconds(0.5)));
   long views = 0;
 
   while (!StopSignals::requested()) {
     const Timestamp now = clock.now();
     if (now >= next_view && !monitor) {
-      ProtocolProfile profile = identify_log(heard, vehicle->geometry).profile;
-      if (Status st = apply_set_options(profile, args); !st) {
-        return usage_error(monitor_command(), io, st.error().message);
-      }
-      monitor.emplace(seconds(o.window), profile);
-      for (const CanFrame& f : heard)
-        monitor->on_frame(f, now);
-      heard.clear();
+      auto m = identified_monitor(args, *vehicle, o, heard, now);
+      if (!m) return usage_error(monitor_command(), io, m.error().message);
+      monitor.emplace(std::move(*m));
     }
     if (now >= next_view) {
       const BusStatus status = (*bus)->status();
-      std::string view = o.json ? monitor->render_json(o.iface, status, now) + "\n"
-                                : monitor->render_text(o.iface, status, now, color);
-      if (clear) {
-        view = "\x1b[H\x1b[2J" + view;
-      } else if (!o.json && views > 0) {
-        view = "\n" + view;
-      }
-      io.out << view;
+      io.out << drawn(o.json ? monitor->render_json(o.iface, status, now) + "\n"
+                             : monitor->render_text(o.iface, status, now, color),
+                      clear, o.json, views);
       io.out.flush();
       ++views;
-      if (o.once) {
-        if (!monitor->heard_chassis()) {
-          io.err << "ranger_can monitor: no RANGER feedback on " << o.iface << " within "
-                 << o.window << " s\n";
-          return 1;
-        }
-        return 0;
+      if (o.once && !monitor->heard_chassis()) {
+        io.err << "ranger_can monitor: no RANGER feedback on " << o.iface << " within " << o.window
+               << " s\n";
+        return 1;
       }
-      if (o.count && views >= *o.count) return 0;
+      if (o.once || (o.count && views >= *o.count)) return 0;
       next_view += period;
       if (next_view <= now) next_view = now + period;
     }
-    auto frame = (*bus)->receive(std::min<std::chrono::nanoseconds>(next_view - clock.now(), 50ms));
-    if (frame) {
-      if (monitor) {
-        monitor->on_frame(*frame, clock.now());
-      } else {
-        heard.push_back(*frame);
-      }
-    } else if (frame.error().code != Errc::kTimeout) {
-      // The bus reports and recovers a lost interface itself; the view shows the state.
-      ::usleep(20000);
-    }
+    const auto frame =
+        (*bus)->receive(std::min<std::chrono::nanoseconds>(next_view - clock.now(), 50ms));
+    take(frame, monitor, heard, clock.now());
   }
   return 0;
 }

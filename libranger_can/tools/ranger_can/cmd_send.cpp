@@ -56,13 +56,10 @@ Result<Message> parse_park(const Words& w) {
 Status parse_light(const std::string& what, const std::string& word, protocol::LightMode& mode,
                    std::uint8_t& brightness) {
   brightness = 0;
-  if (word == "off")
-    mode = protocol::LightMode::kOff;
-  else if (word == "on")
-    mode = protocol::LightMode::kOn;
-  else if (word == "breathing")
-    mode = protocol::LightMode::kBreathing;
-  else if (word.rfind("custom:", 0) == 0) {
+  const auto named = protocol::kLightModeNames.parse(word);  // custom takes its brightness
+  if (named && *named != protocol::LightMode::kCustom) {
+    mode = *named;
+  } else if (word.rfind("custom:", 0) == 0) {
     auto pct = parse_integer("lights " + what + " custom:PCT", word.substr(7), 0, 100);
     if (!pct) return pct.error();
     mode = protocol::LightMode::kCustom;
@@ -92,8 +89,10 @@ Result<Message> parse_version(const Words&) {
 }
 
 Result<Message> parse_control(const Words& w) {
-  if (w[0] == "can") return Message{ControlModeCommand{protocol::ControlMode::kCan}};
-  if (w[0] == "standby") return Message{ControlModeCommand{protocol::ControlMode::kStandby}};
+  const auto mode = protocol::kControlModeNames.parse(w[0]);
+  if (mode == protocol::ControlMode::kCan || mode == protocol::ControlMode::kStandby) {
+    return Message{ControlModeCommand{*mode}};
+  }
   return bad("control: unknown control mode '" + w[0] + "' (can or standby)");
 }
 

@@ -55,6 +55,7 @@
 #include "ranger_can/result.hpp"
 #include "ranger_can/text.hpp"
 #include "ranger_can/transport/bus.hpp"
+#include "ranger_can/types.hpp"
 #include "ranger_can/wire/codec.hpp"
 #include "ranger_can/wire/frame.hpp"
 #include "ranger_can/wire/profile.hpp"
@@ -180,7 +181,7 @@ struct ControllerConfig {
   double standstill_speed = 0.02;  // m/s, every wheel slower than this = standstill
   // rad: full speed while every wheel is within this of its commanded angle, zero beyond twice
   // it, linear in between (0 disables steer-first).
-  double steer_first_threshold = 10.0 * M_PI / 180.0;
+  double steer_first_threshold = deg_to_rad(10.0);
   std::chrono::nanoseconds ultrasonic_confirm_timeout = std::chrono::milliseconds(500);
   int ultrasonic_max_attempts = 3;
   double low_battery_soc = vehicle_spec::kLowBatteryCutoffSoc;  // %: the chassis cuts the drives

@@ -84,11 +84,11 @@ struct IdentificationConfig {
   std::chrono::nanoseconds settle_time = std::chrono::milliseconds(300);
   // The probe's steering angle, rad (REP-103: to the left). 6 deg stays within the 40 deg
   // Ackermann range even when the chassis reads it 5.7 times larger (0.001 rad for 0.01 deg).
-  double probe_angle = 6.0 * M_PI / 180.0;
+  double probe_angle = deg_to_rad(6.0);
   bool spin_check = true;  // switch to spin mode at standstill to read the 0x271 unit and sign
   // Accepted when the best combination explains every wheel within this (rad, plus 10 % of the
   // angle) and the second best is at least `margin` times worse.
-  double angle_tolerance = 2.0 * M_PI / 180.0;
+  double angle_tolerance = deg_to_rad(2.0);
   double margin = 3.0;
 
   Status validate() const;  // durations > 0, probe angle in (1, 7] deg, tolerances > 0
@@ -198,12 +198,23 @@ class ChassisIdentifier {
     SteeringSign sign;
   };
   void start(Timestamp now);
+  // The passive evidence, frame by frame: what only some revisions send and padding (every chassis
+  // frame), 0x211, 0x291, 0x361 and the rolling wheels (0x271 + 0x281).
   void observe_passive(const CanFrame& frame);
+  void observe_origin(const CanFrame& frame);
+  void observe_status(const CanFrame& frame);
+  void observe_bms(const CanFrame& frame);
+  void observe_rolling(const CanFrame& frame);
   // What a chassis frame says about the revision: IDs and lengths only some revisions have.
   void observe_signatures(const CanFrame& frame, const protocol::FrameInfo& info);
   // Longer than its layout in every revision that defines it (padding, not another layout).
   static bool padded(const CanFrame& frame, const protocol::FrameInfo& info);
   void observe_probe(const CanFrame& frame, Timestamp now);
+  // The phases, tick by tick; why the identification timed out in the phase it is in.
+  std::string timeout_reason() const;
+  void tick_listening(Timestamp now);
+  void tick_awaiting_control(Timestamp now);
+  void tick_step(Timestamp now);
   void decide_passive(Timestamp now);
   void begin_step(IdentificationPhase phase, Timestamp now);
   bool settled(Timestamp now) const;
@@ -219,7 +230,7 @@ class ChassisIdentifier {
   void evaluate_steer(Timestamp now);
   void fail(std::string why, Timestamp now);
   void decide(Timestamp now);
-  void set(std::string_view name, std::string_view value, std::string evidence);
+  void set(ProtocolSetting setting, std::string_view value, std::string evidence);
   void note(std::string line);
   std::optional<std::array<double, 4>> wheel_angles(const CanFrame& frame, AngleUnit unit,
                                                     SteeringSign sign) const;
