@@ -466,6 +466,21 @@ void mini_v1_geometry(DriverConfig& c) {
   c.controller.limits.max_spin_wheel_speed = 0.076;
 }
 
+// The model a variant is (its geometry and limits a driver must be given), or "".
+std::string model_of(const std::string& v) {
+  if (v == "mini_v1") return "ranger_mini_v1";
+  if (v == "mini_v3") return "ranger_mini_v3";
+  return "";
+}
+void model_geometry(DriverConfig& c, const std::string& v) {
+  if (v == "mini_v1") mini_v1_geometry(c);
+  if (v == "mini_v3") {
+    const ModelPreset m = *model_preset(model_of(v));
+    c.controller.geometry = m.geometry;
+    c.controller.limits = m.limits;
+  }
+}
+
 // What each variant speaks (sim_bus_source.cpp's table), as the settings a commissioning should
 // find; nullopt for the undecidable one.
 std::optional<ProtocolProfile> truth(const std::string& v) {
@@ -486,13 +501,14 @@ std::optional<ProtocolProfile> truth(const std::string& v) {
     p.spin_sign = -1;
     p.mode_numbering = ModeNumbering::kMiniV1;
   }
+  if (v == "mini_v3") p = preset("mini_v3");
   if (v == "undecidable") return std::nullopt;
   return p;
 }
 
 const std::vector<std::string> kAll = {
-    "manual",        "agx_v2",      "padded",  "spin_cw",    "steer_left_positive",
-    "speed221_body", "inner_angle", "mini_v1", "undecidable"};
+    "manual",        "agx_v2",      "padded",  "spin_cw", "steer_left_positive",
+    "speed221_body", "inner_angle", "mini_v1", "mini_v3", "undecidable"};
 
 }  // namespace variants
 
@@ -512,7 +528,7 @@ TEST_P(EveryVariant, AutoIdentifiesItAndDrivesTheRoute) {
   const std::string v = GetParam();
   ASSERT_TRUE(variants::known(v)) << "sim:" << v << " is no variant of the library";
   DriverConfig c = test::auto_config();
-  if (v == "mini_v1") variants::mini_v1_geometry(c);
+  variants::model_geometry(c, v);
   IdentifyRig rig("sim:" + v, c);
   rig.set_rearm(true);
   rig.command({0.5, 0.0, 0.0});
@@ -564,7 +580,7 @@ TEST_P(EveryVariant, CommissionWritesItsTrueSettingsAndTheFileDrivesTheRoute) {
   std::vector<std::string> args = {"sim:" + v, "--wheels-lifted", "--output", path};
   // A MINI's owner names the model: its geometry (the spin position, the kinematics) is not
   // the RANGER's, and the signs and fields are still read from the chassis.
-  if (v == "mini_v1") args.insert(args.end(), {"--model", "ranger_mini_v1"});
+  if (!variants::model_of(v).empty()) args.insert(args.end(), {"--model", variants::model_of(v)});
   const auto r = test::run_cli(cli::run_commission, args);
   if (v == "undecidable") {
     EXPECT_EQ(r.rc, 1);
@@ -581,7 +597,7 @@ TEST_P(EveryVariant, CommissionWritesItsTrueSettingsAndTheFileDrivesTheRoute) {
         << p.name << " commissioned on sim:" << v;
   }
   DriverConfig c = test::forced_config(*loaded);
-  if (v == "mini_v1") variants::mini_v1_geometry(c);
+  variants::model_geometry(c, v);
   IdentifyRig rig("sim:" + v, c);
   rig.expect_route("sim:" + v + " commissioned", v == "mini_v1" ? 0.3 : 1.0);
   EXPECT_EQ(rig.rearms(), 0);
