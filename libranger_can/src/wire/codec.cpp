@@ -943,4 +943,34 @@ std::uint32_t id_of(const Message& message) {
   return std::visit(IdOf{}, message);
 }
 
+std::optional<UnsupportedFeature> unsupported_feature(const Message& command,
+                                                      const ProtocolProfile& p) {
+  if (const auto* m = std::get_if<MotionModeCommand>(&command)) {
+    if (protocol::motion_mode_to_wire(m->mode, p.mode_numbering)) return std::nullopt;
+    const std::string mode(protocol::to_string(m->mode));
+    return UnsupportedFeature{mode, "its motion-mode numbering " +
+                                        std::string(to_string(p.mode_numbering)) + " has no " +
+                                        mode + " mode"};
+  }
+  if (std::holds_alternative<DriveModeCommand>(command)) {
+    if (protocol::find_frame(protocol::kDriveModeCommandId)->in(p.frame_layout))
+      return std::nullopt;
+    return UnsupportedFeature{"drive modes", "its frame layout " +
+                                                 std::string(to_string(p.frame_layout)) +
+                                                 " has no 0x423 drive mode command"};
+  }
+  const auto* l = std::get_if<LightCommand>(&command);
+  if (l == nullptr || p.light_modes != LightModes::kOnOff) return std::nullopt;
+  const std::string reason = "light_modes on_off: the lights on or off only";
+  if (l->front_mode == protocol::LightMode::kBreathing) {
+    return UnsupportedFeature{"breathing lights", reason};
+  }
+  if (l->rear_mode != protocol::LightMode::kOff) return UnsupportedFeature{"a rear light", reason};
+  if (l->front_mode == protocol::LightMode::kCustom || l->front_custom != 0 ||
+      l->rear_custom != 0) {
+    return UnsupportedFeature{"brightness", reason};
+  }
+  return std::nullopt;
+}
+
 }  // namespace ranger

@@ -53,10 +53,10 @@ struct MotionCommand {
 };
 // 0x111's valid ranges in SI units, for code above the codec (the linear speed's range is open
 // point 1: interpretation::kMaxLinearSpeedMps).
-inline constexpr double kMaxAckermannSteeringRad = deg_to_rad(40.0);     // +-4000 x 0.01 deg
-inline constexpr double kMaxObliqueSteeringRad = deg_to_rad(90.0);       // +-9000 x 0.01 deg
-inline constexpr double kMaxSpinSpeedMps = 1.0;                          // +-1000 mm/s
-struct MotionModeCommand {                                               // 0x141
+inline constexpr double kMaxAckermannSteeringRad = deg_to_rad(40.0);  // +-4000 x 0.01 deg
+inline constexpr double kMaxObliqueSteeringRad = deg_to_rad(90.0);    // +-9000 x 0.01 deg
+inline constexpr double kMaxSpinSpeedMps = 1.0;                       // +-1000 mm/s
+struct MotionModeCommand {                                            // 0x141
   protocol::MotionMode mode = protocol::MotionMode::kAckermann;
   // Decoding only: the wire byte, and whether the profile's numbering defines it (when not,
   // `mode` holds no enumerator and the command must not be obeyed). Encoding writes `mode`.
@@ -259,6 +259,17 @@ Result<CanFrame> encode(const Message& message);
 
 // The frame ID a message encodes to (for a valid message).
 std::uint32_t id_of(const Message& message);
+
+// What a command asks for that `profile`'s chassis does not have, for a refusal that names it
+// (encode() refuses the same): `feature` as people call it ("side_slip", "park", "drive modes",
+// "breathing lights", "a rear light", "brightness") and `reason`, the setting that lacks it
+// ("its motion-mode numbering mini_v3 has no side_slip mode"). nullopt when the profile has it.
+struct UnsupportedFeature {
+  std::string feature;
+  std::string reason;
+};
+std::optional<UnsupportedFeature> unsupported_feature(const Message& command,
+                                                      const ProtocolProfile& profile);
 
 // ---- Wire-level helpers (exposed for tests and the DBC cross-check) --------------------------
 namespace wire {
