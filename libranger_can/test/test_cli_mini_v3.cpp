@@ -5,9 +5,14 @@
 // three readings apart on the virtual chassis.
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <fstream>
 #include <string>
 #include <vector>
 
+#include "cli_monitor_view.hpp"
+#include "ranger_can/wire/candump_log.hpp"
+#include "ranger_can/wire/codec.hpp"
 #include "support/cli_run.hpp"
 
 namespace ranger {
@@ -150,6 +155,26 @@ TEST(CliMiniV3, SendWritesItsCommandsAndRefusesWhatItLacksByName) {
   const auto model =
       run_cli(cli::run_send, {"can0", "drive_mode", "voltage", "--model", "ranger_mini_v3", "-n"});
   EXPECT_EQ(model.rc, 0) << model.err;
+}
+
+TEST(CliMiniV3, MonitorShowsTheDriveModeAndBothOdometers) {
+  cli::ChassisMonitor monitor(std::chrono::seconds(1), *protocol_preset("mini_v3"));
+  const Timestamp now(std::chrono::seconds(5));
+  std::ifstream in(kTable);
+  for (std::string line; std::getline(in, line);) {
+    auto e = parse_candump_line(line);
+    ASSERT_TRUE(e.ok()) << line;
+    monitor.on_frame(e->frame, now);
+  }
+  const std::string view = monitor.render_text("can0", BusStatus{}, now, false);
+  EXPECT_TRUE(contains(view, "Motion    mode spin   SWITCHING   drive current")) << view;
+  EXPECT_TRUE(contains(view, "Odometer front  left 12.345 m  right -0.250 m")) << view;
+  EXPECT_TRUE(contains(view, "Odometer rear   left 12.340 m  right 12.395 m")) << view;
+  EXPECT_TRUE(contains(view, "emergency_stop")) << view;
+  EXPECT_TRUE(contains(view, "alarms under_voltage,charge_over_current")) << view;
+  const std::string json = monitor.render_json("can0", BusStatus{}, now);
+  EXPECT_TRUE(contains(json, "\"drive_mode\":\"current\"")) << json;
+  EXPECT_TRUE(contains(json, "\"rear_odometer\":{\"left\":12.34,\"right\":12.395}")) << json;
 }
 
 TEST(CliMiniV3, IdentifyTellsTheThreeReadingsApart) {
