@@ -143,6 +143,12 @@ JsonWriter& JsonWriter::strings(const std::vector<std::string>& v) {
   return end_array();
 }
 
+JsonWriter& JsonWriter::raw(std::string_view json) {
+  before_value();
+  out_ += json;
+  return *this;
+}
+
 JsonWriter& JsonWriter::seconds(Timestamp t) {
   before_value();
   append_seconds(out_, t);

@@ -431,6 +431,25 @@ TEST(ScenarioRun, TheSameScriptGivesTheSameBytes) {
   EXPECT_EQ(err1.str(), err2.str());
 }
 
+// The driver's events ride on the next sample as "events":[{...}] after its other fields; a sample
+// with none since the one before has no such field; an event after the last sample comes on a
+// line of its own, {"t":...,"events":[...]}.
+TEST(ScenarioRun, SamplesCarryTheDriverEventsSinceTheSampleBefore) {
+  const Scenario s = parse_ok("wait 2\nestop on\nwait 0.1\n");
+  ScenarioOptions o;
+  o.every = 500ms;
+  std::ostringstream out, err;
+  ASSERT_TRUE(run_scenario(s, o, out, err).ok());
+  const auto lines = test::lines_of(out.str());
+  ASSERT_EQ(lines.size(), 6u) << out.str();  // t = 0, 0.5, ... 2.0, then the e-stop's events
+  EXPECT_TRUE(contains(lines[0], "\"identification\":\"none\",\"events\":[{\"seq\":1,\"t\":0.000,"))
+      << lines[0];
+  EXPECT_EQ(lines[0].substr(lines[0].size() - 3), "}]}");
+  EXPECT_FALSE(contains(lines[4], "\"events\"")) << lines[4];  // nothing new by t = 2
+  EXPECT_EQ(lines[5].rfind("{\"t\":2.100,\"events\":[{\"seq\":", 0), 0u) << lines[5];
+  EXPECT_TRUE(contains(lines[5], "emergency")) << lines[5];
+}
+
 // ---- the sub-command ----------------------------------------------------------------------------
 
 test::CliOutcome cli(const cli::Args& args, const std::string& input = "") {

@@ -14,6 +14,7 @@
 
 #include "ranger_can/control/controller.hpp"
 #include "ranger_can/control/driver.hpp"
+#include "ranger_can/control/driver_events.hpp"
 #include "ranger_can/control/identification.hpp"
 #include "ranger_can/control/mode_switch.hpp"
 #include "ranger_can/control/odometry.hpp"
@@ -118,6 +119,8 @@ TEST(EnumNames, EveryTableHoldsEveryEnumerator) {
   expect_table_complete(kVendorFramesNames, "VendorFrames");
   expect_table_complete(kFirmwareStateNames, "FirmwareVersion::State");
   expect_table_complete(sim::kOpNames, "Expectation::Op");
+  expect_table_complete(kSeverityNames, "Severity");
+  expect_table_complete(kEventKindNames, "EventKind");
 }
 
 // The finder itself: it sees a missing enumerator.

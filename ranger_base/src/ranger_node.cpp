@@ -11,20 +11,14 @@
 #include <sensor_msgs/Range.h>
 #include <tf2_msgs/TFMessage.h>
 
-#include <poll.h>
 #include <pthread.h>
-#include <sys/eventfd.h>
-#include <time.h>
-#include <unistd.h>
 
 #include <boost/make_shared.hpp>
 
 #include <algorithm>
 #include <chrono>
 #include <cinttypes>
-#include <cmath>
-#include <cstdio>
-#include <sstream>
+#include <map>
 #include <string>
 
 #include <ranger_can/sim/chassis_commands.hpp>
@@ -37,17 +31,9 @@ namespace ranger_base {
 namespace {
 
 namespace protocol = ranger::protocol;
-using std::chrono::milliseconds;
 using std::chrono::nanoseconds;
+using Kind = ranger::RequestOutcome::Kind;
 using State = ranger::RequestOutcome::State;
-
-// How long a service waits beyond the driver's own answer timeout (the driver decides; this only
-// covers its next iteration).
-constexpr nanoseconds kAnswerMargin = milliseconds(200);
-// A service waits for its answer in slices this long, so that shutdown never waits for it.
-constexpr nanoseconds kWaitSlice = milliseconds(20);
-// While the chassis was never heard, "still waiting" is repeated this often.
-constexpr nanoseconds kWaitingReminder = std::chrono::seconds(30);
 
 const ranger::Clock& driver_clock() {
   static const ranger::SteadyClock clock;
@@ -56,10 +42,6 @@ const ranger::Clock& driver_clock() {
 const ranger::Clock& bus_clock() {
   static const ranger::SystemClock clock;
   return clock;
-}
-
-double secs(nanoseconds d) {
-  return ranger::seconds(d);
 }
 
 using ranger::text::join;
@@ -71,11 +53,6 @@ std::string join_pairs(const std::vector<std::pair<std::string, std::string>>& p
   for (const auto& [name, value] : pairs)
     items.push_back(name + separator + value);
   return join(items);
-}
-
-bool is_socketcan(const std::string& port) {
-  const auto kind = ranger::bus_kind(port);
-  return kind && *kind == ranger::BusKind::kSocketCan;
 }
 
 // Publishes a message as a shared pointer: a subscriber in the same process gets this very
@@ -90,6 +67,14 @@ void publish_shared(const ros::Publisher& pub, M&& message) {
 template <class Make>
 void publish_if_heard(const ros::Publisher& pub, Make make) {
   if (pub.getNumSubscribers() > 0) publish_shared(pub, make());
+}
+
+// The driver's event in the log at its severity: the one mapping from the library's events.
+void log_event(const ranger::DriverEvent& event) {
+  using Level = ros::console::levels::Level;
+  static constexpr Level kLevel[] = {Level::Debug, Level::Info, Level::Warn, Level::Error};
+  ROS_LOG(kLevel[static_cast<int>(event.severity)], ROSCONSOLE_DEFAULT_NAME, "%s",
+          ranger::describe(event).c_str());
 }
 
 // A publication is due from this long before its time (the estimates come with the driver's
@@ -147,7 +132,8 @@ RangerNode::RangerNode(const ros::NodeHandle& nh, const ros::NodeHandle& private
       source_(std::move(source)),
       sim_(std::dynamic_pointer_cast<ranger::sim::SimBusSource>(source_)),
       driver_(std::make_unique<ranger::Driver>(params_.driver, source_, driver_clock())),
-      updater_(nh, private_nh) {
+      updater_(nh, private_nh),
+      publication_waker_(driver_clock()) {
   cmd_nh_.setCallbackQueue(&cmd_queue_);
   service_nh_.setCallbackQueue(&service_queue_);
 
@@ -177,17 +163,17 @@ RangerNode::RangerNode(const ros::NodeHandle& nh, const ros::NodeHandle& private
       ProtocolContext{params_.protocol.source, params_.port_name});
   // Both observers run on the driver thread: they queue, or wake the publication thread, and
   // return (publication never runs on the thread that owns the 0x111 keep-alive).
-  publication_wake_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
   // The send's wall time is read only for cmd_vel_out.
   driver_->set_sent_observer([this](const ranger::SentEvent& e) { on_sent(e); },
                              params_.publish_cmd);
   driver_->set_step_observer(
       [this](const std::shared_ptr<const ranger::DriverSnapshot>&) { on_step(); });
+  // The driver's events are logged by the publication thread (log_events), never on its own.
+  driver_->set_event_observer([this](const ranger::DriverEvent&) { wake_publication(); });
 }
 
 RangerNode::~RangerNode() {
   shutdown();
-  if (publication_wake_fd_ >= 0) ::close(publication_wake_fd_);
 }
 
 void RangerNode::start() {
@@ -234,7 +220,7 @@ void RangerNode::log_protocol() const {
         "(listening first, then a few degrees of steering at zero speed; identify_timeout %.1f "
         "s); nothing is driven until then, and the plausibility monitors check them while "
         "driving",
-        secs(params_.driver.identification.timeout));
+        ranger::seconds(params_.driver.identification.timeout));
     if (!pp.model_settings.empty()) {
       ROS_INFO(
           "the %s's own readings (%s) are not assumed with protocol auto: the identification "
@@ -258,21 +244,14 @@ void RangerNode::log_protocol() const {
 void RangerNode::shutdown() {
   if (shut_down_) return;
   shut_down_ = true;
-  stopping_ = true;
   // Commands stop first: no cmd_vel may restart the chassis after the stop.
   cmd_vel_sub_.shutdown();
   sim_inject_sub_.shutdown();
-  driver_->stop();  // the zero motion command (on_sent logs it), then the driver thread ends
+  driver_->stop();  // the zero motion command (an event says it), then the driver thread ends
   publication_stop_ = true;
   wake_publication();
-  if (publication_thread_.joinable()) publication_thread_.join();  // cmd_vel_out has the stop
-  if (!stop_sent_) {
-    const auto s = driver_->snapshot();
-    ROS_INFO("no stop sent to the chassis: %s",
-             !s->bus_open ? ("the bus " + params_.port_name + " was never opened").c_str()
-                          : (s->read_only ? "a replayed log is read-only"
-                                          : "the driver had nothing to stop"));
-  }
+  // cmd_vel_out has the stop, the log the driver's event about it.
+  if (publication_thread_.joinable()) publication_thread_.join();
   // A disabled queue wakes its spinner thread at once instead of after its poll timeout.
   cmd_queue_.disable();
   service_queue_.disable();
@@ -287,25 +266,13 @@ void RangerNode::on_cmd_vel(const geometry_msgs::Twist::ConstPtr& msg) {
   if (has_non_planar_components(*msg)) {
     ROS_WARN_THROTTLE(5.0, "cmd_vel: linear.z, angular.x and angular.y are ignored (planar base)");
   }
-  const ranger::Status st = driver_->command(ranger::MotionRequest{twist, std::nullopt});
-  if (!st) {
-    if (st.error().code == ranger::Errc::kNotFinite) {
-      ROS_ERROR_THROTTLE(1.0, "cmd_vel refused, chassis stopped: %s", st.error().message.c_str());
-    } else {
-      ROS_WARN_THROTTLE(5.0, "cmd_vel not applied: %s", st.error().message.c_str());
-    }
-  }
+  // A refusal (NaN, not connected) is the driver's event, logged with the others.
+  (void)driver_->command(ranger::MotionRequest{twist, std::nullopt});
 }
 
 void RangerNode::on_sent(const ranger::SentEvent& e) {
   const auto achieved = achieved_twist(e);
-  if (!achieved) return;  // not a motion command
-  if (e.sent.shutdown) {
-    stop_sent_ = true;
-    ROS_INFO("stop sent to the chassis (zero motion command, frame 0x%03" PRIX32 ")",
-             e.sent.frame.id);
-  }
-  if (!params_.publish_cmd) return;
+  if (!achieved || !params_.publish_cmd) return;  // not a motion command, or not published
   ros::Time stamp;
   stamp.fromNSec(static_cast<std::uint64_t>(
       std::chrono::duration_cast<nanoseconds>(e.wall.time_since_epoch()).count()));
@@ -321,40 +288,22 @@ void RangerNode::on_step() {
 }
 
 void RangerNode::wake_publication() {
-  if (publication_wake_fd_ < 0) return;
-  const std::uint64_t one = 1;
-  // A full counter (EAGAIN) means a wake-up is pending anyway.
-  [[maybe_unused]] const auto n = ::write(publication_wake_fd_, &one, sizeof one);
+  publication_waker_.wake();
 }
 
 void RangerNode::on_sim_inject(const std_msgs::String::ConstPtr& msg) {
   if (!sim_) return;
   const std::string& line = msg->data;
-  auto action = ranger::sim::parse_chassis_command(line);
-  if (!action) {
+  const auto said = sim_->with_chassis(
+      [&](ranger::sim::VirtualChassis& c) { return ranger::sim::apply_chassis_command(line, c); });
+  if (!said) {
     ROS_WARN("sim/inject \"%s\" not applied: %s (valid commands: %s; see ranger_base/README.md)",
-             line.c_str(), action.error().message.c_str(),
+             line.c_str(), said.error().message.c_str(),
              join(ranger::sim::chassis_command_names()).c_str());
     return;
   }
-  const std::string said = sim_->with_chassis(*action);
   ROS_INFO("sim/inject \"%s\" applied to the virtual chassis%s%s", line.c_str(),
-           said.empty() ? "" : ": ", said.c_str());
-}
-
-ranger::RequestOutcome RangerNode::wait_for(std::uint64_t id, nanoseconds timeout) {
-  const auto deadline = std::chrono::steady_clock::now() + timeout;
-  for (;;) {
-    const auto left = deadline - std::chrono::steady_clock::now();
-    auto outcome = driver_->wait_for(
-        id, std::max<nanoseconds>(nanoseconds(0), std::min<nanoseconds>(left, kWaitSlice)));
-    if (outcome.state == State::kAnswered || outcome.state == State::kFailed) return outcome;
-    if (stopping_) {
-      outcome.message = "shutting down";
-      return outcome;
-    }
-    if (left <= nanoseconds(0)) return outcome;
-  }
+           said->empty() ? "" : ": ", said->c_str());
 }
 
 bool RangerNode::on_resume(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
@@ -366,17 +315,13 @@ bool RangerNode::on_resume(std_srvs::Trigger::Request&, std_srvs::Trigger::Respo
     ROS_WARN("%s", res.message.c_str());
     return true;
   }
-  const auto outcome = wait_for(driver_->resume(), params_.driver.request_answer_timeout);
+  const auto outcome = wait_for(driver_->resume(), Kind::kResume);
+  // (The outcome is logged as the driver's event.)
   res.success = outcome.state == State::kAnswered;
-  if (res.success) {
-    res.message = "re-armed: cmd_vel drives the chassis again";
-    ROS_INFO("resume: %s", res.message.c_str());
-  } else {
-    res.message = outcome.message.empty()
-                      ? "resume not applied (" + std::string(ranger::to_string(outcome.state)) + ")"
-                      : outcome.message;
-    ROS_WARN("resume: %s", res.message.c_str());
-  }
+  res.message = res.success ? "re-armed: cmd_vel drives the chassis again"
+                : outcome.message.empty()
+                    ? "resume not applied (" + std::string(ranger::to_string(outcome.state)) + ")"
+                    : outcome.message;
   return true;
 }
 
@@ -389,7 +334,7 @@ bool RangerNode::on_clear_errors(ranger_msgs::ClearErrors::Request& req,
     res.error_word = driver_->snapshot()->controller.error_bits;
     return true;
   }
-  const auto outcome = wait_for(*posted, params_.driver.request_answer_timeout + kAnswerMargin);
+  const auto outcome = wait_for(*posted, Kind::kClearErrors);
   const std::string asked = "clear_errors code " + std::to_string(req.code) + " (" +
                             protocol::error_clear_description(req.code) + ")";
   if (outcome.state == State::kAnswered && outcome.error_word) {
@@ -400,13 +345,11 @@ bool RangerNode::on_clear_errors(ranger_msgs::ClearErrors::Request& req,
     res.message = asked + ": the chassis answered with error word " +
                   ranger::text::hex(res.error_word, 8) +
                   (names.empty() ? " (no errors)" : " (" + join(names) + ")");
-    ROS_INFO("%s", res.message.c_str());
   } else {
     res.error_word = driver_->snapshot()->controller.error_bits;
     res.message = asked + ": " +
                   (outcome.state == State::kFailed ? outcome.message
                                                    : std::string("the chassis did not answer"));
-    ROS_WARN("%s", res.message.c_str());
   }
   return true;
 }
@@ -422,39 +365,33 @@ bool RangerNode::on_set_ultrasonic(ranger_msgs::SetUltrasonic::Request& req,
                   ": set exactly one of them; nothing sent";
     return true;
   }
-  const auto& c = params_.driver.controller;
-  const auto budget = c.ultrasonic_confirm_timeout * (c.ultrasonic_max_attempts + 1);
-  const auto outcome = wait_for(driver_->set_ultrasonic(req.enable), budget);
+  const auto outcome = wait_for(driver_->set_ultrasonic(req.enable), Kind::kUltrasonic);
   res.success = outcome.state == State::kAnswered;
   res.enabled = driver_->snapshot()->controller.ultrasonic_enabled.value_or(false);
   res.message = outcome.message.empty()
                     ? "the chassis did not confirm the ultrasonic setting in time"
                     : outcome.message;
-  if (res.success) ROS_INFO("set_ultrasonic: %s", res.message.c_str());
   return true;
 }
 
 bool RangerNode::on_set_motion_mode(ranger_msgs::SetMotionMode::Request& req,
                                     ranger_msgs::SetMotionMode::Response& res) {
   using Req = ranger_msgs::SetMotionMode::Request;
-  using protocol::MotionMode;
-  // The service's constants are the modes' values (agx_v2's numbering); park has a service of
-  // its own.
-  static_assert(Req::ACKERMANN == static_cast<int>(MotionMode::kAckermann) &&
-                Req::OBLIQUE == static_cast<int>(MotionMode::kOblique) &&
-                Req::SPIN == static_cast<int>(MotionMode::kSpin) &&
-                Req::SIDE_SLIP == static_cast<int>(MotionMode::kSideSlip));
-  std::optional<MotionMode> mode;
-  if (req.mode != Req::AUTOMATIC) {
-    mode = static_cast<MotionMode>(req.mode);
-    if (!protocol::kMotionModeNames.contains(*mode) || *mode == MotionMode::kPark) {
-      res.success = false;
-      res.message = "mode " + std::to_string(req.mode) +
-                    " unknown: use 0 (Ackermann), 1 (oblique), 2 (spin), 4 (side slip) or 255 "
-                    "(automatic)";
-      return true;
-    }
+  using M = protocol::MotionMode;
+  static const std::map<std::uint8_t, std::optional<M>> kModes = {{Req::ACKERMANN, M::kAckermann},
+                                                                  {Req::OBLIQUE, M::kOblique},
+                                                                  {Req::SPIN, M::kSpin},
+                                                                  {Req::SIDE_SLIP, M::kSideSlip},
+                                                                  {Req::AUTOMATIC, std::nullopt}};
+  const auto known = kModes.find(req.mode);
+  if (known == kModes.end()) {
+    res.success = false;
+    res.message = "mode " + std::to_string(req.mode) +
+                  " unknown: use 0 (Ackermann), 1 (oblique), 2 (spin), 4 (side slip) or 255 "
+                  "(automatic)";
+    return true;
   }
+  const std::optional<M> mode = known->second;
   if (mode) {
     const auto s = driver_->snapshot();
     if (!protocol::motion_mode_to_wire(*mode, s->profile.mode_numbering)) {
@@ -471,7 +408,6 @@ bool RangerNode::on_set_motion_mode(ranger_msgs::SetMotionMode::Request& req,
   res.message = mode ? "motion mode pinned to " + std::string(protocol::to_string(*mode)) +
                            " (the switch happens at standstill)"
                      : "automatic motion-mode selection";
-  ROS_INFO("set_motion_mode: %s", res.message.c_str());
   return true;
 }
 
@@ -489,39 +425,22 @@ bool RangerNode::on_set_lights(ranger_msgs::SetLights::Request& req,
     res.message = posted.error().message;
     return true;
   }
-  // The vendor frames may still be being listened for: their wait, then the answer's.
-  const auto budget =
-      params_.driver.vendor_frames_wait + params_.driver.request_answer_timeout + kAnswerMargin;
-  const auto outcome = wait_for(*posted, budget);
+  const auto outcome = wait_for(*posted, Kind::kLights);
   res.success = outcome.state == State::kAnswered;
   res.message = outcome.message.empty() ? "the chassis did not report its lights in time (" +
                                               std::string(ranger::to_string(outcome.state)) + ")"
                                         : outcome.message;
   fill_lights_response(driver_->snapshot()->lights, res);
-  if (res.success) {
-    ROS_INFO("set_lights: %s", res.message.c_str());
-  } else {
-    ROS_WARN("set_lights: %s", res.message.c_str());
-  }
   return true;
 }
 
 bool RangerNode::on_park(std_srvs::SetBool::Request& req, std_srvs::SetBool::Response& res) {
-  const auto& c = params_.driver.controller;
-  // Bringing the chassis to rest, then the switch with its retries.
-  const auto budget = c.mode_switch_timeout * (c.mode_switch_max_attempts + 1) +
-                      params_.driver.request_answer_timeout + std::chrono::seconds(3);
-  const auto outcome = wait_for(driver_->set_park(req.data), budget);
+  const auto outcome = wait_for(driver_->set_park(req.data), Kind::kPark);
   res.success = outcome.state == State::kAnswered;
   res.message = outcome.message.empty()
                     ? std::string(req.data ? "park" : "release") + " not confirmed in time (" +
                           std::string(ranger::to_string(outcome.state)) + ")"
                     : outcome.message;
-  if (res.success) {
-    ROS_INFO("park: %s", res.message.c_str());
-  } else {
-    ROS_WARN("park: %s", res.message.c_str());
-  }
   return true;
 }
 
@@ -541,6 +460,7 @@ void RangerNode::publication_loop() {
   bool waiting_for_snapshot = false;  // motion is due, the latest snapshot had nothing new
   while (!publication_stop_) {
     try {
+      log_events();
       publish_sent();
       const auto now = Clock::now();
       const bool motion_heard = motion_has_subscribers();
@@ -578,17 +498,10 @@ void RangerNode::publication_loop() {
     if (!waiting_for_snapshot && motion_has_subscribers()) {
       until = std::min(until, next_motion_publication_ - motion_early);
     }
-    const auto wait = std::chrono::duration_cast<nanoseconds>(std::clamp<Clock::duration>(
-        until - Clock::now(), Clock::duration::zero(), std::chrono::seconds(1)));
-    const timespec ts{static_cast<time_t>(wait.count() / 1'000'000'000),
-                      static_cast<long>(wait.count() % 1'000'000'000)};
-    pollfd fd{publication_wake_fd_, POLLIN, 0};
-    if (::ppoll(&fd, 1, &ts, nullptr) > 0 && (fd.revents & POLLIN)) {
-      std::uint64_t value;
-      [[maybe_unused]] const auto n = ::read(publication_wake_fd_, &value, sizeof value);
-    }
+    publication_waker_.sleep_until(ranger::Timestamp(until.time_since_epoch()));
   }
   try {
+    log_events();    // the driver's last ones (its stop)
     publish_sent();  // the shutdown's stop
   } catch (const std::exception& e) {
     ROS_ERROR("publishing failed: %s", e.what());
@@ -677,189 +590,16 @@ void RangerNode::publish_states() {
       }
     }
   }
-  log_state_changes(*s);
 }
 
-void RangerNode::log_state_changes(const ranger::DriverSnapshot& s) {
-  const std::string& port = params_.port_name;
-  if (s.bus_error != last_bus_error_) {
-    if (!s.bus_error.empty()) {
-      if (is_socketcan(port)) {
-        ROS_ERROR(
-            "cannot open CAN interface %s: %s. Bring the adapter up with `rosrun "
-            "ranger_bringup bringup_can2usb.bash` (or `sudo ip link set %s up type can "
-            "bitrate 500000`); retrying every %.1f s",
-            port.c_str(), s.bus_error.c_str(), port.c_str(),
-            secs(params_.driver.reconnect_interval));
-      } else {
-        ROS_ERROR("cannot open %s: %s (retrying every %.1f s)", port.c_str(), s.bus_error.c_str(),
-                  secs(params_.driver.reconnect_interval));
-      }
-    }
-    last_bus_error_ = s.bus_error;
-  }
-  if (s.bus_open && !last_bus_open_) {
-    if (s.controller.link == ranger::LinkState::kNeverConnected) {
-      ROS_INFO("%s open: waiting for the chassis on %s", port.c_str(), port.c_str());
-    } else {
-      ROS_INFO("%s open", port.c_str());
-    }
-    waiting_since_ = s.now;
-    next_waiting_log_ = s.now + kWaitingReminder;
-  }
-  last_bus_open_ = s.bus_open;
-  if (!s.bus_open) return;
-
-  const auto& c = s.controller;
-  if (c.link == ranger::LinkState::kNeverConnected && s.now >= next_waiting_log_) {
-    ROS_INFO(
-        "still waiting for the chassis on %s: nothing heard for %.0f s (is it powered on, "
-        "and the bus at 500 kbit/s?)",
-        port.c_str(), secs(s.now - waiting_since_));
-    next_waiting_log_ = s.now + kWaitingReminder;
-  }
-  if (!last_link_ || *last_link_ != c.link) {
-    if (c.link == ranger::LinkState::kConnected) {
-      if (last_link_ == ranger::LinkState::kStale) {
-        ROS_INFO("chassis heard again on %s: odometry resumes from the last pose", port.c_str());
-      } else {
-        ROS_INFO("chassis connected on %s", port.c_str());
-      }
-    } else if (c.link == ranger::LinkState::kStale) {
-      ROS_WARN(
-          "chassis on %s went silent (no system status for %.2f s): motion stopped, no "
-          "odometry until it is heard again",
-          port.c_str(), secs(params_.driver.controller.link_timeout));
-    }
-    last_link_ = c.link;
-  }
-  log_protocol_changes(s);  // the identification's decision before "accepts motion"
-  if (!last_refusal_ || *last_refusal_ != c.refusal) {
-    using R = ranger::MotionRefusal;
-    const std::string detail = describe_refusal(s);
-    switch (c.refusal) {
-      case R::kNone:
-        ROS_INFO("chassis accepts motion commands");
-        break;
-      case R::kLinkLost:  // the link messages above say it (and the start-up log the listening)
-        break;
-      case R::kCmdTimeout:
-      case R::kModeUnknown:
-      case R::kSwitching:
-      case R::kParked:  // the commander's own wish
-        ROS_INFO("%s", detail.c_str());
-        break;
-      case R::kIdentifying:  // the identification's own log says how it ends
-        if (!s.identification || !s.identification->done()) {
-          ROS_INFO("motion waits: %s", detail.c_str());
-        }
-        break;
-      case R::kStandby:
-        if (c.reclaim_blocked) {
-          ROS_WARN("motion refused: %s", detail.c_str());
-        } else {
-          ROS_INFO("%s", detail.c_str());
-        }
-        break;
-      case R::kRemote:
-      case R::kEstop:
-      case R::kCriticalError:
-      case R::kLowBattery:
-      case R::kModeSwitchFailed:
-      case R::kImplausible:
-      case R::kRearmRequired:
-      case R::kBelowMinimum:
-        ROS_WARN("motion refused: %s", detail.c_str());
-        break;
-    }
-    last_refusal_ = c.refusal;
-  }
-  if (c.error_bits != last_error_bits_) {
-    const auto names = protocol::error_bit_names(c.error_bits, s.profile.error_word);
-    if (names.empty()) {
-      ROS_INFO("chassis errors cleared (error word %s)",
-               ranger::text::hex(c.error_bits, 8).c_str());
-    } else {
-      ROS_WARN("chassis error word %s: %s", ranger::text::hex(c.error_bits, 8).c_str(),
-               join(names).c_str());
-    }
-    last_error_bits_ = c.error_bits;
-  }
-  for (const auto& id : s.frames.counts()) {
-    if (id.padded == 0 || padded_ids_reported_.count(id.id)) continue;
-    padded_ids_reported_.insert(id.id);
-    ROS_INFO("0x%03" PRIX32
-             " (%s) frames arrive longer than their layout: decoded from their "
-             "leading bytes, the rest ignored",
-             id.id, std::string(protocol::frame_name(id.id)).c_str());
-  }
-  if (c.last_solution && c.last_solution->flags != ranger::kKinematicsExact) {
-    ROS_WARN_THROTTLE(5.0, "cmd_vel adjusted to what the chassis can do: %s",
-                      ranger::kinematics_flags_to_string(c.last_solution->flags).c_str());
-  }
-}
-
-void RangerNode::log_protocol_changes(const ranger::DriverSnapshot& s) {
-  if (s.identification) {
-    const ranger::IdentificationStatus& id = *s.identification;
-    if (!id.done()) {  // going on (again, after the bus was reopened): its end is logged anew
-      identification_logged_ = false;
-      logged_decisions_ = 0;
-    }
-    if (id.decided_ok() && !identification_logged_) {
-      identification_logged_ = true;
-      logged_decisions_ = id.decided.size();
-      ROS_INFO(
-          "chassis identified in %.2f s (confidence %.2f): protocol settings %s. Evidence: %s. "
-          "Kept at the %s preset's value (no frame at rest tells them; the plausibility monitors "
-          "check them while driving): %s",
-          secs(id.elapsed()), id.confidence, ranger::describe(s.profile).c_str(),
-          join(id.evidence, "; ").c_str(), id.revision.c_str(),
-          id.undecided.empty() ? "none" : join(id.undecided).c_str());
-    } else if (id.phase == ranger::IdentificationPhase::kFailed && !identification_logged_) {
-      identification_logged_ = true;
-      std::string commission;
-      if (is_socketcan(params_.port_name)) {
-        commission = " (on this robot: ranger_can commission " + params_.port_name +
-                     " --wheels-lifted --output FILE)";
-      }
-      ROS_ERROR("%s%s", id.message.c_str(), commission.c_str());
-    }
-    // Settings the identification could not decide at rest, learned while driving (the monitors
-    // stopped the robot; the value they named is in use now).
-    if (id.decided_ok()) {
-      for (std::size_t i = logged_decisions_; i < id.decided.size(); ++i) {
-        const ranger::IdentifiedSetting& d = id.decided[i];
-        ROS_WARN(
-            "learned while driving: %s = %s (%s); protocol settings now %s. The robot stopped: "
-            "send a zero cmd_vel or call resume to drive again",
-            d.name.c_str(), d.value.c_str(), d.evidence.c_str(),
-            ranger::describe(s.profile).c_str());
-      }
-      logged_decisions_ = std::max(logged_decisions_, id.decided.size());
-    }
-  }
-  // Each monitor warning once (by what it suggests: its measured detail changes every cycle).
-  for (const ranger::PlausibilityFinding& w : s.plausibility.warnings) {
-    const std::string key = w.check + "|" + w.setting + "|" + w.try_value;
-    if (!warned_findings_.insert(key).second) continue;
-    ROS_WARN(
-        "plausibility: %s (check that setting; a persisting mismatch of a sign or a unit "
-        "stops the robot)",
-        w.text().c_str());
-  }
-  if (const auto& stop = s.plausibility.stop) {
-    const std::string key =
-        stop->check + "|" + stop->setting + "|" + std::to_string(stop->since.count());
-    if (key != logged_stop_) {
-      logged_stop_ = key;
-      ROS_ERROR(
-          "plausibility stop: %s. The robot is stopped: set that parameter (or load a "
-          "commissioning file) and restart, or call resume to try again",
-          stop->text().c_str());
-    }
-  } else {
-    logged_stop_.clear();
+void RangerNode::log_events() {
+  events_.clear();
+  const std::uint64_t missed = driver_->events_since(logged_event_, events_);
+  if (missed > 0)
+    ROS_WARN("%" PRIu64 " driver events were not logged (the log fell behind)", missed);
+  for (const ranger::DriverEvent& e : events_) {
+    logged_event_ = e.sequence;
+    log_event(e);
   }
 }
 

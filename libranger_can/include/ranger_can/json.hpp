@@ -41,6 +41,7 @@ class JsonWriter {
   JsonWriter& null();
   JsonWriter& string_or_null(const std::optional<std::string>& v);
   JsonWriter& strings(const std::vector<std::string>& v);  // an array of strings
+  JsonWriter& raw(std::string_view json);                  // a value already written as JSON
   JsonWriter& seconds(Timestamp t);  // a timestamp as seconds with exactly 6 decimals
 
  private:

@@ -583,55 +583,89 @@ double ChassisController::steer_first_factor(const KinematicsSolution& solution,
   return std::clamp((2.0 * threshold - worst) / threshold, 0.0, 1.0);
 }
 
+// What step 2 of run_motion decided: the refusal before any mode switch, and what may move.
+struct ChassisController::MotionGate {
+  MotionRefusal refusal = MotionRefusal::kNone;
+  bool probing = false;       // the identification's zero-speed probe
+  bool parking = false;       // park wanted: to rest, then 0x141 park
+  bool leaving_park = false;  // park released: out of it without waiting for a twist
+  bool may_drive = false;     // something to command (and allowed to)
+};
+
 void ChassisController::run_motion(Timestamp now) {
-  // 1. The caller's command timeout.
+  check_command_timeout(now);                                             // 1.
+  MotionGate gate = gate_motion();                                        // 2.
+  const std::optional<MotionMode> mode_to_send = switch_mode(gate, now);  // 3.
+  const MotionRefusal refusal = settle_refusal(gate.refusal);
+  MotionCommand command{};  // 4.
+  const KinematicsSolution* solution = motion_command(refusal, gate.probing, now, command);
+  keep_alive(command, solution, now);  // 5.
+  // 6. The mode command goes after the zero 0x111 of this tick.
+  if (mode_to_send) {
+    ++state_.counters.mode_switch_requests;
+    send(MotionModeCommand{*mode_to_send}, now);
+  }
+}
+
+// 1. The caller's command timeout.
+void ChassisController::check_command_timeout(Timestamp now) {
   if (state_.has_command && !state_.cmd_timed_out &&
       now - state_.last_command_time >= config_.cmd_timeout) {
     state_.cmd_timed_out = true;
     ++state_.counters.cmd_timeouts;
     command_changed_ = true;
   }
+}
 
-  // 2. Everything that forbids motion except a mode switch.
-  MotionRefusal refusal = evaluate_refusal();
+// 2. Everything that forbids motion except a mode switch.
+ChassisController::MotionGate ChassisController::gate_motion() const {
+  MotionGate g;
+  g.refusal = evaluate_refusal();
+  const MotionRefusal r = g.refusal;
   // A switch that failed goes on retrying at its bounded rate (it stops nothing else).
   // The identification's probe: zero speed, a steering angle, possibly in another mode.
-  const bool probing = refusal == MotionRefusal::kIdentifying && state_.probe.has_value() &&
-                       state_.motion_mode.has_value() && !state_.quiet;
-  // Park wanted: to rest, then 0x141 park. Park released: out of it without waiting for a twist.
-  const bool parking = refusal == MotionRefusal::kParked && state_.chassis_mode.has_value();
-  const bool leaving_park =
+  g.probing = r == MotionRefusal::kIdentifying && state_.probe.has_value() &&
+              state_.motion_mode.has_value() && !state_.quiet;
+  g.parking = r == MotionRefusal::kParked && state_.chassis_mode.has_value();
+  const bool drivable = r == MotionRefusal::kNone || r == MotionRefusal::kModeSwitchFailed;
+  g.leaving_park =
       leave_park_ && state_.parked() &&
-      (refusal == MotionRefusal::kNone || refusal == MotionRefusal::kCmdTimeout ||
-       refusal == MotionRefusal::kBelowMinimum || refusal == MotionRefusal::kModeSwitchFailed);
-  const bool may_drive =
-      ((refusal == MotionRefusal::kNone || refusal == MotionRefusal::kModeSwitchFailed) &&
-       state_.has_command) ||
-      (probing && probe_mode_.has_value()) || parking || leaving_park;
+      (drivable || r == MotionRefusal::kCmdTimeout || r == MotionRefusal::kBelowMinimum);
+  g.may_drive = (drivable && state_.has_command) || (g.probing && probe_mode_.has_value()) ||
+                g.parking || g.leaving_park;
+  return g;
+}
 
-  // 3. Motion-mode switching: decide the wanted mode, then stop -> 0x141 -> confirmation.
+// 3a. The mode wanted: park, the probe's, the request's, the forced one, else the selector's.
+MotionMode ChassisController::wanted_mode(const MotionGate& g, MotionMode current, Timestamp now) {
+  MotionMode wanted = current;
+  if (g.parking) {
+    wanted = MotionMode::kPark;
+  } else if (g.probing) {
+    wanted = *probe_mode_;
+  } else if (state_.requested.mode) {
+    wanted = *state_.requested.mode;
+  } else if (state_.mode_override) {
+    wanted = *state_.mode_override;
+  } else {
+    wanted = selector_.select(state_.requested.twist, current, now);
+  }
+  // Out of park into the mode the commander forced, else Ackermann (the selector keeps the
+  // current mode for a twist it cannot classify).
+  if (!g.parking && wanted == MotionMode::kPark) {
+    wanted = state_.mode_override.value_or(MotionMode::kAckermann);
+  }
+  return wanted;
+}
+
+// 3b. Motion-mode switching: stop -> 0x141 -> confirmation; the mode to send now, if any.
+std::optional<MotionMode> ChassisController::switch_mode(const MotionGate& g, Timestamp now) {
   std::optional<MotionMode> mode_to_send;
-  if (!may_drive) {
+  if (!g.may_drive) {
     mode_switch_.cancel();  // nothing to drive (or not allowed to): no reason to switch
   } else {
     const MotionMode current = state_.motion_mode ? *state_.motion_mode : *state_.chassis_mode;
-    MotionMode wanted = current;
-    if (parking) {
-      wanted = MotionMode::kPark;
-    } else if (probing) {
-      wanted = *probe_mode_;
-    } else if (state_.requested.mode) {
-      wanted = *state_.requested.mode;
-    } else if (state_.mode_override) {
-      wanted = *state_.mode_override;
-    } else {
-      wanted = selector_.select(state_.requested.twist, current, now);
-    }
-    // Out of park into the mode the commander forced, else Ackermann (the selector keeps the
-    // current mode for a twist it cannot classify).
-    if (!parking && wanted == MotionMode::kPark) {
-      wanted = state_.mode_override.value_or(MotionMode::kAckermann);
-    }
+    const MotionMode wanted = wanted_mode(g, current, now);
     const bool was_active = mode_switch_.active();
     const int attempts = mode_switch_.status().attempts;
     mode_to_send = mode_switch_.update(wanted, current, at_standstill(now), now);
@@ -641,6 +675,11 @@ void ChassisController::run_motion(Timestamp now) {
     }
   }
   state_.mode_switch = mode_switch_.status();
+  return mode_to_send;
+}
+
+// 3c. The refusal once the switch is known (failed, or under way).
+MotionRefusal ChassisController::settle_refusal(MotionRefusal refusal) {
   if (state_.mode_switch.failed != has(state_.active_causes, StopCause::kModeSwitchFailed)) {
     update_causes();  // the switch failed (or its failure ended) in this very step
     refusal = evaluate_refusal();
@@ -651,9 +690,13 @@ void ChassisController::run_motion(Timestamp now) {
   }
   if (refusal != state_.refusal) command_changed_ = true;
   state_.refusal = refusal;
+  return refusal;
+}
 
-  // 4. The 0x111 to send: the limited request in the chassis's mode, or zero.
-  MotionCommand command{};
+// 4. The 0x111 to send: the limited request in the chassis's mode, or zero (the probe's steering
+// while probing); the solution behind it, if any.
+const KinematicsSolution* ChassisController::motion_command(MotionRefusal refusal, bool probing,
+                                                            Timestamp now, MotionCommand& command) {
   const KinematicsSolution* solution = nullptr;
   state_.steer_first_factor = 1.0;
   if (refusal == MotionRefusal::kNone && state_.has_command && state_.motion_mode) {
@@ -666,17 +709,7 @@ void ChassisController::run_motion(Timestamp now) {
     Result<KinematicsSolution> solved = selector_.solve(
         state_.limited, *state_.motion_mode, config_.geometry, config_.limits, config_.profile);
     if (solved) {
-      // Steer first: hold the speed back while the wheels are far from the commanded angle.
-      const double factor = steer_first_factor(*solved, now);
-      if (factor < 1.0) {
-        solved->command.linear_speed *= factor;
-        solved->achieved = BodyTwist{solved->achieved.vx * factor, solved->achieved.vy * factor,
-                                     solved->achieved.wz * factor};
-        state_.limited = BodyTwist{state_.limited.vx * factor, state_.limited.vy * factor,
-                                   state_.limited.wz * factor};
-        if (state_.steer_first_factor == 1.0) command_changed_ = true;
-      }
-      state_.steer_first_factor = factor;
+      steer_first(*solved, now);
       command = solved->command;
       state_.last_solution = *solved;
       solution = &*state_.last_solution;
@@ -692,31 +725,41 @@ void ChassisController::run_motion(Timestamp now) {
   }
   limiter_started_ = true;
   last_limit_time_ = now;
+  return solution;
+}
 
-  // 5. Keep-alive / prompt send, only while the chassis is (last known) in CAN command mode:
-  // in standby it ignores 0x111, and under remote control the host stays silent.
-  if (state_.control_mode == ControlMode::kCan) {
-    const bool scheduled = now >= next_keep_alive_;
-    const bool prompt = command_changed_ &&
-                        (!prompt_sent_ || now - last_prompt_send_ >= config_.min_command_interval);
-    if (scheduled || prompt || !state_.last_motion_command) {
-      send_motion(command, solution, now);
-      if (prompt && !scheduled) {
-        last_prompt_send_ = now;
-        prompt_sent_ = true;
-      }
-      command_changed_ = false;
-      next_keep_alive_ = scheduled && next_keep_alive_ + config_.keep_alive_period > now
-                             ? next_keep_alive_ + config_.keep_alive_period
-                             : now + config_.keep_alive_period;
-    }
+// Steer first: hold the speed back while the wheels are far from the commanded angle.
+void ChassisController::steer_first(KinematicsSolution& solved, Timestamp now) {
+  const double factor = steer_first_factor(solved, now);
+  if (factor < 1.0) {
+    solved.command.linear_speed *= factor;
+    solved.achieved = BodyTwist{solved.achieved.vx * factor, solved.achieved.vy * factor,
+                                solved.achieved.wz * factor};
+    state_.limited = BodyTwist{state_.limited.vx * factor, state_.limited.vy * factor,
+                               state_.limited.wz * factor};
+    if (state_.steer_first_factor == 1.0) command_changed_ = true;
   }
+  state_.steer_first_factor = factor;
+}
 
-  // 6. The mode command goes after the zero 0x111 of this tick.
-  if (mode_to_send) {
-    ++state_.counters.mode_switch_requests;
-    send(MotionModeCommand{*mode_to_send}, now);
+// 5. Keep-alive / prompt send, only while the chassis is (last known) in CAN command mode: in
+// standby it ignores 0x111, and under remote control the host stays silent.
+void ChassisController::keep_alive(const MotionCommand& command, const KinematicsSolution* solution,
+                                   Timestamp now) {
+  if (state_.control_mode != ControlMode::kCan) return;
+  const bool scheduled = now >= next_keep_alive_;
+  const bool prompt = command_changed_ &&
+                      (!prompt_sent_ || now - last_prompt_send_ >= config_.min_command_interval);
+  if (!scheduled && !prompt && state_.last_motion_command) return;
+  send_motion(command, solution, now);
+  if (prompt && !scheduled) {
+    last_prompt_send_ = now;
+    prompt_sent_ = true;
   }
+  command_changed_ = false;
+  next_keep_alive_ = scheduled && next_keep_alive_ + config_.keep_alive_period > now
+                         ? next_keep_alive_ + config_.keep_alive_period
+                         : now + config_.keep_alive_period;
 }
 
 // ---- output and bookkeeping --------------------------------------------------------------------

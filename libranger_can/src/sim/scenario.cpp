@@ -625,17 +625,17 @@ std::optional<double> sample_number(const ScenarioSample& s, std::string_view fi
   return std::nullopt;
 }
 
-std::string to_json(const ScenarioSample& s) {
-  std::string out;
-  out.reserve(512);
-  JsonWriter w(out);
+namespace {
+
+// The sample's fields, into an object `w` has begun.
+void write_sample(JsonWriter& w, const ScenarioSample& s) {
   auto pose = [&](const Pose2D& p, const BodyTwist& v) {
     w.key("x").fixed(p.x, kDecimals).key("y").fixed(p.y, kDecimals);
     w.key("yaw").fixed(p.yaw, kDecimals);
     w.key("vx").fixed(v.vx, kDecimals).key("vy").fixed(v.vy, kDecimals);
     w.key("wz").fixed(v.wz, kDecimals);
   };
-  w.begin_object().key("t").fixed(static_cast<double>(s.t.count()) / 1000.0, 3);
+  w.key("t").fixed(static_cast<double>(s.t.count()) / 1000.0, 3);
   w.key("truth").begin_object();
   pose(s.truth, s.truth_twist);
   w.key("speed").fixed(s.truth_speed, kDecimals).end_object();
@@ -650,6 +650,25 @@ std::string to_json(const ScenarioSample& s) {
   w.key("latched").strings(s.latched);
   w.key("steer_first_factor").fixed(s.steer_first_factor, kDecimals);
   w.key("identification").string(s.identification);
+}
+
+// "events":[...] of the driver's events (each one JSON object), none when there are none.
+void write_events(JsonWriter& w, const std::vector<std::string>& events) {
+  if (events.empty()) return;
+  w.key("events").begin_array();
+  for (const std::string& e : events)
+    w.raw(e);
+  w.end_array();
+}
+
+}  // namespace
+
+std::string to_json(const ScenarioSample& s) {
+  std::string out;
+  out.reserve(512);
+  JsonWriter w(out);
+  w.begin_object();
+  write_sample(w, s);
   w.end_object();
   return out;
 }
@@ -701,6 +720,18 @@ struct ScenarioRunner::Impl {
     sim->step(clock.now());
     driver->step(clock.now());
     if (!pending.empty()) report_requests(output);
+    if (output.event && driver->last_event_sequence() > events_seen) report_events(output);
+  }
+
+  std::uint64_t events_seen = 0;  // read after every step: none is missed
+  std::vector<DriverEvent> events;
+  void report_events(const ScenarioOutput& output) {
+    events.clear();
+    driver->events_since(events_seen, events);
+    for (const DriverEvent& e : events) {
+      events_seen = e.sequence;
+      output.event(e);
+    }
   }
 
   void publish() { (void)driver->command(MotionRequest{*publishing, std::nullopt}); }
@@ -859,6 +890,7 @@ ScenarioResult ScenarioRunner::run(const Scenario& scenario, const ScenarioOutpu
     }
   };
 
+  if (output.event) m.report_events(output);  // those of t = 0
   for (const ScenarioAction& a : scenario.actions) {
     switch (a.kind) {
       case ScenarioAction::Kind::kCommand:
@@ -923,11 +955,19 @@ Result<ScenarioResult> run_scenario(const Scenario& scenario, const ScenarioOpti
   if (!runner) return runner.error();
   std::size_t failures_shown = 0;
   std::string line;
+  std::vector<std::string> events;  // the driver's events since the last sample
   ScenarioOutput output;
+  output.event = [&](const DriverEvent& e) { events.push_back(to_json(e, kEpoch)); };
+  // A sample carries the events since the one before ("events":[...], only when there are).
   output.sample = [&](const ScenarioSample& s) {
-    line = to_json(s);
-    line += '\n';
-    out << line;
+    line.clear();
+    JsonWriter w(line);
+    w.begin_object();
+    write_sample(w, s);
+    write_events(w, events);
+    w.end_object();
+    events.clear();
+    out << line << '\n';
   };
   output.failure = [&](const std::string& text) {
     if (failures_shown < kMaxReportedErrors) err << prefix << text << "\n";
@@ -935,6 +975,15 @@ Result<ScenarioResult> run_scenario(const Scenario& scenario, const ScenarioOpti
   };
   output.note = [&](const std::string& text) { err << prefix << text << "\n"; };
   const ScenarioResult result = (*runner)->run(scenario, output);
+  // Events after the last sample (a script that ends between samples).
+  if (!events.empty()) {
+    line.clear();
+    JsonWriter w(line);
+    w.begin_object().key("t").fixed(static_cast<double>((*runner)->now().count()) / 1000.0, 3);
+    write_events(w, events);
+    w.end_object();
+    out << line << '\n';
+  }
   out.flush();
   if (result.failures > kMaxReportedErrors) {
     err << prefix << (result.failures - kMaxReportedErrors)

@@ -1,12 +1,17 @@
 // `ranger_can monitor IFACE`: a live view of a RANGER chassis, refreshed about 5 times a second;
 // what to reach for first when something does not move. The view itself is ChassisMonitor
-// (cli_monitor_view.hpp); this file opens the bus, keeps time and decides when to draw.
+// (cli_monitor_view.hpp); this file opens the bus, keeps time and decides when to draw. Beside
+// the view, a read-only driver (ranger::Driver on a socket of its own, in lock-step: it sends
+// nothing) reports the driver's events — the link, the control mode, faults, the identification,
+// padding — as text lines (with the view's time) or, with --json, as JSON objects of their own.
 #include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
+#include <deque>
 #include <iostream>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -18,7 +23,9 @@
 #include "cli_profile.hpp"
 #include "cli_signals.hpp"
 #include "ranger_can/clock.hpp"
+#include "ranger_can/control/driver.hpp"
 #include "ranger_can/parse.hpp"
+#include "ranger_can/text.hpp"
 
 namespace ranger::cli {
 
@@ -87,6 +94,84 @@ void take(const Result<CanFrame>& frame, std::optional<ChassisMonitor>& monitor,
   }
 }
 
+// IFACE once more, for the driver that reports the events: read-only (it sends nothing).
+class ListeningSource : public BusSource {
+ public:
+  explicit ListeningSource(std::string iface) : iface_(std::move(iface)) {}
+  Result<std::unique_ptr<Bus>> open() override { return open_interface(iface_); }
+  std::string name() const override { return iface_; }
+  bool read_only() const override { return true; }
+
+ private:
+  std::string iface_;
+};
+
+// The read-only driver's iterations and its events as the monitor shows them: JSON objects, or
+// text lines with the view's time ("   1.234 warn: chassis on can0 went silent ..."; the debug
+// ones left out). On a screen that is cleared for every view, the last few lines are shown under
+// the view instead.
+class EventLines {
+ public:
+  EventLines(Driver& driver, Timestamp start, bool json, bool under_view)
+      : driver_(driver), start_(start), json_(json), under_view_(under_view) {}
+
+  // Runs the driver at `now` (at most every 10 ms: it reads what queued meanwhile); what is new
+  // to print now.
+  std::string step(Timestamp now) {
+    if (now < next_step_) return "";
+    driver_.step(now);
+    next_step_ = now + std::chrono::milliseconds(10);
+    return take();
+  }
+  // What is new since the last call: printed now (returned), or kept for the view.
+  std::string take() {
+    std::vector<DriverEvent> events;
+    driver_.events_since(seen_, events);
+    std::string out;
+    for (const DriverEvent& e : events) {
+      seen_ = e.sequence;
+      if (json_) {
+        out += to_json(e, start_) + "\n";
+      } else if (e.severity != Severity::kDebug) {
+        out += text::format("%8.3f ", seconds(e.time - start_)) +
+               std::string(to_string(e.severity)) + ": " + describe(e) + "\n";
+      }
+    }
+    if (!under_view_) return out;
+    recent_.push_back(out);
+    while (recent_.size() > kRecent)
+      recent_.pop_front();
+    return "";
+  }
+  // The recent lines, for the bottom of a cleared screen ("" when they are printed as they come).
+  std::string recent() const {
+    std::string out;
+    for (const std::string& lines : recent_)
+      out += lines;
+    return out.empty() ? out : "events:\n" + out;
+  }
+
+ private:
+  static constexpr std::size_t kRecent = 8;
+  Driver& driver_;
+  Timestamp start_;
+  bool json_, under_view_;
+  std::uint64_t seen_ = 0;
+  Timestamp next_step_{0};
+  std::deque<std::string> recent_;
+};
+
+// The read-only driver beside the view: the vehicle and protocol the options give (auto: it
+// identifies the chassis from what it hears, as the view does).
+DriverConfig listening_config(const Vehicle& vehicle, bool identify) {
+  DriverConfig c;
+  apply_vehicle(vehicle, c);
+  c.controller.listen_only = true;
+  c.controller.auto_command_mode = false;
+  if (identify) c.protocol = ProtocolChoice::kAuto;
+  return c;
+}
+
 int monitor_main(const ParsedArgs& args, Io io) {
   const MonitorOptions o = options_from(args);
   const Result<Vehicle> vehicle = vehicle_from_args(args);
@@ -104,12 +189,15 @@ int monitor_main(const ParsedArgs& args, Io io) {
 
   StopSignals signals;
   SteadyClock clock;
+  Driver driver(listening_config(*vehicle, protocol_is_auto(args)),
+                std::make_shared<ListeningSource>(o.iface), clock);
   // With --protocol auto (the default) the first half second of frames (or the --once window)
   // identifies the chassis's settings passively, as `decode` does for a log; the view starts then.
   std::vector<CanFrame> heard;  // while identifying
   std::optional<ChassisMonitor> monitor;
   if (!protocol_is_auto(args)) monitor.emplace(from_seconds(o.window), vehicle->profile);
   const Timestamp start = clock.now();
+  EventLines events(driver, start, o.json, clear);
   const auto period = from_seconds(1.0 / o.rate);
   Timestamp next_view =
       start + (o.once ? from_seconds(o.window) : std::max(period, from_seconds(0.5)));
@@ -117,6 +205,7 @@ int monitor_main(const ParsedArgs& args, Io io) {
 
   while (!StopSignals::requested()) {
     const Timestamp now = clock.now();
+    io.out << events.step(now);
     if (now >= next_view && !monitor) {
       auto m = identified_monitor(args, *vehicle, o, heard, now);
       if (!m) return usage_error(monitor_command(), io, m.error().message);
@@ -125,7 +214,7 @@ int monitor_main(const ParsedArgs& args, Io io) {
     if (now >= next_view) {
       const BusStatus status = (*bus)->status();
       io.out << drawn(o.json ? monitor->render_json(o.iface, status, now) + "\n"
-                             : monitor->render_text(o.iface, status, now, color),
+                             : monitor->render_text(o.iface, status, now, color) + events.recent(),
                       clear, o.json, views);
       io.out.flush();
       ++views;
@@ -156,7 +245,11 @@ const CommandSpec& monitor_command() {
       "and motor rpm/current/temperature, battery and BMS alarms, 0x211 errors by name,\n"
       "ultrasonic distances, the commands the host sends (0x111 age and rate), frame rates per\n"
       "ID against the manual's periods, and the bus state. Frames are read under the protocol\n"
-      "profile of --model, --protocol and --set (docs/PROTOCOL_INTERPRETATIONS.md).",
+      "profile of --model, --protocol and --set (docs/PROTOCOL_INTERPRETATIONS.md).\n"
+      "The driver's events (the link, the control mode, faults by name, the identification,\n"
+      "frames longer than their layout, ...) come between the views as lines 'SEC severity:\n"
+      "text' (SEC since the start), under the view when the screen is cleared, and as JSON\n"
+      "objects of their own with --json ({\"seq\",\"t\",\"event\",\"severity\",\"text\",...}).",
       {required_arg("IFACE", "the CAN interface of the chassis", "can0")},
       {
           flag("--once",
@@ -166,7 +259,7 @@ const CommandSpec& monitor_command() {
           option("--rate", "HZ", "views per second (default 5)", number_in(0.1, 100.0)),
           option("--window", "SEC", "frame-rate window and --once listening time (default 1)",
                  number_in(0.05, 3600.0)),
-          flag("--json", "one JSON object per view instead of text"),
+          flag("--json", "one JSON object per view (and per event) instead of text"),
           flag("--no-color",
                "no ANSI colours (default: colours on a terminal unless NO_COLOR is set)"),
           flag("--no-clear",

@@ -122,8 +122,10 @@ const CommandSpec& scenario_command() {
       "its fastest point, body centre or a wheel); odom: the driver's odometry; the modes as the\n"
       "driver knows them (null: never reported); refusal: why the requested motion is not driven\n"
       "(\"none\" while it is); identification: its phase under --protocol auto (\"none\" when the\n"
-      "protocol is given). Numbers have fixed decimals (t 3, others 6): the same script gives\n"
-      "the same bytes.",
+      "protocol is given). A sample also carries \"events\":[...] when the driver had any since\n"
+      "the previous sample: each {\"seq\",\"t\",\"event\",\"severity\",\"text\",...} (the lines the\n"
+      "ROS node logs; events after the last sample come on a line {\"t\":s,\"events\":[...]}).\n"
+      "Numbers have fixed decimals (t 3, others 6): the same script gives the same bytes.",
       {optional_arg("FILE", "the script; standard input when absent or '-'", any_text())},
       {
           option("--every", "SEC",

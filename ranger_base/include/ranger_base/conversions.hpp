@@ -73,8 +73,8 @@ bool listening(const ranger::ControllerState& state);
 // "implausible_feedback", ...; "" while driven).
 std::string refusal_name(const ranger::ControllerState& state);
 // Why motion is refused, and what to do about it, in words (system_state's
-// motion_inhibited_detail, diagnostics, the log); "" while the chassis is driven as asked. The
-// identification's words come from snapshot.identification.
+// motion_inhibited_detail, diagnostics; the library's ranger::describe_refusal, which the
+// driver's refusal events carry too); "" while the chassis is driven as asked.
 std::string describe_refusal(const ranger::DriverSnapshot& snapshot);
 // The stop causes of a set by name ("emergency_stop", "remote", ...), in the library's order.
 std::vector<std::string> cause_names(ranger::StopCauses causes);

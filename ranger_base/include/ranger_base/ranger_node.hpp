@@ -1,9 +1,11 @@
 // The RANGER driver's ROS side around libranger_can's driver runtime (ranger::Driver): parameters
-// become a DriverConfig, snapshots become messages and diagnostics, ROS callbacks post to the
-// driver's mailbox. The node knows no frame: the driver owns the bus, the controller, the
-// odometry and the joint tracker on a thread of its own. One class behind both front ends: the
-// executable ranger_base_node (ranger_base_node.cpp) and the nodelet ranger_base/RangerNodelet
-// (ranger_nodelet.cpp) construct it the same way (from_parameters) and run the same code.
+// become a DriverConfig, snapshots become messages and diagnostics, the driver's events become log
+// lines (one mapping of severities; the text is the library's describe()), ROS callbacks post to
+// the driver's mailbox. The node knows no frame: the driver owns the bus, the controller, the
+// odometry and the joint tracker on a thread of its own, and decides what is a transition. One
+// class behind both front ends: the executable ranger_base_node (ranger_base_node.cpp) and the
+// nodelet ranger_base/RangerNodelet (ranger_nodelet.cpp) construct it the same way
+// (from_parameters) and run the same code.
 //
 // All topic and service names are relative (the node works under a namespace); only /tf and
 // /diagnostics are global, by their own conventions. Every message is published as a shared
@@ -12,13 +14,13 @@
 //
 // Threads:
 //  * the driver's (the bus, the 0x111 keep-alive): the node only posts to its mailbox and reads
-//    its snapshots; the node's observers on it (a sent frame, an iteration done) append to a
-//    queue or write to an eventfd and never wait for publication;
+//    its snapshots and events; the node's observers on it (a sent frame, an iteration done, an
+//    event) append to a queue or write to an eventfd and never wait for publication or logging;
 //  * publication, the node's own (publication_loop): odometry/TF/joints at publish_rate (each
 //    estimate once: when the rate is due it waits for the driver's next snapshot with a new
 //    estimate), states at state_publish_rate, diagnostics at 1 Hz, cmd_vel_out for every motion
-//    frame sent. However slow a subscriber or however much is published, the driver's schedule
-//    does not move;
+//    frame sent, and the driver's events logged as they come. However slow a subscriber or however
+//    much is published, the driver's schedule does not move;
 //  * cmd_vel runs on the thread that delivers it (roscpp's network thread, or an in-process
 //    publisher's), through an ImmediateCallbackQueue: it posts to the driver's mailbox and
 //    returns, never queued behind anything and with no thread woken for it;
@@ -44,7 +46,6 @@
 #include <memory>
 #include <mutex>
 #include <optional>
-#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -101,8 +102,11 @@ class RangerNode {
                           ranger_msgs::SetMotionMode::Response& res);
   bool on_set_lights(ranger_msgs::SetLights::Request& req, ranger_msgs::SetLights::Response& res);
   bool on_park(std_srvs::SetBool::Request& req, std_srvs::SetBool::Response& res);
-  // The outcome of request `id` once answered or failed, after `timeout`, or at shutdown.
-  ranger::RequestOutcome wait_for(std::uint64_t id, std::chrono::nanoseconds timeout);
+  // The outcome of request `id` (of `kind`) once answered or failed, after the driver's budget
+  // for it, or at shutdown.
+  ranger::RequestOutcome wait_for(std::uint64_t id, ranger::RequestOutcome::Kind kind) {
+    return driver_->wait_for(id, driver_->answer_budget(kind));
+  }
 
   // ---- the publication thread ----
   void publication_loop();
@@ -114,10 +118,7 @@ class RangerNode {
   bool motion_has_subscribers() const;  // odom, /tf, joint_states or sim/ground_truth
   void publish_states();                // ranger_msgs states, battery, ultrasonic
   void publish_diagnostics();
-  void log_state_changes(const ranger::DriverSnapshot& s);
-  // The identification's decision or failure (once), settings learned while driving, each new
-  // plausibility warning (once) and a plausibility stop.
-  void log_protocol_changes(const ranger::DriverSnapshot& s);
+  void log_events();          // the driver's events since the last call, at their severity
   void log_protocol() const;  // at start: the model and where the protocol settings come from
 
   ros::NodeHandle nh_;
@@ -148,13 +149,10 @@ class RangerNode {
 
   std::unique_ptr<ros::AsyncSpinner> service_spinner_;
 
-  std::atomic<bool> stopping_{false};   // services stop waiting
-  std::atomic<bool> stop_sent_{false};  // the driver's shutdown stop was observed
-
   // The publication thread and what wakes it (the driver's observers write to the eventfd; the
   // queue's lock is held only to append or to swap it out).
   std::thread publication_thread_;
-  int publication_wake_fd_ = -1;
+  ranger::LoopWaker publication_waker_;  // on the driver's (monotonic) clock
   std::atomic<bool> publication_stop_{false};
   std::atomic<bool> snapshot_wanted_{false};  // publication waits for the driver's next iteration
   struct SentTwist {
@@ -170,18 +168,8 @@ class RangerNode {
   ranger::Timestamp last_odom_stamp_{0}, last_joints_stamp_{0};
   std::array<ranger::Timestamp, 2> last_ultrasonic_stamp_{};
   ranger::Timestamp last_remote_received_{0};  // the driver's clock
-  // For logging transitions once instead of every cycle (the publication thread: publish_states).
-  std::optional<ranger::MotionRefusal> last_refusal_;
-  std::optional<ranger::LinkState> last_link_;
-  bool last_bus_open_ = false;
-  std::string last_bus_error_;
-  std::uint32_t last_error_bits_ = 0;
-  ranger::Timestamp waiting_since_{0}, next_waiting_log_{0};
-  std::set<std::uint32_t> padded_ids_reported_;
-  bool identification_logged_ = false;  // its decision or failure
-  std::size_t logged_decisions_ = 0;    // identification decisions logged (learned ones after)
-  std::set<std::string> warned_findings_;
-  std::string logged_stop_;
+  std::uint64_t logged_event_ = 0;             // the sequence number of the last event logged
+  std::vector<ranger::DriverEvent> events_;    // log_events' buffer
   bool shut_down_ = false;
 };
 

@@ -406,7 +406,19 @@ class ChassisController {
   double steer_first_factor(const KinematicsSolution& solution, Timestamp now) const;
   void run_control_mode(Timestamp now);
   void run_ultrasonic(Timestamp now);
+  // run_motion's numbered steps (controller.cpp).
+  struct MotionGate;
   void run_motion(Timestamp now);
+  void check_command_timeout(Timestamp now);
+  MotionGate gate_motion() const;
+  protocol::MotionMode wanted_mode(const MotionGate& gate, protocol::MotionMode current,
+                                   Timestamp now);
+  std::optional<protocol::MotionMode> switch_mode(const MotionGate& gate, Timestamp now);
+  MotionRefusal settle_refusal(MotionRefusal refusal);
+  const KinematicsSolution* motion_command(MotionRefusal refusal, bool probing, Timestamp now,
+                                           MotionCommand& command);
+  void steer_first(KinematicsSolution& solved, Timestamp now);
+  void keep_alive(const MotionCommand& command, const KinematicsSolution* solution, Timestamp now);
 
   Bus& bus_;
   ControllerConfig config_;

@@ -188,6 +188,8 @@ struct ScenarioOutput {
   // Something worth knowing that is no failure: a chassis command's text (status), a driver
   // request that failed or was answered ("line N: resume failed: ... (t=S s)").
   std::function<void(const std::string&)> note;
+  // Every event of the driver (control/driver_events.hpp), in order, as the step that made it ends.
+  std::function<void(const DriverEvent&)> event;
 };
 
 class ScenarioRunner {
