@@ -852,9 +852,6 @@ class Encoder {
                      m.front_custom != 0 ? m.front_custom : m.rear_custom,
                      std::string("0 ") + kValid + ": no brightness");
     }
-    if (m.counter != 0) {
-      return invalid("light_command", "counter", m.counter, std::string("0 ") + kValid);
-    }
     return ok_status();
   }
 
@@ -866,7 +863,9 @@ class Encoder {
     f.data[2] = m.front_custom;
     f.data[3] = static_cast<std::uint8_t>(m.rear_mode);
     f.data[4] = m.rear_custom;
-    f.data[7] = m.counter;
+    // Light modes on_off: 0x121's bytes 2-7 are zero (0x231 keeps its counter in byte 7).
+    const bool reserved = p_.light_modes == LightModes::kOnOff && id == protocol::kLightCommandId;
+    f.data[7] = reserved ? 0 : m.counter;
     return f;
   }
 

@@ -101,7 +101,7 @@ void ChassisMonitor::on_frame(const CanFrame& frame, Timestamp now) {
     return;
   }
   auto decoded = decode(frame, profile_);
-  stats_.record(frame.id, now, decoded.ok(), protocol::extra_bytes(frame));
+  stats_.record(frame.id, now, decoded.ok(), protocol::extra_bytes(frame, profile_.frame_layout));
   if (!decoded) {
     ++decode_errors_;
     return;

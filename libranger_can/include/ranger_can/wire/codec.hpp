@@ -81,7 +81,7 @@ struct UltrasonicSettingCommand {  // 0x451
 };
 // 0x121 (agx_v2, mini_v3). Under the profile's light_modes on_off (the MINI 3.0) byte 1 is the
 // lights' on/off and bytes 2-7 are zero: the encoder refuses a front mode other than off/on, a rear
-// mode other than off, a brightness or a counter.
+// mode other than off or a brightness, and sends no counter.
 struct LightCommand {
   bool enable = false;                                         // byte 0: lights under CAN control
   protocol::LightMode front_mode = protocol::LightMode::kOff;  // byte 1
