@@ -116,7 +116,7 @@ TEST(CliMiniV3, SendWritesItsCommandsAndRefusesWhatItLacksByName) {
   };
   const auto voltage = send({"drive_mode", "voltage"});
   ASSERT_EQ(voltage.rc, 0) << voltage.err;
-  EXPECT_TRUE(contains(voltage.out, "can0 423#01")) << voltage.out;
+  EXPECT_TRUE(contains(voltage.out, "can0 423#01   mode=1 (voltage)")) << voltage.out;
   EXPECT_TRUE(contains(send({"drive_mode", "current"}).out, "can0 423#00"));
   EXPECT_TRUE(contains(send({"park", "on"}).out, "can0 141#03"));
   EXPECT_TRUE(contains(send({"clear-errors", "0x0B"}).out, "can0 441#0B"));

@@ -110,6 +110,14 @@ void diagnose_control(const DriverSnapshot& s, DiagnosticStatusWrapper& out) {
           c.mode_override ? std::string(protocol::to_string(*c.mode_override)) : "automatic");
   out.add("Mode switch", std::string(ranger::to_string(c.mode_switch.phase)));
   out.add("Park", c.park_requested ? (c.parked() ? "parked" : "parking") : "released");
+  if (s.drive_mode) out.add("Drive mode", std::string(protocol::to_string(*s.drive_mode)));
+  for (const auto* o : {&s.feedback.odometer, &s.feedback.rear_odometer}) {
+    if (!*o || !(*o)->value.left_distance || !(*o)->value.right_distance) continue;
+    const auto& v = (*o)->value;
+    out.add(v.rear ? "Odometer rear left / right (m)" : "Odometer front left / right (m)",
+            ranger::text::fixed(*v.left_distance, 3) + " / " +
+                ranger::text::fixed(*v.right_distance, 3));
+  }
   if (s.lights) {
     out.add("Lights", ranger::describe(s.lights->front, s.lights->front_brightness, s.lights->rear,
                                        s.lights->rear_brightness) +
@@ -276,6 +284,8 @@ void diagnose_battery(const DriverSnapshot& s, DiagnosticStatusWrapper& out) {
   }
   if (const auto& alarm = fb.bms_alarm[0]) {
     const auto& a = alarm->value;
+    out.add("BMS alarms", join(protocol::bms_status_names(a.alarm1, a.alarm2)));
+    out.add("BMS warnings", join(protocol::bms_status_names(a.warning1, a.warning2)));
     if (a.alarm1 != 0 || a.alarm2 != 0) {
       out.mergeSummary(DiagnosticStatus::ERROR,
                        "BMS alarm " + hex(a.alarm1, 2) + " " + hex(a.alarm2, 2));

@@ -55,6 +55,10 @@ int mode_wire_value(const MotionModeCommand& m, const ProtocolProfile& p) {
 std::string_view mode_name(proto::MotionMode mode, bool known) {
   return known ? proto::to_string(mode) : std::string_view("unknown");
 }
+// The wire value of a 0x423 (the raw byte when decoding found no drive mode).
+std::uint8_t drive_mode_wire_value(const DriveModeCommand& m) {
+  return m.mode_known ? static_cast<std::uint8_t>(m.mode) : m.mode_raw;
+}
 // A drive mode's name from its wire value ("unknown" for an undefined one).
 std::string_view drive_mode_name(std::uint8_t raw) {
   const auto mode = proto::drive_mode_from_wire(raw);
@@ -146,8 +150,8 @@ struct JsonFields {
     }
   }
   void operator()(const DriveModeCommand& m) const {
-    w.key("mode").integer(m.mode_raw);
-    w.key("mode_name").string(drive_mode_name(m.mode_raw));
+    w.key("mode").integer(drive_mode_wire_value(m));
+    w.key("mode_name").string(drive_mode_name(drive_mode_wire_value(m)));
   }
   void operator()(const UltrasonicFeedback& m) const {
     w.key("first_sensor").integer(m.first_sensor);
@@ -284,7 +288,8 @@ struct TextFields {
     }
   }
   void operator()(const DriveModeCommand& m) const {
-    out += format("mode=%d (%s)", m.mode_raw, std::string(drive_mode_name(m.mode_raw)).c_str());
+    const std::uint8_t v = drive_mode_wire_value(m);
+    out += format("mode=%d (%s)", v, std::string(drive_mode_name(v)).c_str());
   }
   void operator()(const UltrasonicFeedback& m) const {
     for (int i = 0; i < 4; ++i) {
