@@ -100,6 +100,21 @@ void diagnose_link(const DriverSnapshot& s, DiagnosticStatusWrapper& out) {
   }
 }
 
+namespace {
+// The drive mode and the wheels' own odometers, where the chassis reports them (the RANGER MINI
+// 3.0's 0x291 byte 2, 0x311/0x312 in metres).
+void add_drive_mode_and_odometers(const DriverSnapshot& s, DiagnosticStatusWrapper& out) {
+  if (s.drive_mode) out.add("Drive mode", std::string(protocol::to_string(*s.drive_mode)));
+  for (const auto* o : {&s.feedback.odometer, &s.feedback.rear_odometer}) {
+    if (!*o || !(*o)->value.left_distance || !(*o)->value.right_distance) continue;
+    const auto& v = (*o)->value;
+    out.add(v.rear ? "Odometer rear left / right (m)" : "Odometer front left / right (m)",
+            ranger::text::fixed(*v.left_distance, 3) + " / " +
+                ranger::text::fixed(*v.right_distance, 3));
+  }
+}
+}  // namespace
+
 void diagnose_control(const DriverSnapshot& s, DiagnosticStatusWrapper& out) {
   const auto& c = s.controller;
   out.add("Control mode",
@@ -110,14 +125,7 @@ void diagnose_control(const DriverSnapshot& s, DiagnosticStatusWrapper& out) {
           c.mode_override ? std::string(protocol::to_string(*c.mode_override)) : "automatic");
   out.add("Mode switch", std::string(ranger::to_string(c.mode_switch.phase)));
   out.add("Park", c.park_requested ? (c.parked() ? "parked" : "parking") : "released");
-  if (s.drive_mode) out.add("Drive mode", std::string(protocol::to_string(*s.drive_mode)));
-  for (const auto* o : {&s.feedback.odometer, &s.feedback.rear_odometer}) {
-    if (!*o || !(*o)->value.left_distance || !(*o)->value.right_distance) continue;
-    const auto& v = (*o)->value;
-    out.add(v.rear ? "Odometer rear left / right (m)" : "Odometer front left / right (m)",
-            ranger::text::fixed(*v.left_distance, 3) + " / " +
-                ranger::text::fixed(*v.right_distance, 3));
-  }
+  add_drive_mode_and_odometers(s, out);
   if (s.lights) {
     out.add("Lights", ranger::describe(s.lights->front, s.lights->front_brightness, s.lights->rear,
                                        s.lights->rear_brightness) +

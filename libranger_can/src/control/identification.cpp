@@ -862,38 +862,44 @@ void ChassisIdentifier::evaluate_steer(Timestamp now) {
   begin_step(IdentificationPhase::kReturning, now);
 }
 
-void ChassisIdentifier::decide_passive(Timestamp now) {
-  const std::string listened = duration_text(now - status_.started);
-  const bool counting =
-      byte7_steps_ >= kMinByte7Steps && byte7_increments_ * 10 >= byte7_steps_ * 9;
-  if (!forced_revision_) {
-    if (!mini_signatures_.empty() && counting) {
-      // The MINI 3.0 carries faults in 0x211 byte 7, the vendor's revision a counter: neither fits.
-      fail("the chassis sends " + text::join(mini_signatures_) +
-               ", which only the RANGER MINI 3.0 (mini_v3) has, but its 0x211 byte 7 counts up "
-               "like agx_v2's counter (the MINI 3.0 carries faults there): no revision fits",
-           now);
-      return;
-    }
-    if (!mini_signatures_.empty()) {
-      status_.revision = "mini_v3";
-      note("heard " + text::join(mini_signatures_) +
-           ": only the RANGER MINI 3.0's manual has it: preset mini_v3");
-    } else if (!agx_signatures_.empty() || uart_seen_) {
-      status_.revision = "agx_v2";
-      std::string what = text::join(agx_signatures_);
-      if (uart_seen_) what += std::string(what.empty() ? "" : ", ") + "0x211 control mode 2 (UART)";
-      note("heard " + what + ": only the vendor's revision sends it: preset agx_v2");
-    } else {
-      status_.revision = "manual";
-      note(
-          "no frame only the vendor's revision sends (0x231, 0x241, 0x311, 0x4A1 answers, "
-          "control mode UART) in " +
-          listened + ": preset manual");
-    }
-  } else {
+bool ChassisIdentifier::byte7_counts() const {
+  return byte7_steps_ >= kMinByte7Steps && byte7_increments_ * 10 >= byte7_steps_ * 9;
+}
+
+bool ChassisIdentifier::decide_revision(Timestamp now) {
+  if (forced_revision_) {
     note("preset " + status_.revision + " given (not identified)");
+    return true;
   }
+  if (!mini_signatures_.empty() && byte7_counts()) {
+    // The MINI 3.0 carries faults in 0x211 byte 7, the vendor's revision a counter: neither fits.
+    fail("the chassis sends " + text::join(mini_signatures_) +
+             ", which only the RANGER MINI 3.0 (mini_v3) has, but its 0x211 byte 7 counts up "
+             "like agx_v2's counter (the MINI 3.0 carries faults there): no revision fits",
+         now);
+    return false;
+  }
+  if (!mini_signatures_.empty()) {
+    status_.revision = "mini_v3";
+    note("heard " + text::join(mini_signatures_) +
+         ": only the RANGER MINI 3.0's manual has it: preset mini_v3");
+  } else if (!agx_signatures_.empty() || uart_seen_) {
+    status_.revision = "agx_v2";
+    std::string what = text::join(agx_signatures_);
+    if (uart_seen_) what += std::string(what.empty() ? "" : ", ") + "0x211 control mode 2 (UART)";
+    note("heard " + what + ": only the vendor's revision sends it: preset agx_v2");
+  } else {
+    status_.revision = "manual";
+    note(
+        "no frame only the vendor's revision sends (0x231, 0x241, 0x311, 0x312, 0x4A1 answers, "
+        "control mode UART) in " +
+        duration_text(now - status_.started) + ": preset manual");
+  }
+  return true;
+}
+
+void ChassisIdentifier::decide_passive(Timestamp now) {
+  if (!decide_revision(now)) return;  // the frames fit no revision
   if (auto p = protocol_preset(status_.revision)) status_.profile = *p;
   // Frame lengths.
   if (!padded_ids_.empty()) {
@@ -908,7 +914,7 @@ void ChassisIdentifier::decide_passive(Timestamp now) {
          std::to_string(status_.profile.tx_dlc));
   }
   // 0x211 byte 7.
-  if (counting) {
+  if (byte7_counts()) {
     set(S::kErrorWord, "agx16",
         "0x211 byte 7 rose by one in " + std::to_string(byte7_increments_) + " of " +
             std::to_string(byte7_steps_) + " frames: a counter, so bytes 4-5 are the error word");

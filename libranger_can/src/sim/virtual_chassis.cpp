@@ -800,6 +800,31 @@ Message VirtualChassis::motion_feedback() const {
   return fb;
 }
 
+void VirtualChassis::send_vendor_frames(Timestamp t) {
+  const ProtocolProfile& p = config_.profile;
+  // 0x231 and 0x241, each with its counter.
+  LightState light = lights_.report();
+  if (p.light_modes == LightModes::kOnOff) {  // on/off only: no rear light, no brightness
+    light.rear_mode = protocol::LightMode::kOff;
+    light.front_custom = light.rear_custom = 0;
+  }
+  light.counter = vendor_counter_;
+  send(light, t);
+  // The remote control on, SWB up (command mode) unless the remote is in charge; the
+  // sticks as the operator holds them (centred within the dead band).
+  RemoteControlState rc;
+  rc.swa = remote_.swa;
+  rc.swb = control_mode_ == ControlMode::kRemote ? protocol::RemoteSwitch::kMiddle
+                                                 : protocol::RemoteSwitch::kUp;
+  rc.swc = remote_.swc;
+  rc.swd = remote_.swd;
+  rc.stick_left_v = stick_wire(remote_.left);
+  rc.stick_right_h = stick_wire(remote_.right);
+  rc.counter = vendor_counter_;
+  send(rc, t);
+  ++vendor_counter_;
+}
+
 void VirtualChassis::send_odometers(Timestamp t) {
   OdometerFeedback front, rear;
   front.left_distance = wheel_distance_[kLeftFront];
@@ -857,29 +882,7 @@ void VirtualChassis::send_due(ScheduleId which, Timestamp t) {
       mm.drive_mode = static_cast<std::uint8_t>(drive_mode_);  // where the layout has byte 2
       send(mm, t);
       if (config_.odometer_frames) send_odometers(t);
-      if (config_.vendor_frames) {
-        // 0x231 and 0x241, each with its counter.
-        LightState light = lights_.report();
-        if (p.light_modes == LightModes::kOnOff) {  // on/off only: no rear light, no brightness
-          light.rear_mode = protocol::LightMode::kOff;
-          light.front_custom = light.rear_custom = 0;
-        }
-        light.counter = vendor_counter_;
-        send(light, t);
-        // The remote control on, SWB up (command mode) unless the remote is in charge; the
-        // sticks as the operator holds them (centred within the dead band).
-        RemoteControlState rc;
-        rc.swa = remote_.swa;
-        rc.swb = control_mode_ == ControlMode::kRemote ? protocol::RemoteSwitch::kMiddle
-                                                       : protocol::RemoteSwitch::kUp;
-        rc.swc = remote_.swc;
-        rc.swd = remote_.swd;
-        rc.stick_left_v = stick_wire(remote_.left);
-        rc.stick_right_h = stick_wire(remote_.right);
-        rc.counter = vendor_counter_;
-        send(rc, t);
-        ++vendor_counter_;
-      }
+      if (config_.vendor_frames) send_vendor_frames(t);
       break;
     }
     case kUltrasonic: {

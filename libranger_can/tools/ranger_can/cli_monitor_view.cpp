@@ -51,6 +51,18 @@ std::string drive_mode_text(std::uint8_t raw) {
   return mode ? std::string(protocol::to_string(*mode)) : "unknown (" + std::to_string(raw) + ")";
 }
 
+// One axle's odometers as JSON: {"left","right"} in metres where the profile gives the unit, else
+// {"left_raw","right_raw"}.
+void write_odometer(JsonWriter& w, const OdometerFeedback& v) {
+  w.key(v.rear ? "rear_odometer" : "front_odometer").begin_object();
+  if (v.left_distance && v.right_distance) {
+    w.key("left").number(*v.left_distance).key("right").number(*v.right_distance);
+  } else {
+    w.key("left_raw").integer(v.left_wheel).key("right_raw").integer(v.right_wheel);
+  }
+  w.end_object();
+}
+
 // One axle's odometers: in metres where the profile gives the unit, else the raw counts.
 std::string odometer_text(const OdometerFeedback& o) {
   if (o.left_distance && o.right_distance) {
@@ -387,15 +399,7 @@ std::string ChassisMonitor::render_json(std::string_view iface, const BusStatus&
     }
   }
   for (const auto* o : {&fb_.odometer, &fb_.rear_odometer}) {
-    if (!*o) continue;
-    const OdometerFeedback& v = (*o)->value;
-    w.key(v.rear ? "rear_odometer" : "front_odometer").begin_object();
-    if (v.left_distance && v.right_distance) {
-      w.key("left").number(*v.left_distance).key("right").number(*v.right_distance);
-    } else {
-      w.key("left_raw").integer(v.left_wheel).key("right_raw").integer(v.right_wheel);
-    }
-    w.end_object();
+    if (*o) write_odometer(w, (*o)->value);
   }
   if (fb_.motion) {
     w.key("speed").number(fb_.motion->value.speed);

@@ -216,6 +216,10 @@ class ChassisIdentifier {
   void tick_awaiting_control(Timestamp now);
   void tick_step(Timestamp now);
   void decide_passive(Timestamp now);
+  // The revision preset from the frames' signatures (or the forced one); false when they fit no
+  // revision (the identification has failed).
+  bool decide_revision(Timestamp now);
+  bool byte7_counts() const;  // 0x211 byte 7 rose by one in >= 90 % of >= 10 frames
   void begin_step(IdentificationPhase phase, Timestamp now);
   bool settled(Timestamp now) const;
   void evaluate_spin(Timestamp now);

@@ -285,6 +285,7 @@ class VirtualChassis {
   // commands only with vendor_frames).
   bool is_own_command(const Message& message, std::uint32_t id) const;
   void send_odometers(Timestamp t);
+  void send_vendor_frames(Timestamp t);  // 0x231 and 0x241, each with its counter
   void answer_version_request();
   std::uint32_t bit(protocol::Fault fault, int motor = 0) const;
   void set_control_mode(protocol::ControlMode mode, const std::string& why);
