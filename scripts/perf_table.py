@@ -127,6 +127,25 @@ def node():
         f"{t} {r} Hz" for t, r in load["subscribers_messages_per_s"].items()), "node")
 
 
+def node_ros2():
+    """ROS 2 node
+    ros2/ranger_base's ranger_base_node (rclpy over the ranger_can binding) in the same run, the
+    same load: `port_name:=sim`, subscribers on `odom`, `/tf`, `joint_states`, `cmd_vel` at
+    20 Hz; latency as above (ros2/ranger_base/ranger_base/measure_performance.py)."""
+    doc = json.loads(read("node_ros2.json"))
+    load, lat = doc["load"], doc["latency"]
+    ros1 = json.loads(read("node.json"))["load"]["driver_cpu_percent"] if read("node.json") \
+        else None
+    ratio = load["driver_percent"] / ros1 if ros1 else None
+    row("Driver CPU (node minus chassis thread)", f"{load['driver_percent']} % of one core"
+        + (f" ({ratio:.1f}x the ROS 1 node's)" if ratio else ""), "node_ros2",
+        "≤ 2x the ROS 1 node's", ratio is not None and ratio <= 2.0)
+    row("RSS", f"{load['rss_mb']} MB", "node_ros2")
+    for p, limit in (("p50", None), ("p90", None), ("p99", 2.0)):
+        row(f"cmd_vel -> 0x111 latency {p}", f"{lat[p + '_ms']} ms", "node_ros2",
+            f"≤ {limit:g} ms" if limit else "", limit and lat[p + "_ms"] <= limit)
+
+
 def keepalive():
     """Publication off the CAN schedule
     The 0x111 keep-alive's period while the node publishes to a subscriber on every topic it
@@ -226,6 +245,7 @@ section(codec, callgrind)
 section(control)
 section(bus)
 section(node)
+section(node_ros2)
 section(keepalive)
 section(nodelet)
 section(fleet)

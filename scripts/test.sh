@@ -14,13 +14,16 @@
 #             plain build with CMake 3.16; catkin_lint -W1
 #   sanitize  ASan+UBSan and TSan builds of the library and its tests, ASan build of the ROS node
 #   fuzz      every libFuzzer target for a bounded time (RANGER_FUZZ_SECONDS, default 60)
+#   ros2      the Python binding and the ROS 2 packages (scripts/test_ros2.sh): the venv of ROS 2
+#             wheels (scripts/setup_ros2.sh), the colcon build of ros2/ as the README has it, the
+#             binding's and the ROS 2 node's tests on this host only, pip install ./libranger_can
 #
 # RANGER_STAGES="unit ros" runs a subset (default: all of the above, in that order).
 set -uo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
 results=$root/build/test-results
-stages=${RANGER_STAGES:-unit vcan ros ros_vcan workspaces sanitize fuzz}
+stages=${RANGER_STAGES:-unit vcan ros ros_vcan workspaces sanitize fuzz ros2}
 failed=()
 passed=()
 
@@ -67,6 +70,7 @@ stage_ros() {
 stage_workspaces() { scripts/test_workspaces.sh; }
 stage_sanitize() { scripts/test_sanitizers.sh; }
 stage_fuzz() { scripts/fuzz.sh "${RANGER_FUZZ_SECONDS:-60}"; }
+stage_ros2() { scripts/test_ros2.sh "$results"; }
 
 echo "== setup"
 scripts/setup.sh test || { echo "setup failed: cannot install the system packages" >&2; exit 1; }

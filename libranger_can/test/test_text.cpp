@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "ranger_can/control/controller.hpp"
+#include "ranger_can/control/diagnostics.hpp"
 #include "ranger_can/control/driver.hpp"
 #include "ranger_can/control/driver_events.hpp"
 #include "ranger_can/control/identification.hpp"
@@ -121,6 +122,7 @@ TEST(EnumNames, EveryTableHoldsEveryEnumerator) {
   expect_table_complete(sim::kOpNames, "Expectation::Op");
   expect_table_complete(kSeverityNames, "Severity");
   expect_table_complete(kEventKindNames, "EventKind");
+  expect_table_complete(kDiagnosticLevelNames, "DiagnosticLevel");
 }
 
 // The finder itself: it sees a missing enumerator.

@@ -629,6 +629,37 @@ def workspace_build_in_ci(session, cmd, match):
         "test.sh has no workspaces stage running scripts/test_workspaces.sh"
 
 
+def pip_install_in_ros2_stage(session, cmd, match):
+    """`pip install ./libranger_can`: verified, not run here (it builds the library, minutes):
+    the ros2 stage (scripts/test_ros2.sh) installs it into a fresh venv and runs the README's
+    Python example with it."""
+    script = read("scripts/test_ros2.sh")
+    assert re.search(r'pip" install .*\./libranger_can', script), "test_ros2.sh: no pip install"
+    assert re.search(r"^stage_ros2\(\) \{ scripts/test_ros2\.sh", read("scripts/test.sh"), re.M)
+
+
+def ros2_workspace_build(session, cmd, match):
+    """The ROS 2 workspace build: verified, not run here: the ros2 stage runs the same colcon
+    command in a workspace whose src/ranger_ros is this checkout, then sources its setup.bash
+    (scripts/ros2_env.sh) for the tests."""
+    script = read("scripts/test_ros2.sh")
+    assert 'ln -sfn "$root" "$ws/src/ranger_ros"' in script
+    assert "build --paths src/ranger_ros/ros2/*" in script
+    assert "ws=$root/build/ros2_ws" in script
+    assert "source scripts/ros2_env.sh" in script  # the tests run in that workspace's setup
+    assert 'source "$ranger_root/build/ros2_ws/install/setup.bash"' in read("scripts/ros2_env.sh")
+
+
+def ros2_launch_checked(session, cmd, match):
+    """A ROS 2 launch (no `ros2` command or `launch` here): verified by the ros2 stage's
+    test_launch_files.py, which runs every `ros2 launch ranger_bringup` line of this README
+    through the file with stand-ins for launch and checks every executable, parameter and file it
+    names; the file must exist."""
+    assert os.path.exists(os.path.join(REPO, "ros2", "ranger_bringup", "launch",
+                                       match.group("file")))
+    assert "README.md" in read("ros2/ranger_bringup/test/test_launch_files.py")
+
+
 @dataclass
 class Rule:
     pattern: str  # matched against the whole command
@@ -676,6 +707,13 @@ RULES = [
     Rule(r"\./scripts/demo\.sh|scripts/demo\.sh --no-setup --no-build --headless",
          demo_runs_in_test_demo, "verified: test_demo.py runs it (--no-setup --no-build "
          "--headless --output)"),
+    Rule(r"pip install \./libranger_can", pip_install_in_ros2_stage,
+         "verified: the ros2 stage installs it into a fresh venv and runs the Python example"),
+    Rule(r"cd ~/ros2_ws && colcon build --paths src/ranger_ros/ros2/\* && "
+         r"source install/setup\.bash", ros2_workspace_build,
+         "verified: the ros2 stage runs that colcon command in a workspace holding this checkout"),
+    Rule(r"ros2 launch ranger_bringup (?P<file>\S+\.launch\.py)( .*)?", ros2_launch_checked,
+         "verified: the ros2 stage's test_launch_files.py runs it with stand-ins for launch"),
     Rule(r"scripts/build\.sh (lib|ros|all)", build_sh_runs_first,
          "verified: test.sh runs scripts/build.sh all before every stage"),
 ]

@@ -246,9 +246,13 @@ Status ChassisController::set_command(const MotionRequest& request, Timestamp no
   return ok_status();
 }
 
-bool ChassisController::can_drive_in(MotionMode mode) const {
+bool can_drive_in(MotionMode mode, const ProtocolProfile& profile) {
   return drivable_mode(mode) &&
-         protocol::motion_mode_to_wire(mode, config_.profile.mode_numbering).has_value();
+         protocol::motion_mode_to_wire(mode, profile.mode_numbering).has_value();
+}
+
+bool ChassisController::can_drive_in(MotionMode mode) const {
+  return ranger::can_drive_in(mode, config_.profile);
 }
 
 void ChassisController::request_motion_mode(std::optional<MotionMode> mode, Timestamp now) {

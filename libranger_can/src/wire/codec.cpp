@@ -402,7 +402,7 @@ Message decode_version(const CanFrame& f) {
 
 // Whether `f` is a RANGER frame its decoder can read: not an error frame, a known ID, at least its
 // layout's length (the one length check: every decoder reads its layout's leading bytes only).
-Status check_decodable(const CanFrame& f, const ProtocolProfile& p) {
+std::optional<Error> check_decodable(const CanFrame& f, const ProtocolProfile& p) {
   if (f.is_error) {
     return Error{Errc::kInvalidArgument,
                  "error frame (class " + hex(f.id, 8) + ") carries no RANGER message"};
@@ -414,13 +414,13 @@ Status check_decodable(const CanFrame& f, const ProtocolProfile& p) {
   }
   if (f.dlc > CanFrame::kMaxDlc) return dlc_above_8(f);
   if (f.dlc < layout) return too_short(f, layout);
-  return ok_status();
+  return std::nullopt;
 }
 
 }  // namespace
 
 Result<Message> decode(const CanFrame& f, const ProtocolProfile& p) {
-  if (Status st = check_decodable(f, p); !st) return st.error();
+  if (auto error = check_decodable(f, p)) return std::move(*error);
   const std::uint8_t* d = f.data.data();
   // The motors' frames: one layout each for the eight motors.
   if (f.id >= kHighSpeedFirst && f.id < kHighSpeedFirst + protocol::kMotorCount) {

@@ -7,6 +7,7 @@
 #include <ostream>
 #include <stdexcept>
 
+#include "ranger_can/frontend/node_parameters.hpp"
 #include "ranger_can/parse.hpp"
 #include "ranger_can/text.hpp"
 
@@ -51,6 +52,16 @@ ValueRule checked_by(std::function<Status(const std::string&)> check) {
   ValueRule r;
   r.kind = ValueRule::Kind::kCustom;
   r.check = std::move(check);
+  return r;
+}
+
+ValueRule parameter_rule(std::string_view name) {
+  ValueRule r;
+  r.kind = ValueRule::Kind::kParameter;
+  r.parameter = find_node_parameter(name);
+  if (r.parameter == nullptr) {
+    throw std::logic_error("'" + std::string(name) + "' is not a row of the parameter table");
+  }
   return r;
 }
 
@@ -144,6 +155,29 @@ Error usage(std::string message) {
   return Error{Errc::kInvalidArgument, std::move(message)};
 }
 
+// `text` read as the row's type, then checked against the row: "--soc = 150 is out of range:
+// valid [0, 100] %".
+Status check_parameter_text(const std::string& what, const Parameter& row,
+                            const std::string& text) {
+  ParameterValue v(text);
+  if (row.type == ParameterType::kNumber || row.type == ParameterType::kSeconds) {
+    auto d = parse_double(what, text);
+    if (!d) return d.error();
+    v = *d;
+  } else if (row.type == ParameterType::kInteger) {
+    auto n = parse_integer(what, text, std::numeric_limits<std::int64_t>::min(),
+                           std::numeric_limits<std::int64_t>::max());
+    if (!n) return n.error();
+    v = static_cast<long long>(*n);
+  } else if (row.type == ParameterType::kBool && (text == "true" || text == "false")) {
+    v = text == "true";
+  }
+  if (auto checked = check_parameter(row, v); !checked) {
+    return usage(what + " " + checked.error().message);
+  }
+  return ok_status();
+}
+
 Status check_value(const std::string& what, const ValueRule& rule, const std::string& value) {
   switch (rule.kind) {
     case ValueRule::Kind::kAny:
@@ -171,6 +205,8 @@ Status check_value(const std::string& what, const ValueRule& rule, const std::st
       if (!s) return usage(what + ": " + s.error().message);
       return ok_status();
     }
+    case ValueRule::Kind::kParameter:
+      return check_parameter_text(what, *rule.parameter, value);
   }
   return ok_status();
 }

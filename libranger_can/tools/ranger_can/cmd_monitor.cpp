@@ -21,8 +21,10 @@
 #include "cli_monitor_view.hpp"
 #include "cli_options.hpp"
 #include "cli_profile.hpp"
+#include "cli_session.hpp"
 #include "cli_signals.hpp"
 #include "ranger_can/clock.hpp"
+#include "ranger_can/control/diagnostics.hpp"
 #include "ranger_can/control/driver.hpp"
 #include "ranger_can/parse.hpp"
 #include "ranger_can/text.hpp"
@@ -172,6 +174,28 @@ DriverConfig listening_config(const Vehicle& vehicle, bool identify) {
   return c;
 }
 
+// --diagnostics: the driver listens (sends nothing) for the window, at least the identification's
+// listening time and a little, then the groups /diagnostics shows are printed.
+int diagnostics_main(const ParsedArgs& args, Io io) {
+  const MonitorOptions o = options_from(args);
+  const Result<Vehicle> vehicle = vehicle_from_args(args);
+  if (!vehicle) return usage_error(monitor_command(), io, vehicle.error().message);
+  const DriverConfig config = listening_config(*vehicle, protocol_is_auto(args));
+  StopSignals signals;
+  auto session = DriverSession::open(o.iface, config, /*listen_only=*/true);
+  if (!session) {
+    io.err << "ranger_can monitor: " << session.error().message << "\n";
+    return 1;
+  }
+  (*session)->run_for(std::max(from_seconds(o.window), config.identification.listen_time + 300ms));
+  const auto snapshot = (*session)->snapshot();
+  (*session)->stop();
+  ChassisDiagnostics diagnostics({o.iface, "", ""});
+  for (const DiagnosticGroup& group : diagnostics.report(*snapshot))
+    io.out << to_text(group);
+  return snapshot->controller.link == LinkState::kConnected ? 0 : 1;
+}
+
 int monitor_main(const ParsedArgs& args, Io io) {
   const MonitorOptions o = options_from(args);
   const Result<Vehicle> vehicle = vehicle_from_args(args);
@@ -234,6 +258,11 @@ int monitor_main(const ParsedArgs& args, Io io) {
   return 0;
 }
 
+// --diagnostics prints the groups once; otherwise the live view.
+int monitor_or_diagnostics(const ParsedArgs& args, Io io) {
+  return args.has("--diagnostics") ? diagnostics_main(args, io) : monitor_main(args, io);
+}
+
 }  // namespace
 
 const CommandSpec& monitor_command() {
@@ -260,6 +289,10 @@ const CommandSpec& monitor_command() {
           option("--window", "SEC", "frame-rate window and --once listening time (default 1)",
                  number_in(0.05, 3600.0)),
           flag("--json", "one JSON object per view (and per event) instead of text"),
+          flag("--diagnostics",
+               "listen through the driver (nothing sent) for --window seconds (at least 1.5), "
+               "print the diagnostic groups the ROS node's /diagnostics shows, exit (0 if the "
+               "chassis was heard, 1 if not); IFACE may also be sim[:VARIANT] or replay:FILE"),
           flag("--no-color",
                "no ANSI colours (default: colours on a terminal unless NO_COLOR is set)"),
           flag("--no-clear",
@@ -269,7 +302,7 @@ const CommandSpec& monitor_command() {
           set_option(),
       },
       "",
-      monitor_main,
+      monitor_or_diagnostics,
   };
   return spec;
 }

@@ -478,11 +478,11 @@ const CommandSpec& sim_command() {
           option("--mode-switch-time", "SEC",
                  "time a motion-mode switch takes once at rest (default " +
                      seconds_of(defaults.mode_switch_duration) + ")",
-                 number_in(0.0, 60.0)),
+                 parameter_rule("sim/mode_switch_duration")),
           option("--soc", "PCT",
                  "initial battery state of charge, 0-100 (default " +
                      number_text(defaults.initial_soc) + ")",
-                 number_in(0.0, 100.0)),
+                 parameter_rule("sim/initial_soc")),
           option("--batteries", "N",
                  "batteries fitted, 1-" + std::to_string(protocol::kBatteryCount) + " (default " +
                      std::to_string(defaults.drivetrain.batteries) + ")",

@@ -281,6 +281,11 @@ struct ControllerState {
   bool rearm_required() const { return latched_causes != 0; }
 };
 
+// Whether a twist can be driven in `mode` under `profile`: ackermann, oblique, spin, and side slip
+// where the profile's mode numbering has it (MINI V1, agx_v2); never park. The controller's rule
+// (ChassisController::can_drive_in), for a front end to refuse a mode by name before asking.
+bool can_drive_in(protocol::MotionMode mode, const ProtocolProfile& profile);
+
 // A frame the controller has just sent (for cmd_vel_out, latency figures and wire audits).
 struct SentFrame {
   CanFrame frame;   // as on the wire (stamp = the controller's `now`)

@@ -1,0 +1,134 @@
+# Type stubs of the extension module (libranger_can/python/src/module.cpp).
+from typing import Dict, List, Optional, Tuple
+
+__version__: str
+
+class Odometry:
+    x: float; y: float; yaw: float; vx: float; vy: float; wz: float
+    stamp_ns: int  # the frames' time (wall clock), 0 = none yet
+    distance: float
+    pose_variance: Tuple[float, float, float]  # x, y, yaw
+    twist_variance: Tuple[float, float, float]  # vx, vy, wz
+    source: str  # "wheels" | "motion"
+    steps: int
+
+class Joints:
+    steering_names: List[str]; wheel_names: List[str]
+    steering_position: List[float]; steering_velocity: List[float]
+    wheel_position: List[float]; wheel_velocity: List[float]
+    has_steering: bool; has_wheels: bool
+    stamp_ns: int
+
+class Motor:
+    motor: int; joint: str; rpm: float; current: float; position: int
+    driver_voltage: float; driver_temperature: float; motor_temperature: float
+    driver_status: int; driver_status_names: List[str]
+    high_speed_stamp_ns: int; low_speed_stamp_ns: int
+
+class Battery:
+    battery: int  # 0 = the pack, 1..4 the slots
+    present: bool; soc: float; soh: float; voltage: float; current: float; temperature: float
+    alarm1: int; alarm2: int; warning1: int; warning2: int
+    alarms: List[str]; warnings: List[str]
+    stamp_ns: int
+
+class UltrasonicReading:
+    sensor: int; raw: int; range: Optional[float]; status: str; stamp_ns: int
+
+class Identification:
+    phase: str; revision: str; message: str
+    evidence: List[str]; undecided: List[str]; decided: List[Tuple[str, str]]
+    confidence: float; done: bool; elapsed: float
+
+class RemoteState:
+    swa: str; swb: str; swc: str; swd: str
+    left_vertical: float; left_horizontal: float; right_vertical: float
+    right_horizontal: float; knob: float
+    stamp_ns: int; received_ns: int
+
+class Lights:
+    can_control: bool; front: str; rear: str; front_brightness: int; rear_brightness: int
+
+class FrameCount:
+    id: int; name: str; frames: int; rejected: int; padded: int
+
+class RequestOutcome:
+    id: int; kind: str; what: str
+    state: str  # "pending" | "sent" | "answered" | "failed"
+    message: str
+    error_word: Optional[int]
+    @property
+    def done(self) -> bool: ...
+
+class Event:
+    sequence: int
+    time_ns: int  # the driver's (monotonic) clock
+    kind: str  # event_kinds(): "link_silent", "refusal_changed", "shutdown_stop", ...
+    severity: str  # "debug" | "info" | "warn" | "error"
+    text: str  # the line for people
+    json: str
+
+class GroundTruth:
+    x: float; y: float; yaw: float; vx: float; vy: float; wz: float
+    distance_travelled: float; yaw_travelled: float
+    control_mode: str; motion_mode: str; emergency_stop: bool; motion_allowed: bool
+    motion_refused_reason: str; stamp_ns: int; lights: Lights
+
+class SentMotion:
+    vx: float; vy: float; wz: float; wall: float; shutdown: bool
+
+class ParameterRow:
+    name: str; type: str; unit: str; lo: float; hi: float; lo_open: bool; hi_open: bool
+    has_range: bool; default: str; choices: List[str]; meaning: str; group: str
+
+class CliResult:
+    exit_code: int; out: str; err: str
+
+class Snapshot:
+    sequence: int; now_ns: int; port: str; bus_open: bool; read_only: bool; bus_error: str
+    bus_state: str; link: str
+    control_mode: Optional[str]; control_mode_raw: int
+    vehicle_status: Optional[str]; vehicle_status_raw: Optional[int]
+    motion_mode: Optional[str]; chassis_mode: Optional[str]; chassis_mode_raw: Optional[int]
+    switching: bool; mode_override: Optional[str]
+    refusal: str  # ranger_can.refusal_names(): "none", "estop", "rearm_required", ...
+    refusal_detail: str  # what it means and what to do, in words ("" while driven)
+    rearm_required: bool; latched_causes: List[str]; active_causes: List[str]
+    reclaim_blocked: bool; awaiting_command_mode: bool; cmd_timed_out: bool
+    steer_first_factor: float
+    faults: List[str]; error_word: int; error_layout: str; error_names: List[str]
+    battery_voltage: Optional[float]; battery_soc: Optional[float]
+    park_requested: bool; parked: bool; ultrasonic_enabled: Optional[bool]
+    identifying: Optional[str]; standstill_probe: bool; quiet: bool; implausible_reason: str
+    motion_known: bool
+    odometry: Odometry; joints: Joints; motors: List[Motor]; batteries: List[Battery]
+    ultrasonic: List[UltrasonicReading]
+    protocol: str; profile: str; profile_revision: str
+    identification: Optional[Identification]
+    plausibility_warnings: List[str]; plausibility_stop: Optional[str]
+    vendor_frames: str; remote: Optional[RemoteState]; lights: Optional[Lights]
+    firmware_version: str; firmware_state: str
+    frames: List[FrameCount]; requests: List[RequestOutcome]; loop_iterations: int
+
+class _Session:
+    def __init__(self, port: str, params: Dict[str, object], record_sent: bool = ...,
+                 display_prefix: str = ...) -> None: ...
+    def __getattr__(self, name: str): ...
+
+def parameters() -> List[ParameterRow]: ...
+def model_names() -> List[str]: ...
+def variant_names() -> List[str]: ...
+def protocol_names() -> List[str]: ...
+def motion_modes() -> List[str]: ...
+def light_modes() -> List[str]: ...
+def refusal_names() -> List[str]: ...
+def event_kinds() -> List[str]: ...
+def fault_names() -> List[str]: ...
+def driver_status_bit_names() -> List[str]: ...
+def bms_status_bit_names() -> List[str]: ...
+def chassis_command_names() -> List[str]: ...
+def steering_joint_names() -> List[str]: ...
+def wheel_joint_names() -> List[str]: ...
+def error_clear_description(code: int) -> str: ...
+def error_names(error_word: int, layout: str) -> List[str]: ...
+def _cli(args: List[str], input: str = ...) -> CliResult: ...

@@ -1,0 +1,687 @@
+// ranger_can._ranger_can: the pybind11 mapping of libranger_can. Nothing here decides anything:
+// each function calls the library (or the ranger_can tool's sub-commands, for candump decoding
+// and odometry replay) and converts values; the Python package (ranger_can/__init__.py) adds the
+// context manager, the clean-up at interpreter exit and the exception classes.
+//
+// Errors: every ranger::Error becomes ranger_can.RangerError carrying the library's message and
+// its code name. Waiting (wait_snapshot, wait_for, wait_sent, the tool's commands) releases the
+// GIL; nothing Python ever runs on the driver's thread.
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <chrono>
+#include <sstream>
+#include <string>
+
+#include "ranger_can/control/controller.hpp"
+#include "ranger_can/control/geometry.hpp"
+#include "ranger_can/control/model.hpp"
+#include "ranger_can/control/rearm.hpp"
+#include "ranger_can/sim/chassis_commands.hpp"
+#include "ranger_can/sim/sim_bus_source.hpp"
+#include "ranger_can/text.hpp"
+#include "ranger_can/wire/profile.hpp"
+#include "ranger_can/wire/protocol.hpp"
+
+#include "cli_commands.hpp"
+#include "options.hpp"
+#include "session.hpp"
+#include "views.hpp"
+
+namespace py = pybind11;
+
+namespace ranger::python {
+namespace {
+
+// A library error on its way to Python (translated into ranger_can.RangerError).
+struct LibraryError {
+  Error error;
+};
+
+std::string_view code_name(Errc c) {
+  switch (c) {
+    case Errc::kUnknownId:
+      return "unknown_id";
+    case Errc::kBadDlc:
+      return "bad_dlc";
+    case Errc::kOutOfRange:
+      return "out_of_range";
+    case Errc::kNotFinite:
+      return "not_finite";
+    case Errc::kInvalidArgument:
+      return "invalid_argument";
+    case Errc::kParseError:
+      return "parse_error";
+    case Errc::kIoError:
+      return "io_error";
+    case Errc::kNoSuchInterface:
+      return "no_such_interface";
+    case Errc::kNotCanInterface:
+      return "not_can_interface";
+    case Errc::kInterfaceDown:
+      return "interface_down";
+    case Errc::kWouldBlock:
+      return "would_block";
+    case Errc::kTimeout:
+      return "timeout";
+    case Errc::kPermissionDenied:
+      return "permission_denied";
+  }
+  return "error";
+}
+
+template <typename T>
+T value_or_throw(Result<T> r) {
+  if (!r) throw LibraryError{r.error()};
+  return std::move(*r);
+}
+
+void check(const Status& st) {
+  if (!st) throw LibraryError{st.error()};
+}
+
+[[noreturn]] void invalid(std::string message) {
+  throw LibraryError{Error{Errc::kInvalidArgument, std::move(message)}};
+}
+
+std::chrono::nanoseconds to_ns(double s) {
+  if (!(s >= 0.0)) return std::chrono::nanoseconds(0);
+  return from_seconds(std::min(s, 1e6));
+}
+
+protocol::MotionMode parse_mode(const std::string& text) {
+  if (auto m = protocol::kMotionModeNames.parse(text)) return *m;
+  invalid("motion mode \"" + text + "\" unknown: one of " +
+          text::join(protocol::kMotionModeNames.names()));
+}
+
+protocol::LightMode parse_light(const std::string& text) {
+  if (auto m = protocol::kLightModeNames.parse(text)) return *m;
+  invalid("light mode \"" + text + "\" unknown: one of " +
+          text::join(protocol::kLightModeNames.names()));
+}
+
+template <typename T>
+std::optional<std::string> name_of(const std::optional<T>& v) {
+  if (!v) return std::nullopt;
+  return std::string(protocol::to_string(*v));
+}
+
+std::vector<std::string> cause_names(StopCauses causes) {
+  std::vector<std::string> out;
+  for (const auto& [cause, name] : kStopCauseNames) {
+    if (has(causes, cause)) out.emplace_back(name);
+  }
+  return out;
+}
+
+// Converts a Python parameter value (bool, int, float, str, list of numbers or strings).
+Value to_value(const std::string& name, const py::handle& h) {
+  if (py::isinstance<py::bool_>(h)) return h.cast<bool>();
+  if (py::isinstance<py::int_>(h)) return h.cast<std::int64_t>();
+  if (py::isinstance<py::float_>(h)) return h.cast<double>();
+  if (py::isinstance<py::str>(h)) return h.cast<std::string>();
+  if (py::isinstance<py::list>(h) || py::isinstance<py::tuple>(h)) {
+    const auto seq = h.cast<py::sequence>();
+    bool all_text = true, all_numbers = true;
+    for (const auto& item : seq) {
+      all_text = all_text && py::isinstance<py::str>(item);
+      all_numbers = all_numbers && !py::isinstance<py::bool_>(item) &&
+                    (py::isinstance<py::int_>(item) || py::isinstance<py::float_>(item));
+    }
+    if (seq.size() > 0 && all_text) return h.cast<std::vector<std::string>>();
+    if (all_numbers) return h.cast<std::vector<double>>();
+  }
+  invalid("parameter " + name + " = " + py::repr(h).cast<std::string>() +
+          ": expected a bool, a number, a string or a list of them");
+}
+
+// The DriverSnapshot as Python sees it: properties read it on demand.
+class Snapshot {
+ public:
+  explicit Snapshot(std::shared_ptr<const DriverSnapshot> s) : s_(std::move(s)) {}
+  const DriverSnapshot& s() const { return *s_; }
+  const ControllerState& c() const { return s_->controller; }
+
+ private:
+  std::shared_ptr<const DriverSnapshot> s_;
+};
+
+// The Python-visible owner: a Session, and what a front end needs of its setup.
+class PySession {
+ public:
+  explicit PySession(std::unique_ptr<Session> s) : s_(std::move(s)) {}
+  Session& s() { return *s_; }
+  const Setup& setup() const { return s_->setup(); }
+
+  // How long a request of `kind` may take before a front end gives up waiting: the driver's
+  // own answer budget for it.
+  double budget(const std::string& kind) {
+    if (const auto k = kRequestKindNames.parse(kind)) {
+      return seconds(s_->driver().answer_budget(*k));
+    }
+    invalid("request kind \"" + kind + "\" unknown");
+  }
+
+ private:
+  std::unique_ptr<Session> s_;
+};
+
+struct CliResult {
+  int exit_code = 0;
+  std::string out, err;
+};
+
+CliResult run_cli(const std::vector<std::string>& args, const std::string& input) {
+  std::istringstream in(input);
+  std::ostringstream out, err;
+  CliResult r;
+  r.exit_code = cli::run_main(args, cli::Io{in, out, err});
+  r.out = out.str();
+  r.err = err.str();
+  return r;
+}
+
+}  // namespace
+}  // namespace ranger::python
+
+using namespace ranger;
+using namespace ranger::python;
+
+PYBIND11_MODULE(_ranger_can, m) {
+  m.doc() = "libranger_can, the RANGER driver library (use the ranger_can package)";
+
+  // The exception classes live in ranger_can/_errors.py; errors are translated into them.
+  py::module_ errors = py::module_::import("ranger_can._errors");
+  static py::object ranger_error = errors.attr("RangerError");
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const LibraryError& e) {
+      py::object exc = ranger_error(e.error.message, std::string(code_name(e.error.code)));
+      PyErr_SetObject(ranger_error.ptr(), exc.ptr());
+    }
+  });
+
+  // ---- values ----
+  py::class_<OdometryView>(m, "Odometry")
+      .def_readonly("x", &OdometryView::x)
+      .def_readonly("y", &OdometryView::y)
+      .def_readonly("yaw", &OdometryView::yaw)
+      .def_readonly("vx", &OdometryView::vx)
+      .def_readonly("vy", &OdometryView::vy)
+      .def_readonly("wz", &OdometryView::wz)
+      .def_readonly("stamp_ns", &OdometryView::stamp_ns)
+      .def_readonly("distance", &OdometryView::distance)
+      .def_readonly("pose_variance", &OdometryView::pose_variance)
+      .def_readonly("twist_variance", &OdometryView::twist_variance)
+      .def_readonly("source", &OdometryView::source)
+      .def_readonly("steps", &OdometryView::steps)
+      .def("__repr__", [](const OdometryView& o) {
+        std::ostringstream out;
+        out << "Odometry(x=" << o.x << ", y=" << o.y << ", yaw=" << o.yaw << ", vx=" << o.vx
+            << ", vy=" << o.vy << ", wz=" << o.wz << ")";
+        return out.str();
+      });
+  py::class_<JointsView>(m, "Joints")
+      .def_readonly("steering_names", &JointsView::steering_names)
+      .def_readonly("wheel_names", &JointsView::wheel_names)
+      .def_readonly("steering_position", &JointsView::steering_position)
+      .def_readonly("steering_velocity", &JointsView::steering_velocity)
+      .def_readonly("wheel_position", &JointsView::wheel_position)
+      .def_readonly("wheel_velocity", &JointsView::wheel_velocity)
+      .def_readonly("has_steering", &JointsView::has_steering)
+      .def_readonly("has_wheels", &JointsView::has_wheels)
+      .def_readonly("stamp_ns", &JointsView::stamp_ns);
+  py::class_<MotorView>(m, "Motor")
+      .def_readonly("motor", &MotorView::motor)
+      .def_readonly("joint", &MotorView::joint)
+      .def_readonly("rpm", &MotorView::rpm)
+      .def_readonly("current", &MotorView::current)
+      .def_readonly("position", &MotorView::position)
+      .def_readonly("driver_voltage", &MotorView::driver_voltage)
+      .def_readonly("driver_temperature", &MotorView::driver_temperature)
+      .def_readonly("motor_temperature", &MotorView::motor_temperature)
+      .def_readonly("driver_status", &MotorView::driver_status)
+      .def_readonly("driver_status_names", &MotorView::driver_status_names)
+      .def_readonly("high_speed_stamp_ns", &MotorView::high_speed_stamp_ns)
+      .def_readonly("low_speed_stamp_ns", &MotorView::low_speed_stamp_ns);
+  py::class_<BatteryView>(m, "Battery")
+      .def_readonly("battery", &BatteryView::battery)
+      .def_readonly("present", &BatteryView::present)
+      .def_readonly("soc", &BatteryView::soc)
+      .def_readonly("soh", &BatteryView::soh)
+      .def_readonly("voltage", &BatteryView::voltage)
+      .def_readonly("current", &BatteryView::current)
+      .def_readonly("temperature", &BatteryView::temperature)
+      .def_readonly("alarm1", &BatteryView::alarm1)
+      .def_readonly("alarm2", &BatteryView::alarm2)
+      .def_readonly("warning1", &BatteryView::warning1)
+      .def_readonly("warning2", &BatteryView::warning2)
+      .def_readonly("alarms", &BatteryView::alarms)
+      .def_readonly("warnings", &BatteryView::warnings)
+      .def_readonly("stamp_ns", &BatteryView::stamp_ns);
+  py::class_<UltrasonicView>(m, "UltrasonicReading")
+      .def_readonly("sensor", &UltrasonicView::sensor)
+      .def_readonly("raw", &UltrasonicView::raw)
+      .def_readonly("range", &UltrasonicView::range)
+      .def_readonly("status", &UltrasonicView::status)
+      .def_readonly("stamp_ns", &UltrasonicView::stamp_ns);
+  py::class_<IdentificationView>(m, "Identification")
+      .def_readonly("phase", &IdentificationView::phase)
+      .def_readonly("revision", &IdentificationView::revision)
+      .def_readonly("message", &IdentificationView::message)
+      .def_readonly("evidence", &IdentificationView::evidence)
+      .def_readonly("undecided", &IdentificationView::undecided)
+      .def_readonly("decided", &IdentificationView::decided)
+      .def_readonly("confidence", &IdentificationView::confidence)
+      .def_readonly("done", &IdentificationView::done)
+      .def_readonly("elapsed", &IdentificationView::elapsed);
+  py::class_<RemoteView>(m, "RemoteState")
+      .def_readonly("swa", &RemoteView::swa)
+      .def_readonly("swb", &RemoteView::swb)
+      .def_readonly("swc", &RemoteView::swc)
+      .def_readonly("swd", &RemoteView::swd)
+      .def_readonly("left_vertical", &RemoteView::left_vertical)
+      .def_readonly("left_horizontal", &RemoteView::left_horizontal)
+      .def_readonly("right_vertical", &RemoteView::right_vertical)
+      .def_readonly("right_horizontal", &RemoteView::right_horizontal)
+      .def_readonly("knob", &RemoteView::knob)
+      .def_readonly("stamp_ns", &RemoteView::stamp_ns)
+      .def_readonly("received_ns", &RemoteView::received_ns);
+  py::class_<LightsView>(m, "Lights")
+      .def_readonly("can_control", &LightsView::can_control)
+      .def_readonly("front", &LightsView::front)
+      .def_readonly("rear", &LightsView::rear)
+      .def_readonly("front_brightness", &LightsView::front_brightness)
+      .def_readonly("rear_brightness", &LightsView::rear_brightness);
+  py::class_<FrameView>(m, "FrameCount")
+      .def_readonly("id", &FrameView::id)
+      .def_readonly("name", &FrameView::name)
+      .def_readonly("frames", &FrameView::frames)
+      .def_readonly("rejected", &FrameView::rejected)
+      .def_readonly("padded", &FrameView::padded);
+  py::class_<OutcomeView>(m, "RequestOutcome")
+      .def_readonly("id", &OutcomeView::id)
+      .def_readonly("kind", &OutcomeView::kind)
+      .def_readonly("what", &OutcomeView::what)
+      .def_readonly("state", &OutcomeView::state)
+      .def_readonly("message", &OutcomeView::message)
+      .def_readonly("error_word", &OutcomeView::error_word)
+      .def_property_readonly("done", &OutcomeView::done)
+      .def("__repr__", [](const OutcomeView& o) {
+        return "RequestOutcome(" + o.kind + " #" + std::to_string(o.id) + ": " + o.state +
+               (o.message.empty() ? "" : ", " + o.message) + ")";
+      });
+  py::class_<EventView>(m, "Event")
+      .def_readonly("sequence", &EventView::sequence)
+      .def_readonly("time_ns", &EventView::time_ns)
+      .def_readonly("kind", &EventView::kind)
+      .def_readonly("severity", &EventView::severity)
+      .def_readonly("text", &EventView::text)
+      .def_readonly("json", &EventView::json)
+      .def("__repr__",
+           [](const EventView& e) { return "Event(" + e.severity + " " + e.kind + ": " + e.text + ")"; });
+  py::class_<GroundTruthView>(m, "GroundTruth")
+      .def_readonly("x", &GroundTruthView::x)
+      .def_readonly("y", &GroundTruthView::y)
+      .def_readonly("yaw", &GroundTruthView::yaw)
+      .def_readonly("vx", &GroundTruthView::vx)
+      .def_readonly("vy", &GroundTruthView::vy)
+      .def_readonly("wz", &GroundTruthView::wz)
+      .def_readonly("distance_travelled", &GroundTruthView::distance_travelled)
+      .def_readonly("yaw_travelled", &GroundTruthView::yaw_travelled)
+      .def_readonly("control_mode", &GroundTruthView::control_mode)
+      .def_readonly("motion_mode", &GroundTruthView::motion_mode)
+      .def_readonly("emergency_stop", &GroundTruthView::emergency_stop)
+      .def_readonly("motion_allowed", &GroundTruthView::motion_allowed)
+      .def_readonly("motion_refused_reason", &GroundTruthView::motion_refused_reason)
+      .def_readonly("stamp_ns", &GroundTruthView::stamp_ns)
+      .def_readonly("lights", &GroundTruthView::lights);
+  py::class_<SentMotion>(m, "SentMotion")
+      .def_property_readonly("vx", [](const SentMotion& s) { return s.achieved.vx; })
+      .def_property_readonly("vy", [](const SentMotion& s) { return s.achieved.vy; })
+      .def_property_readonly("wz", [](const SentMotion& s) { return s.achieved.wz; })
+      .def_readonly("wall", &SentMotion::wall)
+      .def_readonly("shutdown", &SentMotion::shutdown);
+  py::class_<ParameterRow>(m, "ParameterRow")
+      .def_readonly("name", &ParameterRow::name)
+      .def_readonly("type", &ParameterRow::type)
+      .def_readonly("unit", &ParameterRow::unit)
+      .def_readonly("lo", &ParameterRow::lo)
+      .def_readonly("hi", &ParameterRow::hi)
+      .def_readonly("lo_open", &ParameterRow::lo_open)
+      .def_readonly("hi_open", &ParameterRow::hi_open)
+      .def_readonly("has_range", &ParameterRow::has_range)
+      .def_readonly("default", &ParameterRow::default_text)
+      .def_readonly("choices", &ParameterRow::choices)
+      .def_readonly("meaning", &ParameterRow::meaning)
+      .def_readonly("group", &ParameterRow::group)
+      .def("__repr__", [](const ParameterRow& r) { return "ParameterRow(" + r.name + ")"; });
+  py::class_<CliResult>(m, "CliResult")
+      .def_readonly("exit_code", &CliResult::exit_code)
+      .def_readonly("out", &CliResult::out)
+      .def_readonly("err", &CliResult::err);
+
+  // ---- the snapshot ----
+  using S = Snapshot;
+  py::class_<S>(m, "Snapshot")
+      .def_property_readonly("sequence", [](const S& s) { return s.s().sequence; })
+      .def_property_readonly("now_ns", [](const S& s) { return s.s().now.count(); })
+      .def_property_readonly("port", [](const S& s) { return s.s().bus_name; })
+      .def_property_readonly("bus_open", [](const S& s) { return s.s().bus_open; })
+      .def_property_readonly("read_only", [](const S& s) { return s.s().read_only; })
+      .def_property_readonly("bus_error", [](const S& s) { return s.s().bus_error; })
+      .def_property_readonly("bus_state",
+                             [](const S& s) { return std::string(to_string(s.s().bus.state)); })
+      .def_property_readonly("link", [](const S& s) { return std::string(to_string(s.c().link)); })
+      .def_property_readonly("control_mode", [](const S& s) { return name_of(s.c().control_mode); })
+      .def_property_readonly("control_mode_raw", [](const S& s) { return s.c().control_mode_raw; })
+      .def_property_readonly("vehicle_status",
+                             [](const S& s) { return name_of(s.c().vehicle_status); })
+      .def_property_readonly("vehicle_status_raw",
+                             [](const S& s) -> std::optional<int> {
+                               const auto& st = s.s().feedback.system_status;
+                               if (!st) return std::nullopt;
+                               return st->value.vehicle_status_raw;
+                             })
+      .def_property_readonly("motion_mode", [](const S& s) { return name_of(s.c().motion_mode); })
+      .def_property_readonly("chassis_mode", [](const S& s) { return name_of(s.c().chassis_mode); })
+      .def_property_readonly("chassis_mode_raw",
+                             [](const S& s) -> std::optional<int> {
+                               const auto& mm = s.s().feedback.motion_mode;
+                               if (!mm) return std::nullopt;
+                               return mm->value.mode_raw;
+                             })
+      .def_property_readonly("switching", [](const S& s) { return s.c().chassis_switching; })
+      .def_property_readonly("mode_override",
+                             [](const S& s) { return name_of(s.c().mode_override); })
+      .def_property_readonly("refusal",
+                             [](const S& s) { return std::string(to_string(s.c().refusal)); })
+      .def_property_readonly("refusal_detail",
+                             [](const S& s) {
+                               return describe_refusal(s.c(), s.s().identification.get());
+                             })
+      .def_property_readonly("rearm_required", [](const S& s) { return s.c().rearm_required(); })
+      .def_property_readonly("latched_causes",
+                             [](const S& s) { return cause_names(s.c().latched_causes); })
+      .def_property_readonly("active_causes",
+                             [](const S& s) { return cause_names(s.c().active_causes); })
+      .def_property_readonly("reclaim_blocked", [](const S& s) { return s.c().reclaim_blocked; })
+      .def_property_readonly("awaiting_command_mode",
+                             [](const S& s) { return s.c().awaiting_command_mode; })
+      .def_property_readonly("cmd_timed_out", [](const S& s) { return s.c().cmd_timed_out; })
+      .def_property_readonly("steer_first_factor",
+                             [](const S& s) { return s.c().steer_first_factor; })
+      .def_property_readonly("faults", [](const S& s) { return s.c().faults; })
+      .def_property_readonly("error_word", [](const S& s) { return s.c().error_bits; })
+      .def_property_readonly(
+          "error_layout",
+          [](const S& s) { return std::string(to_string(s.s().profile.error_word)); })
+      .def_property_readonly("error_names",
+                             [](const S& s) {
+                               return protocol::error_bit_names(s.c().error_bits,
+                                                                s.s().profile.error_word);
+                             })
+      .def_property_readonly("battery_voltage",
+                             [](const S& s) -> std::optional<double> {
+                               const auto& st = s.s().feedback.system_status;
+                               if (!st) return std::nullopt;
+                               return st->value.battery_voltage;
+                             })
+      .def_property_readonly("battery_soc", [](const S& s) { return s.c().battery_soc; })
+      .def_property_readonly("park_requested", [](const S& s) { return s.c().park_requested; })
+      .def_property_readonly("parked", [](const S& s) { return s.c().parked(); })
+      .def_property_readonly("ultrasonic_enabled",
+                             [](const S& s) { return s.c().ultrasonic_enabled; })
+      .def_property_readonly("identifying",
+                             [](const S& s) -> std::optional<std::string> {
+                               if (!s.c().identifying) return std::nullopt;
+                               return std::string(to_string(*s.c().identifying));
+                             })
+      .def_property_readonly("standstill_probe", [](const S& s) { return s.c().standstill_probe; })
+      .def_property_readonly("quiet", [](const S& s) { return s.c().quiet; })
+      .def_property_readonly("implausible_reason",
+                             [](const S& s) { return s.c().implausible_reason; })
+      .def_property_readonly("motion_known", [](const S& s) { return s.s().motion_known; })
+      .def_property_readonly("odometry", [](const S& s) { return odometry_view(s.s()); })
+      .def_property_readonly("joints", [](const S& s) { return joints_view(s.s()); })
+      .def_property_readonly("motors", [](const S& s) { return motors_view(s.s()); })
+      .def_property_readonly("batteries", [](const S& s) { return batteries_view(s.s()); })
+      .def_property_readonly("ultrasonic", [](const S& s) { return ultrasonic_view(s.s()); })
+      .def_property_readonly("protocol",
+                             [](const S& s) { return std::string(to_string(s.s().protocol)); })
+      .def_property_readonly("profile", [](const S& s) { return describe(s.s().profile); })
+      .def_property_readonly("profile_revision", [](const S& s) { return s.s().profile.revision; })
+      .def_property_readonly("identification",
+                             [](const S& s) { return identification_view(s.s()); })
+      .def_property_readonly("plausibility_warnings",
+                             [](const S& s) {
+                               std::vector<std::string> out;
+                               for (const auto& w : s.s().plausibility.warnings)
+                                 out.push_back(w.text());
+                               return out;
+                             })
+      .def_property_readonly("plausibility_stop",
+                             [](const S& s) -> std::optional<std::string> {
+                               if (!s.s().plausibility.stop) return std::nullopt;
+                               return s.s().plausibility.stop->text();
+                             })
+      .def_property_readonly("vendor_frames",
+                             [](const S& s) { return std::string(to_string(s.s().vendor_frames)); })
+      .def_property_readonly("remote", [](const S& s) { return remote_view(s.s()); })
+      .def_property_readonly("lights", [](const S& s) { return lights_view(s.s()); })
+      .def_property_readonly("firmware_version", [](const S& s) { return s.s().firmware.text; })
+      .def_property_readonly(
+          "firmware_state", [](const S& s) { return std::string(to_string(s.s().firmware.state)); })
+      .def_property_readonly("frames", [](const S& s) { return frames_view(s.s()); })
+      .def_property_readonly("requests",
+                             [](const S& s) {
+                               std::vector<OutcomeView> out;
+                               for (const auto& r : s.s().requests)
+                                 out.push_back(outcome_view(r));
+                               return out;
+                             })
+      .def_property_readonly("loop_iterations", [](const S& s) { return s.s().loop_iterations; })
+      .def("__repr__", [](const S& s) {
+        return "Snapshot(#" + std::to_string(s.s().sequence) + ", link " +
+               std::string(to_string(s.c().link)) + ", refusal " +
+               std::string(to_string(s.c().refusal)) + ")";
+      });
+
+  // ---- the driver ----
+  py::class_<PySession>(m, "_Session")
+      .def(py::init([](const std::string& port, const py::dict& params, bool record_sent,
+                       const std::string& display_prefix) {
+             std::map<std::string, Value> values;
+             for (const auto& [k, v] : params) {
+               const std::string name = py::str(k);
+               values[name] = to_value(name, v);
+             }
+             Setup setup = value_or_throw(make_setup(port, values, display_prefix));
+             setup.record_sent = record_sent;
+             return std::make_unique<PySession>(value_or_throw(Session::open(setup)));
+           }),
+           py::arg("port"), py::arg("params"), py::arg("record_sent") = false,
+           py::arg("display_prefix") = "")
+      .def("start", [](PySession& p) { p.s().start(); })
+      .def(
+          "stop", [](PySession& p) { p.s().stop(); }, py::call_guard<py::gil_scoped_release>())
+      .def_property_readonly("started", [](PySession& p) { return p.s().started(); })
+      .def_property_readonly("stopped", [](PySession& p) { return p.s().stopped(); })
+      .def_property_readonly("stop_sent", [](PySession& p) { return p.s().stop_sent(); })
+      .def_property_readonly("port", [](const PySession& p) { return p.setup().port; })
+      .def_property_readonly("model", [](const PySession& p) { return p.setup().model; })
+      .def_property_readonly("model_display_name",
+                             [](const PySession& p) { return p.setup().model_display_name; })
+      .def_property_readonly("protocol", [](const PySession& p) { return p.setup().protocol; })
+      .def_property_readonly("protocol_source",
+                             [](const PySession& p) { return p.setup().protocol_source; })
+      .def_property_readonly("is_sim", [](PySession& p) { return p.s().sim() != nullptr; })
+      .def_property_readonly("geometry",
+                             [](const PySession& p) {
+                               const auto& g = p.setup().driver.controller.geometry;
+                               return py::make_tuple(g.wheelbase, g.track, g.wheel_radius);
+                             })
+      .def_property_readonly(
+          "max_linear_speed",
+          [](const PySession& p) { return p.setup().driver.controller.limits.max_linear_speed; })
+      .def("budget", &PySession::budget, py::arg("kind"))
+      .def("snapshot", [](PySession& p) { return Snapshot(p.s().snapshot()); })
+      .def(
+          "wait_snapshot",
+          [](PySession& p, std::uint64_t sequence, double timeout) {
+            std::shared_ptr<const DriverSnapshot> s;
+            {
+              py::gil_scoped_release release;
+              s = p.s().wait_snapshot(sequence, to_ns(timeout));
+            }
+            return Snapshot(std::move(s));
+          },
+          py::arg("sequence"), py::arg("timeout"))
+      .def(
+          "command",
+          [](PySession& p, double vx, double vy, double wz, std::optional<std::string> mode) {
+            MotionRequest r{BodyTwist{vx, vy, wz}, std::nullopt};
+            if (mode) r.mode = parse_mode(*mode);
+            check(p.s().driver().command(r));
+          },
+          py::arg("vx"), py::arg("vy"), py::arg("wz"), py::arg("mode") = py::none())
+      .def(
+          "set_motion_mode",
+          [](PySession& p, std::optional<std::string> mode) {
+            std::optional<protocol::MotionMode> m;
+            if (mode) {
+              m = parse_mode(*mode);
+              const auto s = p.s().snapshot();
+              if (!protocol::motion_mode_to_wire(*m, s->profile.mode_numbering)) {
+                invalid(*mode + ": unsupported by protocol " + s->profile.revision +
+                        " (its motion-mode numbering has no " + *mode +
+                        " mode; side slip is the MINI V1's)");
+              }
+            }
+            p.s().driver().set_motion_mode(m);
+          },
+          py::arg("mode"))
+      .def("clear_errors",
+           [](PySession& p, int code) {
+             if (code < 0 || code > 255)
+               invalid("clear_errors: code " + std::to_string(code) + " outside 0..255");
+             return value_or_throw(p.s().driver().clear_errors(static_cast<std::uint8_t>(code)));
+           })
+      .def("set_ultrasonic",
+           [](PySession& p, bool on) { return p.s().driver().set_ultrasonic(on); })
+      .def("resume", [](PySession& p) { return p.s().driver().resume(); })
+      .def(
+          "set_lights",
+          [](PySession& p, const std::string& front, int front_brightness, const std::string& rear,
+             int rear_brightness) {
+            if (front_brightness < 0 || front_brightness > 255 || rear_brightness < 0 ||
+                rear_brightness > 255) {
+              invalid("lights: a brightness is 0..100");
+            }
+            LightsRequest r{parse_light(front), static_cast<std::uint8_t>(front_brightness),
+                            parse_light(rear), static_cast<std::uint8_t>(rear_brightness)};
+            return value_or_throw(p.s().driver().set_lights(r));
+          },
+          py::arg("front"), py::arg("front_brightness"), py::arg("rear"),
+          py::arg("rear_brightness"))
+      .def("set_park", [](PySession& p, bool on) { return p.s().driver().set_park(on); })
+      .def("request_firmware_version",
+           [](PySession& p) { return p.s().driver().request_firmware_version(); })
+      .def(
+          "wait_for",
+          [](PySession& p, std::uint64_t id, double timeout) {
+            RequestOutcome o;
+            {
+              py::gil_scoped_release release;
+              o = p.s().driver().wait_for(id, to_ns(timeout));
+            }
+            return outcome_view(o);
+          },
+          py::arg("id"), py::arg("timeout"))
+      .def("inject",
+           [](PySession& p, const std::string& line) { return value_or_throw(p.s().inject(line)); })
+      .def("ground_truth",
+           [](PySession& p) -> std::optional<GroundTruthView> {
+             if (!p.s().sim()) return std::nullopt;
+             return ground_truth_view(p.s().sim()->snapshot());
+           })
+      .def(
+          "events_since",
+          [](PySession& p, std::uint64_t after) {
+            std::vector<DriverEvent> events;
+            const std::uint64_t missed = p.s().driver().events_since(after, events);
+            std::vector<EventView> out;
+            for (const auto& e : events)
+              out.push_back(event_view(e));
+            return py::make_tuple(out, missed);
+          },
+          py::arg("after"))
+      .def("take_sent", [](PySession& p) { return p.s().take_sent(); })
+      .def(
+          "wait_sent",
+          [](PySession& p, double timeout) {
+            py::gil_scoped_release release;
+            return p.s().wait_sent(to_ns(timeout));
+          },
+          py::arg("timeout"));
+
+  // ---- tables and names ----
+  m.def("parameters", &parameter_rows, py::return_value_policy::copy);
+  m.def("model_names", &model_names);
+  m.def("variant_names", &sim::variant_names);
+  m.def("protocol_names", [] {
+    std::vector<std::string> out = {"auto"};
+    for (const auto& n : protocol_revision_names())
+      out.push_back(n);
+    return out;
+  });
+  m.def("motion_modes", [] { return protocol::kMotionModeNames.names(); });
+  m.def("light_modes", [] { return protocol::kLightModeNames.names(); });
+  m.def("refusal_names", [] { return kMotionRefusalNames.names(); });
+  m.def("event_kinds", [] { return kEventKindNames.names(); });
+  m.def("fault_names", [] {
+    std::vector<std::string> out;
+    for (const auto& f : protocol::kFaultTable)
+      out.emplace_back(protocol::to_string(f.fault));
+    return out;
+  });
+  m.def("driver_status_bit_names", [] {
+    std::vector<std::string> out;
+    for (const auto& b : protocol::driver_status_bits())
+      out.emplace_back(b.name);
+    return out;
+  });
+  m.def("bms_status_bit_names", [] {
+    std::vector<std::string> out;
+    for (const auto& b : protocol::bms_status1_bits())
+      out.emplace_back(b.name);
+    for (const auto& b : protocol::bms_status2_bits())
+      out.emplace_back(b.name);
+    return out;
+  });
+  m.def("chassis_command_names", &sim::chassis_command_names);
+  m.def("steering_joint_names", [] {
+    return std::vector<std::string>(kSteeringJointNames.begin(), kSteeringJointNames.end());
+  });
+  m.def("wheel_joint_names",
+        [] { return std::vector<std::string>(kWheelJointNames.begin(), kWheelJointNames.end()); });
+  m.def("error_clear_description", &protocol::error_clear_description);
+  m.def(
+      "error_names",
+      [](std::uint32_t word, const std::string& layout) {
+        ProtocolProfile p;
+        check(set_setting(p, "error_word", layout));
+        return protocol::error_bit_names(word, p.error_word);
+      },
+      py::arg("error_word"), py::arg("layout"));
+  m.def(
+      "_cli",
+      [](const std::vector<std::string>& args, const std::string& input) {
+        py::gil_scoped_release release;
+        return run_cli(args, input);
+      },
+      py::arg("args"), py::arg("input") = "");
+  m.attr("__version__") = cli::version();
+}

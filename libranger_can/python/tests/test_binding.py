@@ -1,0 +1,350 @@
+"""ranger_can for Python against the in-process virtual chassis: the README's example as written,
+driving in every mode with the odometry against the chassis's ground truth, the command timeout,
+the e-stop latch and resume, the remote control's takeover, the vendor's features, errors as
+exceptions carrying the library's messages, the GIL released while waiting, the stop at exit.
+
+Waiting is on the driver's state (wait_until), never on a wall-clock duration; durations only
+pace the commands, as a program would.
+"""
+
+import math
+import os
+import re
+import subprocess
+import sys
+import threading
+import time
+
+import pytest
+
+import ranger_can
+from ranger_can import RangerError, RequestFailed
+
+REPO = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
+SAMPLE_LOG = os.path.join(REPO, "libranger_can", "data", "sample.log")
+
+
+def readme_python_example():
+    """The README's Python example: the ```python block that drives ranger_can.Driver."""
+    with open(os.path.join(REPO, "README.md"), encoding="utf-8") as f:
+        text = f.read()
+    blocks = re.findall(r"```python\n(.*?)```", text, re.S)
+    examples = [b for b in blocks if "ranger_can.Driver(" in b]
+    assert examples, "README.md has no ```python block using ranger_can.Driver"
+    return examples[0]
+
+
+def drive(d, vx=0.0, vy=0.0, wz=0.0, distance=None, angle=None, timeout=30.0):
+    """Commands the twist every 50 ms until the ground truth has travelled `distance` m (or
+    turned `angle` rad), then stops and waits for the chassis to be at rest."""
+    start = d.ground_truth()
+    deadline = time.monotonic() + timeout
+    while True:
+        g = d.ground_truth()
+        if distance is not None and g.distance_travelled - start.distance_travelled >= distance:
+            break
+        if angle is not None and g.yaw_travelled - start.yaw_travelled >= angle:
+            break
+        assert time.monotonic() < deadline, f"did not get there: {d.snapshot()!r}"
+        d.command(vx, vy, wz)
+        time.sleep(0.05)
+    for _ in range(10):
+        d.command(0.0, 0.0, 0.0)
+        time.sleep(0.05)
+    d.wait_until(lambda s: abs(d.ground_truth().vx) + abs(d.ground_truth().vy) < 1e-3
+                 and abs(d.ground_truth().wz) < 1e-3, timeout=10)
+    # The odometry integrates the frames that reported the stop.
+    d.wait_snapshot(timeout=0.5)
+
+
+def assert_odometry_follows(d):
+    """Odometry against ground truth: within 1 % of the distance travelled + 2 cm."""
+    s = d.snapshot()
+    g = d.ground_truth()
+    bound = 0.01 * g.distance_travelled + 0.02
+    error = math.hypot(s.odometry.x - g.x, s.odometry.y - g.y)
+    assert error <= bound, f"odometry ({s.odometry.x:.3f}, {s.odometry.y:.3f}) vs truth " \
+                           f"({g.x:.3f}, {g.y:.3f}): {error:.3f} m > {bound:.3f} m"
+    yaw_error = abs(math.remainder(s.odometry.yaw - g.yaw, 2 * math.pi))
+    assert yaw_error <= 0.01 * g.yaw_travelled + 0.02, (s.odometry.yaw, g.yaw)
+
+
+@pytest.fixture
+def sim():
+    with ranger_can.Driver("sim") as d:
+        d.wait_ready(timeout=30)
+        yield d
+
+
+def test_readme_example_runs_as_written():
+    result = subprocess.run([sys.executable, "-c", readme_python_example()], capture_output=True,
+                            text=True, timeout=120, check=False)
+    assert result.returncode == 0, result.stderr
+    x, y, yaw, mode, refusal = result.stdout.split()[:5]
+    assert float(x) > 0.5 and abs(float(y)) < 0.05 and abs(float(yaw)) < 0.05
+    assert mode == "ackermann"
+    assert refusal in ("none", "cmd_timeout")
+
+
+@pytest.mark.parametrize("port", ["sim", "sim:agx_v2"])
+def test_drives_every_mode_with_odometry_following_the_ground_truth(port):
+    with ranger_can.Driver(port) as d:
+        s = d.wait_ready(timeout=30)
+        assert s.identification.phase == "decided"
+        assert s.profile_revision == ("agx_v2" if port == "sim:agx_v2" else "manual")
+        drive(d, vx=0.6, wz=0.2, distance=1.0)  # dual Ackermann, an arc to the left
+        assert d.snapshot().motion_mode == "ackermann"
+        assert_odometry_follows(d)
+        drive(d, vx=0.3, vy=0.3, distance=1.0)  # oblique
+        assert d.snapshot().motion_mode == "oblique"
+        assert_odometry_follows(d)
+        drive(d, wz=0.5, angle=1.5)  # spin
+        assert d.snapshot().motion_mode == "spin"
+        assert_odometry_follows(d)
+        g = d.ground_truth()
+        assert g.distance_travelled > 1.9 and g.yaw_travelled > 1.5
+
+
+def test_no_fresh_command_stops_the_chassis(sim):
+    sim.command(vx=0.4)
+    sim.wait_until(lambda s: sim.ground_truth().vx > 0.3, timeout=10)
+    # No more commands: the driver's 500 ms timeout stops it by itself.
+    s = sim.wait_until(lambda s: s.refusal == "cmd_timeout", timeout=10)
+    assert s.cmd_timed_out
+    sim.wait_until(lambda s: abs(sim.ground_truth().vx) < 1e-3, timeout=10)
+    # The commander's own stop: the next command drives again, no re-arm.
+    sim.command(vx=0.2)
+    sim.wait_until(lambda s: s.refusal == "none" and sim.ground_truth().vx > 0.1, timeout=10)
+
+
+def test_estop_latches_until_resume(sim):
+    sim.events()  # what happened before
+    assert sim.inject("estop on") is not None
+    s = sim.wait_until(lambda s: s.refusal == "estop", timeout=10)
+    assert "emergency_stop" in s.active_causes
+    assert "emergency stop" in s.refusal_detail  # the library's words, with what to do
+    sim.wait_snapshot()  # the events of the iteration that refused are in the ring by then
+    events = sim.events()
+    refusals = [e for e in events if e.kind == "refusal_changed"]
+    assert refusals and refusals[-1].severity == "warn", events
+    assert all(e.kind in ranger_can.event_kinds() for e in events)
+    with pytest.raises(RequestFailed, match="emergency_stop"):
+        sim.resume()
+    sim.inject("estop off")
+    # Released, but motion stays refused however long commands keep coming.
+    deadline = time.monotonic() + 1.0
+    while time.monotonic() < deadline:
+        sim.command(vx=0.3)
+        time.sleep(0.05)
+    s = sim.snapshot()
+    assert s.refusal == "rearm_required" and s.rearm_required
+    assert "emergency_stop" in s.latched_causes
+    assert abs(sim.ground_truth().vx) < 1e-3
+    assert sim.resume().state == "answered"
+    sim.command(vx=0.3)
+    sim.wait_until(lambda s: s.refusal == "none" and sim.ground_truth().vx > 0.1, timeout=10)
+
+
+def test_remote_control_takes_over_and_stays_won_until_resume(sim):
+    sim.inject("remote on")
+    s = sim.wait_until(lambda s: s.refusal == "remote", timeout=10)
+    assert s.control_mode == "remote"
+    sim.inject("remote can")  # the operator hands back with SWB
+    deadline = time.monotonic() + 1.0
+    while time.monotonic() < deadline:
+        sim.command(vx=0.3)
+        time.sleep(0.05)
+    assert sim.snapshot().refusal == "rearm_required"
+    sim.resume()
+    sim.command(vx=0.3)
+    sim.wait_until(lambda s: s.refusal == "none" and sim.ground_truth().vx > 0.1, timeout=10)
+
+
+def test_motion_refused_while_identifying():
+    with ranger_can.Driver("sim") as d:
+        s = d.wait_until(lambda s: s.link == "connected" or s.refusal == "identifying", timeout=10)
+        if s.identification.phase != "decided":
+            d.command(vx=0.5)
+            s = d.wait_snapshot()
+            assert s.refusal == "identifying"
+            assert abs(d.ground_truth().vx) < 1e-6
+        d.wait_ready(timeout=30)
+
+
+def test_park_and_lights_on_agx_v2():
+    with ranger_can.Driver("sim:agx_v2") as d:
+        d.wait_ready(timeout=30)
+        outcome = d.set_lights(front="custom", front_brightness=40, rear="breathing")
+        assert outcome.state == "answered"
+        lights = d.wait_until(lambda s: s.lights is not None, timeout=5).lights
+        assert (lights.front, lights.front_brightness, lights.rear) == ("custom", 40, "breathing")
+        d.park(True)
+        s = d.snapshot()
+        assert s.parked and s.refusal == "parked"
+        d.command(vx=0.3)
+        assert d.wait_snapshot().refusal == "parked"
+        d.park(False)
+        d.command(vx=0.3)
+        d.wait_until(lambda s: d.ground_truth().vx > 0.1, timeout=10)
+        assert d.firmware_version() == "ranger_sim 0.1.0"
+
+
+def test_vendor_features_refused_by_name_on_the_manuals_chassis(sim):
+    with pytest.raises(RequestFailed, match="unsupported by protocol"):
+        sim.set_lights(front="on", rear="on")
+    with pytest.raises(RequestFailed, match="park: unsupported"):
+        sim.park(True)
+    with pytest.raises(RangerError, match="side_slip: unsupported by protocol manual"):
+        sim.set_motion_mode("side_slip")
+
+
+def test_errors_are_exceptions_with_the_librarys_message():
+    with pytest.raises(RangerError) as e:
+        ranger_can.Driver("sim", cmd_vel_timeout=100.0, params={"wheelbase": -1,
+                                                                 "linear/x/max_velocity": 11})
+    message = str(e.value)
+    assert "parameter cmd_vel_timeout = 100 is out of range: valid [0.02, 60] s" in message
+    assert "parameter wheelbase = -1 is out of range: valid (0, 10] m" in message
+    assert "parameter linear/x/max_velocity = 11 is out of range: valid [0, 10] m/s" in message
+    assert e.value.code == "invalid_argument"
+    with pytest.raises(RangerError, match=r"parameter cmd_vel_timeot unknown"):
+        ranger_can.Driver("sim", cmd_vel_timeot=1.0)
+    with pytest.raises(RangerError, match=r"model = \"ranger_maxi\": expected one of ranger, "):
+        ranger_can.Driver("sim", model="ranger_maxi")
+    with pytest.raises(RangerError, match="spin_cw"):  # the valid variants named
+        ranger_can.Driver("sim:nonexistent")
+    with pytest.raises(RangerError, match="mode_numbering = \"agx\": expected one of manual"):
+        ranger_can.Driver("sim", mode_numbering="agx")
+    with ranger_can.Driver("sim") as d:
+        d.wait_until(lambda s: s.bus_open, timeout=10)
+        with pytest.raises(RangerError) as e:
+            d.command(vx=float("nan"))
+        assert e.value.code == "not_finite"
+        with pytest.raises(RangerError, match="valid commands: "):
+            d.inject("estop sideways")
+        with pytest.raises(RangerError, match="motion mode \"crab\" unknown"):
+            d.set_motion_mode("crab")
+        with pytest.raises(RangerError, match="light mode"):
+            d.set_lights(front="disco")
+        with pytest.raises(RangerError, match="code 17 is not an error-clearing code"):
+            d.clear_errors(17)
+    with pytest.raises(RangerError, match="closed"):
+        d.command(vx=0.1)
+
+
+def test_replay_is_read_only_and_not_a_virtual_chassis():
+    with ranger_can.Driver("replay:" + SAMPLE_LOG, protocol="manual") as d:
+        s = d.wait_until(lambda s: s.bus_open, timeout=10)
+        assert s.read_only
+        with pytest.raises(RangerError, match="no virtual chassis"):
+            d.inject("estop on")
+        assert d.ground_truth() is None
+
+
+def test_candump_decoding_and_odometry_replay():
+    frames = ranger_can.decode(SAMPLE_LOG)
+    assert frames[0]["name"] == "system_status" and frames[0]["id"] == 0x211
+    assert "errors" in frames[0]
+    with open(SAMPLE_LOG, encoding="utf-8") as f:
+        assert ranger_can.decode(f.read()) == frames  # the log's text as well as its path
+    replay = ranger_can.replay_odometry(SAMPLE_LOG)
+    assert replay.steps and set(replay.final) >= {"x", "y", "yaw"}
+    assert replay.final["x"] == pytest.approx(replay.steps[-1]["x"])
+    with pytest.raises(RangerError, match="protocol"):
+        ranger_can.decode(SAMPLE_LOG, protocol="v3")
+    with pytest.raises(RangerError):
+        ranger_can.decode("garbage\nmore garbage\n")
+
+
+def test_the_gil_is_released_while_waiting():
+    counted = [0]
+    stop = threading.Event()
+
+    def count():
+        while not stop.is_set():
+            counted[0] += 1
+
+    with ranger_can.Driver("sim") as d:
+        t = threading.Thread(target=count)
+        t.start()
+        before = counted[0]
+        d.wait_sent(timeout=0.3)  # nothing recorded: waits the whole time in C++
+        during = counted[0] - before
+        stop.set()
+        t.join()
+    assert during > 1000, f"the other thread ran {during} times while the driver waited"
+
+
+def test_close_stops_the_chassis_and_is_idempotent():
+    d = ranger_can.Driver("sim", record_sent=True)
+    d.wait_ready(timeout=30)
+    d.command(vx=0.5)
+    d.wait_until(lambda s: d.ground_truth().vx > 0.2, timeout=10)
+    d.close()
+    d.close()
+    assert d.stop_sent
+    stops = [e for e in d.events() if e.kind == "shutdown_stop"]
+    assert stops and "stop sent to the chassis" in stops[-1].text
+    sent = d.sent()
+    assert sent and sent[-1].shutdown and sent[-1].vx == 0.0
+    assert d.closed
+
+
+def test_an_exception_in_the_with_block_stops_the_chassis():
+    with pytest.raises(ZeroDivisionError):
+        with ranger_can.Driver("sim") as d:
+            d.wait_ready(timeout=30)
+            d.command(vx=0.5)
+            1 / 0  # noqa: B018
+    assert d.closed and d.stop_sent
+
+
+def test_interpreter_exit_stops_the_chassis():
+    # atexit hooks run last-registered first: this one, registered before the import, runs after
+    # ranger_can's own and sees what it did.
+    script = """
+import atexit
+drivers = []
+atexit.register(lambda: print("stop_sent", drivers[0].stop_sent, flush=True))
+import ranger_can
+d = ranger_can.Driver("sim")
+drivers.append(d)
+d.wait_ready(timeout=30)
+d.command(vx=0.5)
+"""
+    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                            timeout=120, check=False)
+    assert result.returncode == 0, result.stderr
+    assert "stop_sent True" in result.stdout
+
+
+def test_parameters_table_names_every_row_with_its_range():
+    rows = {r.name: r for r in ranger_can.parameters()}
+    assert rows["cmd_vel_timeout"].unit == "s" and rows["cmd_vel_timeout"].hi == 60
+    assert rows["model"].choices == ranger_can.model_names()
+    assert "agx_v2" in rows["protocol"].choices
+    assert rows["linear/x/max_acceleration"].lo_open
+    assert rows["sim/errors"].type == "string_list"
+    assert set(ranger_can.motion_modes()) >= {"ackermann", "oblique", "spin", "side_slip", "park"}
+    assert "estop" in ranger_can.chassis_command_names()
+
+
+def test_type_stubs_name_everything_the_module_offers():
+    import ranger_can._ranger_can as ext
+    package = os.path.dirname(ranger_can.__file__)
+    with open(os.path.join(package, "_ranger_can.pyi"), encoding="utf-8") as f:
+        stub = f.read()
+    with open(os.path.join(package, "__init__.pyi"), encoding="utf-8") as f:
+        init_stub = f.read()
+    for name, value in vars(ext).items():
+        if name.startswith("__") or name == "_Session":
+            continue
+        assert re.search(rf"\b(class|def) {name}\b", stub), f"{name} not in _ranger_can.pyi"
+        if isinstance(value, type):
+            body = stub.split(f"class {name}")[1].split("\nclass ")[0]
+            for attr in dir(value):
+                if not attr.startswith("_"):
+                    assert re.search(rf"\b{attr}\b", body), f"{name}.{attr} not in the stub"
+    for attr in dir(ranger_can.Driver):
+        if not attr.startswith("_"):
+            assert re.search(rf"\b{attr}\b", init_stub), f"Driver.{attr} not in __init__.pyi"

@@ -1,0 +1,262 @@
+"""ranger_can values -> ROS 2 messages, field for field as the ROS 1 node fills them
+(ranger_base/src/conversions.cpp). Names, units and signs all come from the library; this module
+only places them. Stamps: a frame's time (bus clock = wall time) as it is.
+"""
+
+import math
+
+from builtin_interfaces.msg import Time
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from geometry_msgs.msg import Quaternion, TransformStamped, TwistStamped
+from nav_msgs.msg import Odometry
+from ranger_msgs.msg import (ActuatorState, ActuatorStateArray, BmsFlags, BmsState, BmsStateArray,
+                             DriverStatus, RemoteState, SystemErrors, SystemState,
+                             UltrasonicReading, UltrasonicState)
+from sensor_msgs.msg import BatteryState, JointState, Range
+
+NAN = float("nan")
+
+
+def to_time(stamp_ns: int) -> Time:
+    return Time(sec=int(stamp_ns // 1_000_000_000), nanosec=int(stamp_ns % 1_000_000_000))
+
+
+def yaw_quaternion(yaw: float) -> Quaternion:
+    return Quaternion(z=math.sin(yaw / 2.0), w=math.cos(yaw / 2.0))
+
+
+def _diagonal(values):
+    out = [0.0] * 36
+    for i, v in enumerate(values):
+        out[i * 7] = float(v)
+    return out
+
+
+def _odometry(stamp_ns, params, pose, twist) -> Odometry:
+    msg = Odometry()
+    msg.header.stamp = to_time(stamp_ns)
+    msg.header.frame_id = params["odom_frame"]
+    msg.child_frame_id = params["base_frame"]
+    msg.pose.pose.position.x, msg.pose.pose.position.y = pose[0], pose[1]
+    msg.pose.pose.orientation = yaw_quaternion(pose[2])
+    msg.twist.twist.linear.x, msg.twist.twist.linear.y = twist[0], twist[1]
+    msg.twist.twist.angular.z = twist[2]
+    return msg
+
+
+def to_odometry(o, params) -> Odometry:
+    """Pose covariance = diag(pose_covariance_diagonal) + the odometry's x/y/yaw variance;
+    twist covariance = diag(twist_covariance_diagonal)."""
+    msg = _odometry(o.stamp_ns, params, (o.x, o.y, o.yaw), (o.vx, o.vy, o.wz))
+    pose = _diagonal(params["pose_covariance_diagonal"])
+    pose[0] += o.pose_variance[0]
+    pose[7] += o.pose_variance[1]
+    pose[35] += o.pose_variance[2]
+    msg.pose.covariance = pose
+    msg.twist.covariance = _diagonal(params["twist_covariance_diagonal"])
+    return msg
+
+
+def to_transform(odom: Odometry) -> TransformStamped:
+    t = TransformStamped()
+    t.header = odom.header
+    t.child_frame_id = odom.child_frame_id
+    t.transform.translation.x = odom.pose.pose.position.x
+    t.transform.translation.y = odom.pose.pose.position.y
+    t.transform.rotation = odom.pose.pose.orientation
+    return t
+
+
+def to_joint_state(j) -> JointState:
+    msg = JointState()
+    msg.header.stamp = to_time(j.stamp_ns)
+    msg.name = list(j.steering_names) + list(j.wheel_names)
+    msg.position = list(j.steering_position) + list(j.wheel_position)
+    msg.velocity = list(j.steering_velocity) + list(j.wheel_velocity)
+    return msg
+
+
+def to_ground_truth(g, params) -> Odometry:
+    """The virtual chassis's true pose and twist (zero covariance: exact)."""
+    return _odometry(g.stamp_ns, params, (g.x, g.y, g.yaw), (g.vx, g.vy, g.wz))
+
+
+def to_twist_stamped(sent, frame_id) -> TwistStamped:
+    msg = TwistStamped()
+    msg.header.stamp = to_time(int(sent.wall * 1e9))
+    msg.header.frame_id = frame_id
+    msg.twist.linear.x = sent.vx
+    msg.twist.linear.y = sent.vy
+    msg.twist.angular.z = sent.wz
+    return msg
+
+
+def _set_named(msg, names):
+    for n in names:
+        if hasattr(msg, n):
+            setattr(msg, n, True)
+    return msg
+
+
+def to_system_state(s, stamp, detail: str) -> SystemState:
+    msg = SystemState()
+    msg.header.stamp = stamp
+    msg.link_up = s.link == "connected"
+    msg.motion_known = s.motion_known
+    if s.vehicle_status_raw is not None:
+        msg.vehicle_status = s.vehicle_status_raw
+        msg.vehicle_status_name = s.vehicle_status or "unknown"
+        msg.control_mode = s.control_mode_raw
+        msg.control_mode_name = s.control_mode or "unknown"
+        msg.battery_voltage = float(s.battery_voltage or 0.0)
+    else:
+        msg.vehicle_status_name = msg.control_mode_name = "unknown"
+    if s.chassis_mode_raw is not None:
+        msg.motion_mode = s.chassis_mode_raw
+        msg.motion_mode_name = s.chassis_mode or "unknown"
+        msg.motion_mode_switching = s.switching
+    else:
+        msg.motion_mode_name = "unknown"
+    msg.error_word = s.error_word
+    msg.active_errors = list(s.error_names)
+    msg.errors = _set_named(SystemErrors(), msg.active_errors)
+    msg.motion_inhibited_reason = "" if s.refusal == "none" else s.refusal
+    msg.motion_inhibited_detail = detail
+    msg.protocol = s.protocol
+    msg.protocol_profile = s.profile
+    ident = s.identification
+    msg.identification = ident.phase if ident is not None else ""
+    msg.rearm_required = s.rearm_required
+    msg.latched_causes = list(s.latched_causes)
+    msg.active_causes = list(s.active_causes)
+    msg.reclaim_blocked = s.reclaim_blocked
+    msg.steer_first_factor = float(s.steer_first_factor)
+    msg.park_requested = s.park_requested
+    msg.parked = s.parked
+    msg.firmware_version = s.firmware_version
+    msg.firmware_version_state = s.firmware_state
+    return msg
+
+
+def to_remote_state(r) -> RemoteState:
+    msg = RemoteState()
+    msg.header.stamp = to_time(r.stamp_ns)
+    msg.swa, msg.swb, msg.swc, msg.swd = r.swa, r.swb, r.swc, r.swd
+    msg.left_vertical = float(r.left_vertical)
+    msg.left_horizontal = float(r.left_horizontal)
+    msg.right_vertical = float(r.right_vertical)
+    msg.right_horizontal = float(r.right_horizontal)
+    msg.knob = float(r.knob)
+    return msg
+
+
+def to_actuator_state(motors, stamp) -> ActuatorStateArray:
+    msg = ActuatorStateArray()
+    msg.header.stamp = stamp
+    for m in motors:
+        a = ActuatorState(motor=m.motor, joint_name=m.joint, rpm=m.rpm, current=m.current,
+                          position=m.position, driver_voltage=m.driver_voltage,
+                          driver_temperature=m.driver_temperature,
+                          motor_temperature=m.motor_temperature, driver_status=m.driver_status)
+        a.driver_status_bits = _set_named(DriverStatus(), m.driver_status_names)
+        a.high_speed_stamp = to_time(m.high_speed_stamp_ns)
+        a.low_speed_stamp = to_time(m.low_speed_stamp_ns)
+        msg.actuators.append(a)
+    return msg
+
+
+def to_bms_state(batteries, stamp) -> BmsStateArray:
+    msg = BmsStateArray()
+    msg.header.stamp = stamp
+    for b in batteries:
+        s = BmsState(battery=b.battery, present=b.present, soc=float(b.soc), soh=float(b.soh),
+                     voltage=float(b.voltage), current=float(b.current),
+                     temperature=float(b.temperature), alarm_status1=b.alarm1,
+                     alarm_status2=b.alarm2, warning_status1=b.warning1,
+                     warning_status2=b.warning2)
+        s.header.stamp = to_time(b.stamp_ns)
+        s.alarms = _set_named(BmsFlags(), b.alarms)
+        s.warnings = _set_named(BmsFlags(), b.warnings)
+        msg.batteries.append(s)
+    return msg
+
+
+def to_battery_state(s, stamp) -> BatteryState:
+    msg = BatteryState()
+    msg.header.stamp = stamp
+    msg.voltage = msg.current = msg.temperature = msg.charge = msg.capacity = NAN
+    msg.percentage = msg.design_capacity = NAN
+    msg.power_supply_status = BatteryState.POWER_SUPPLY_STATUS_UNKNOWN
+    msg.power_supply_health = BatteryState.POWER_SUPPLY_HEALTH_UNKNOWN
+    msg.power_supply_technology = BatteryState.POWER_SUPPLY_TECHNOLOGY_LIFE
+    msg.location = "pack"
+    batteries = s.batteries
+    pack = batteries[0]
+    if pack.present:
+        msg.header.stamp = to_time(pack.stamp_ns)
+        msg.present = True
+        msg.voltage, msg.current = float(pack.voltage), float(pack.current)
+        msg.temperature = float(pack.temperature)
+        msg.percentage = float(min(max(pack.soc / 100.0, 0.0), 1.0))
+        msg.power_supply_status = (
+            BatteryState.POWER_SUPPLY_STATUS_CHARGING if pack.current > 0 else
+            BatteryState.POWER_SUPPLY_STATUS_DISCHARGING if pack.current < 0 else
+            BatteryState.POWER_SUPPLY_STATUS_NOT_CHARGING)
+        msg.power_supply_health = BatteryState.POWER_SUPPLY_HEALTH_GOOD
+        alarms = set(pack.alarms)
+        for name, health in (("over_voltage", BatteryState.POWER_SUPPLY_HEALTH_OVERVOLTAGE),
+                             ("high_temperature", BatteryState.POWER_SUPPLY_HEALTH_OVERHEAT),
+                             ("low_temperature", BatteryState.POWER_SUPPLY_HEALTH_COLD)):
+            if name in alarms:
+                msg.power_supply_health = health
+                break
+        else:
+            if alarms & {"under_voltage", "discharge_over_current", "charge_over_current"}:
+                msg.power_supply_health = BatteryState.POWER_SUPPLY_HEALTH_UNSPEC_FAILURE
+    elif s.battery_voltage is not None:
+        msg.present = True
+        msg.voltage = float(s.battery_voltage)
+    msg.cell_voltage = [float(b.voltage) if b.present else NAN for b in batteries[1:]]
+    msg.cell_temperature = [float(b.temperature) if b.present else NAN for b in batteries[1:]]
+    return msg
+
+
+def ultrasonic_frame_id(prefix, sensor) -> str:
+    return f"{prefix}ultrasonic_{sensor}_link"
+
+
+def to_ultrasonic_state(s, stamp) -> UltrasonicState:
+    msg = UltrasonicState()
+    msg.header.stamp = stamp
+    msg.avoidance_known = s.ultrasonic_enabled is not None
+    msg.avoidance_enabled = bool(s.ultrasonic_enabled)
+    for u in s.ultrasonic:
+        msg.sensors.append(UltrasonicReading(sensor=u.sensor, raw=u.raw,
+                                             range=NAN if u.range is None else float(u.range),
+                                             status=u.status))
+    return msg
+
+
+def to_range(u, params) -> Range:
+    msg = Range()
+    msg.header.stamp = to_time(u.stamp_ns)
+    msg.header.frame_id = ultrasonic_frame_id(params["frame_prefix"], u.sensor)
+    msg.radiation_type = Range.ULTRASOUND
+    msg.field_of_view = float(params["ultrasonic/field_of_view"])
+    msg.min_range = float(params["ultrasonic/min_range"])
+    msg.max_range = float(params["ultrasonic/max_range"])
+    msg.range = NAN if u.range is None else float(u.range)
+    if math.isfinite(msg.range) and msg.range > msg.max_range:
+        msg.range = math.inf
+    return msg
+
+
+def to_diagnostics(groups, stamp, hardware_id) -> DiagnosticArray:
+    """Diagnostic groups (name, level, message, key/values) one to one onto diagnostic_msgs."""
+    msg = DiagnosticArray()
+    msg.header.stamp = stamp
+    for g in groups:
+        msg.status.append(DiagnosticStatus(
+            level=g.level, name=g.name, message=g.message, hardware_id=hardware_id,
+            values=[KeyValue(key=k, value=str(v)) for k, v in g.values]))
+    return msg

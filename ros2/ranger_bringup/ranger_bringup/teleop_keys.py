@@ -1,0 +1,1 @@
+../../../ranger_bringup/src/ranger_bringup/teleop_keys.py
