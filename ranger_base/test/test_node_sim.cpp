@@ -811,7 +811,7 @@ class MiniV3 : public NodeSim {
     EXPECT_LT(std::abs(std::remainder(turned_odom - turned_truth, 2 * M_PI)), M_PI / 180.0);
   }
   static std::string drive_mode_diagnostic() {
-    const auto d = diagnostic(ranger_base::kDiagControl);
+    const auto d = diagnostic(std::string(ranger::kDiagControl));
     return d ? value_of(*d, "Drive mode") : "<no diagnostics>";
   }
 };
@@ -916,7 +916,7 @@ TEST_F(MiniV3, TheBmsAlarmsReachSystemStateAndDiagnostics) {
   }));
   // The diagnostics come once a second.
   EXPECT_TRUE(wait_for([] {
-    const auto d = diagnostic(ranger_base::kDiagBattery);
+    const auto d = diagnostic(std::string(ranger::kDiagBattery));
     return d && value_of(*d, "BMS alarms").find("under_voltage") != std::string::npos;
   }));
   EXPECT_TRUE(wait_for([] { return state_.get()->errors.battery_under_voltage; }));
