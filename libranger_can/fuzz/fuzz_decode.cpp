@@ -1,11 +1,12 @@
 // Fuzzes the frame decoder with arbitrary identifiers, DLCs (0..15: a corrupt DLC nibble must
 // not be trusted), bytes, error flags and protocol profiles (every setting's value drawn from the
-// input, so both revisions and every mix of them are reached).
+// input, so every revision and every mix of them are reached).
 //
 // Properties (each a FUZZ_CHECK):
 //  * decode() never crashes and refuses what it cannot read with the documented error codes:
-//    kInvalidArgument for error frames, kUnknownId exactly for IDs outside both revisions,
-//    kBadDlc exactly for a DLC shorter than the ID's layout or above 8, kOutOfRange only for a
+//    kInvalidArgument for error frames, kUnknownId exactly for IDs outside every revision,
+//    kBadDlc exactly for a DLC shorter than the ID's layout (the profile's frame layout's) or
+//    above 8, kOutOfRange only for a
 //    0x221/0x271 steering angle beyond interpretation::kMaxPlausibleSteeringRad; every error has a
 //    message;
 //  * a longer frame decodes from its leading bytes: no byte past the layout is read,
@@ -15,9 +16,10 @@
 //    exactly what the protocol cannot carry back: reserved bytes are sent as zero, a boolean byte
 //    as 0x01, 0x111 fields saturate to their valid range, BMS SOC/SOH to 100 %; only command
 //    frames with values a host may not send (a 0x141 mode the numbering lacks, a 0x421 mode other
-//    than standby/CAN, a 0x441 code > 0x10, a 0x121 light mode > 3) fail to re-encode; with
-//    tx_dlc 8 the same bytes come back zero-padded to 8;
-//  * the protocol tables (names, bit names of both layouts, faults) answer for any value.
+//    than standby/CAN, a 0x441 code > 0x10, a 0x121 light mode > 3 or one light_modes on_off
+//    lacks, a 0x423 where the frame layout has none) fail to re-encode; with tx_dlc 8 the same
+//    bytes come back zero-padded to 8;
+//  * the protocol tables (names, bit names of every layout, faults) answer for any value.
 #include <algorithm>
 #include <cstdint>
 #include <string>
@@ -69,10 +71,10 @@ ProtocolProfile consume_profile(FuzzedDataProvider& in) {
   return p;
 }
 
-// `f` cut to its layout (the bytes a decoder reads): a 0x4A1 answer is all text.
-CanFrame cut_to_layout(CanFrame f) {
+// `f` cut to its layout under `p` (the bytes a decoder reads): a 0x4A1 answer is all text.
+CanFrame cut_to_layout(CanFrame f, const ProtocolProfile& p) {
   if (f.id == protocol::kVersionId && !protocol::is_version_request(f)) return f;
-  const int layout = protocol::layout_dlc(f.id);
+  const int layout = protocol::layout_dlc(f.id, p.frame_layout);
   f.dlc = static_cast<std::uint8_t>(layout);
   for (std::size_t i = static_cast<std::size_t>(layout); i < CanFrame::kMaxDlc; ++i)
     f.data[i] = 0;
@@ -100,6 +102,10 @@ CanFrame canonical(CanFrame f, const ProtocolProfile& p) {
     case protocol::kLightStateId:
       f.data[0] = f.data[0] != 0;
       f.data[5] = f.data[6] = 0;
+      if (p.light_modes == ranger::LightModes::kOnOff) {  // bytes 2-6 reserved (0x121: 2-7)
+        f.data[2] = f.data[3] = f.data[4] = 0;
+        if (f.id == protocol::kLightCommandId) f.data[7] = 0;
+      }
       break;
     case protocol::kRemoteControlStateId:
       f.data[6] = 0;
@@ -131,7 +137,11 @@ bool unsendable_command(const CanFrame& f, const ProtocolProfile& p) {
     case protocol::kErrorClearCommandId:
       return f.data[0] > protocol::kMaxErrorClearCode;
     case protocol::kLightCommandId:
+      if (p.light_modes == ranger::LightModes::kOnOff) return f.data[1] > 1;  // no breathing
       return f.data[1] > 3 || f.data[3] > 3;
+    case protocol::kDriveModeCommandId:
+      return !protocol::find_frame(f.id)->in(p.frame_layout) ||
+             !protocol::drive_mode_from_wire(f.data[0]).has_value();
     default:
       return false;
   }
@@ -140,8 +150,7 @@ bool unsendable_command(const CanFrame& f, const ProtocolProfile& p) {
 void check_tables(FuzzedDataProvider& in, std::uint32_t id) {
   FUZZ_CHECK(!protocol::frame_name(id).empty());
   const auto word = in.ConsumeIntegral<std::uint32_t>();
-  for (const auto layout :
-       {ranger::ErrorWordLayout::kManual32, ranger::ErrorWordLayout::kAgxV2_16}) {
+  for (const auto layout : ranger::kErrorWordLayoutNames.values()) {
     for (const auto& name : protocol::error_bit_names(word, layout))
       FUZZ_CHECK(!name.empty());
     (void)protocol::is_critical_error(word, layout);
@@ -176,7 +185,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                  ? kIds[in.ConsumeIntegralInRange<std::size_t>(0, kIds.size() - 1)]
                  : in.ConsumeIntegral<std::uint32_t>();
   // The layout's length or 8 (padded) three times in four; otherwise any nibble.
-  const int layout = protocol::layout_dlc(frame.id);
+  const int layout = protocol::layout_dlc(frame.id, profile.frame_layout);
   const int pick = in.ConsumeIntegralInRange<int>(0, 3);
   frame.dlc = layout >= 0 && pick != 0 ? static_cast<std::uint8_t>(pick == 1 ? 8 : layout)
                                        : in.ConsumeIntegralInRange<std::uint8_t>(0, 15);
@@ -209,7 +218,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                  frame.id == protocol::kSteeringAnglesId);
       FUZZ_CHECK(frame.dlc >= layout && frame.dlc <= 8);
       // The same content cut to its layout is just as impossible.
-      const auto cut = ranger::decode(cut_to_layout(frame), profile);
+      const auto cut = ranger::decode(cut_to_layout(frame, profile), profile);
       FUZZ_CHECK(!cut.ok() && cut.error().message == message.error().message);
     } else {
       FUZZ_CHECK(code == Errc::kBadDlc);
@@ -224,8 +233,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   FUZZ_CHECK(ranger::id_of(*message) == frame.id);
 
   // Extra bytes are ignored: the frame cut to its layout decodes to the same message.
-  const CanFrame cut = cut_to_layout(frame);
-  FUZZ_CHECK(protocol::extra_bytes(frame) == frame.dlc - cut.dlc);
+  const CanFrame cut = cut_to_layout(frame, profile);
+  FUZZ_CHECK(protocol::extra_bytes(frame, profile.frame_layout) == frame.dlc - cut.dlc);
   const auto cut_message = ranger::decode(cut, profile);
   FUZZ_CHECK(cut_message.ok());
   FUZZ_CHECK(cut_message->index() == message->index());

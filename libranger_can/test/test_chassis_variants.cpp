@@ -1,6 +1,7 @@
 // The virtual chassis under every protocol profile and variant (sim_bus_source.hpp): what each one
-// sends and how it obeys, over the test-support FakeBus with injected time (no sleeping). The
-// driver against each variant, end to end, is tests/variants/.
+// sends and how it obeys (mini_v3, the RANGER MINI 3.0, at the end), over the test-support
+// FakeBus with injected time (no sleeping). The driver against each variant, end to end, is
+// tests/variants/.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -23,6 +24,7 @@ namespace {
 
 using namespace std::chrono_literals;
 using protocol::ControlMode;
+using protocol::DriveMode;
 using protocol::MotionMode;
 
 constexpr double kDeg = M_PI / 180.0;
@@ -103,8 +105,8 @@ MotionCommand ackermann(double v, double rep103_steering) {
 
 TEST(ChassisVariants, TableNamesEveryVariantWithADescriptionAndTheDriverOptions) {
   const std::vector<std::string> expected = {
-      "manual",        "agx_v2",      "padded",  "spin_cw",    "steer_left_positive",
-      "speed221_body", "inner_angle", "mini_v1", "undecidable"};
+      "manual",        "agx_v2",      "padded",  "spin_cw", "steer_left_positive",
+      "speed221_body", "inner_angle", "mini_v1", "mini_v3", "undecidable"};
   EXPECT_EQ(variant_names(), expected);
   for (const VariantInfo& v : variants()) {
     SCOPED_TRACE(v.name);
@@ -120,7 +122,7 @@ TEST(ChassisVariants, UnknownVariantListsTheValidOnes) {
   EXPECT_EQ(c.error().code, Errc::kInvalidArgument);
   EXPECT_EQ(c.error().message,
             "unknown virtual chassis variant 'ranger_xl' (valid: manual, agx_v2, padded, spin_cw, "
-            "steer_left_positive, speed221_body, inner_angle, mini_v1, undecidable)");
+            "steer_left_positive, speed221_body, inner_angle, mini_v1, mini_v3, undecidable)");
 }
 
 TEST(ChassisVariants, EachSettingVariantChangesOneReadingOfTheManual) {
@@ -436,6 +438,170 @@ TEST(ChassisVariants, UndecidableHidesItsSteeringUnitAtRest) {
     EXPECT_EQ(std::get<MotionFeedback>(*mb).steering_angle, 0.0);
   }
   EXPECT_EQ(h.chassis.snapshot().motion_mode, MotionMode::kSpin);
+}
+
+// ---- mini_v3: the RANGER MINI 3.0 as its manual has it (PROTOCOL_MINI_V3.md) -----------------
+// The frames it sends and their lengths, the 32-bit fault word without counter, drive modes
+// (0x423, 0x291 byte 2), the front and rear odometers in mm, park, lights on/off, its limits.
+
+TEST(ChassisVariantMiniV3, IsTheModelsChassisSpeakingItsManual) {
+  const Host m(variant("mini_v3"));
+  const ModelPreset model = *model_preset("ranger_mini_v3");
+  EXPECT_EQ(m.config.profile, *protocol_preset("mini_v3"));
+  EXPECT_EQ(m.config.geometry.wheelbase, model.geometry.wheelbase);
+  EXPECT_EQ(m.config.limits.max_linear_speed, 2.0);
+  EXPECT_EQ(m.config.limits.max_speed_at_large_steering, 0.7);
+  EXPECT_TRUE(m.config.vendor_frames);
+  EXPECT_TRUE(m.config.odometer_frames);
+}
+
+TEST(ChassisVariantMiniV3, SendsItsManualsFramesWithTheirLengthsOnly) {
+  Host m(variant("mini_v3"));
+  m.advance(1s);
+  const auto own = protocol::ids_of(FrameLayout::kMiniV3);
+  std::set<std::uint32_t> seen;
+  for (const auto& f : m.bus.sent) {
+    seen.insert(f.id);
+    EXPECT_NE(std::find(own.begin(), own.end(), f.id), own.end())
+        << "not a MINI 3.0 frame: 0x" << std::hex << f.id;
+    EXPECT_EQ(f.dlc, protocol::layout_dlc(f.id, FrameLayout::kMiniV3)) << std::hex << f.id;
+  }
+  for (std::uint32_t id : {0x211u, 0x221u, 0x231u, 0x241u, 0x251u, 0x261u, 0x271u, 0x281u, 0x291u,
+                           0x311u, 0x312u, 0x361u, 0x362u})
+    EXPECT_EQ(seen.count(id), 1u) << std::hex << id;
+  EXPECT_EQ(m.frames(0x291).back().dlc, 3);
+  EXPECT_EQ(m.frames(0x362).back().dlc, 4);
+  // 0x211 byte 7 is the fault word's lowest byte, not a counter: constant at rest.
+  const auto status = m.frames(protocol::kSystemStatusId);
+  EXPECT_EQ(status.front().data[7], status.back().data[7]);
+  EXPECT_FALSE(m.last<SystemStatus>(protocol::kSystemStatusId).counter.has_value());
+}
+
+TEST(ChassisVariantMiniV3, FaultsByMeaningInItsFaultWord) {
+  Host m(variant("mini_v3"));
+  m.handshake();
+  EXPECT_TRUE(m.chassis.set_fault(protocol::Fault::kOverCurrent, true));
+  EXPECT_TRUE(m.chassis.set_fault(protocol::Fault::kBatteryOverVoltage, true));
+  EXPECT_FALSE(m.chassis.set_fault(protocol::Fault::kSafetyEdge, true)) << "not a MINI 3.0 fault";
+  m.chassis.set_emergency_stop(true);
+  m.advance(40ms);
+  const auto s = m.last<SystemStatus>(protocol::kSystemStatusId);
+  EXPECT_EQ(s.vehicle_status, protocol::VehicleStatus::kEmergencyStop);
+  EXPECT_EQ(protocol::error_bit_names(s.error_bits, ErrorWordLayout::kMini32),
+            (std::vector<std::string>{"battery_over_voltage", "emergency_stop", "over_current"}));
+  // 0x441 0x0F clears the over-current, 0x00 the rest once the e-stop is released.
+  m.chassis.set_emergency_stop(false);
+  m.send(ErrorClearCommand{0x0F});
+  m.send(ErrorClearCommand{0x00});
+  m.advance(40ms);
+  EXPECT_EQ(m.last<SystemStatus>(protocol::kSystemStatusId).error_bits, 0u);
+}
+
+TEST(ChassisVariantMiniV3, DriveModesSetBy0x423AndReportedIn0x291) {
+  Host m(variant("mini_v3"));
+  m.advance(40ms);
+  auto mode = m.last<MotionModeFeedback>(protocol::kMotionModeFeedbackId);
+  ASSERT_TRUE(mode.drive_mode.has_value());
+  EXPECT_EQ(*mode.drive_mode, static_cast<std::uint8_t>(DriveMode::kCurrent));
+  m.send(DriveModeCommand{DriveMode::kVoltage});  // in standby: ignored
+  m.advance(40ms);
+  EXPECT_EQ(m.chassis.snapshot().drive_mode, DriveMode::kCurrent);
+  m.handshake();
+  m.send(DriveModeCommand{DriveMode::kVoltage});
+  m.advance(40ms);
+  EXPECT_EQ(m.chassis.snapshot().drive_mode, DriveMode::kVoltage);
+  mode = m.last<MotionModeFeedback>(protocol::kMotionModeFeedbackId);
+  EXPECT_EQ(*mode.drive_mode, static_cast<std::uint8_t>(DriveMode::kVoltage));
+}
+
+TEST(ChassisVariantMiniV3, FrontAndRearOdometersFollowTheWheels) {
+  Host m(variant("mini_v3"));
+  m.handshake();
+  MotionCommand forward;
+  forward.linear_speed = 0.5;
+  m.drive(forward, 3s);
+  forward.linear_speed = 0.0;
+  m.drive(forward, 1s);
+  const auto s = m.chassis.snapshot();
+  const auto front = m.last<OdometerFeedback>(protocol::kOdometerId);
+  const auto rear = m.last<OdometerFeedback>(protocol::kRearOdometerId);
+  ASSERT_TRUE(front.left_distance && rear.right_distance);
+  EXPECT_FALSE(front.rear);
+  EXPECT_TRUE(rear.rear);
+  // Straight ahead: every wheel rolled the body's distance (to the wire's millimetre).
+  EXPECT_NEAR(*front.left_distance, s.distance_travelled, 0.002);
+  EXPECT_NEAR(*front.right_distance, s.distance_travelled, 0.002);
+  EXPECT_NEAR(*rear.left_distance, s.distance_travelled, 0.002);
+  EXPECT_NEAR(*rear.right_distance, s.distance_travelled, 0.002);
+  EXPECT_NEAR(s.wheel_distance[kLeftRear], s.distance_travelled, 1e-6);
+  // A spin turns the left wheels back and the right ones forward (counter-clockwise).
+  m.switch_mode(MotionMode::kSpin);
+  MotionCommand spin;
+  spin.yaw_rate = 0.5;
+  m.drive(spin, 2s);
+  const auto after = m.last<OdometerFeedback>(protocol::kRearOdometerId);
+  EXPECT_LT(*after.left_distance, *rear.left_distance - 0.1);
+  EXPECT_GT(*after.right_distance, *rear.right_distance + 0.1);
+}
+
+TEST(ChassisVariantMiniV3, ParksAsMode3AndHasNoSideSlip) {
+  Host m(variant("mini_v3"));
+  m.handshake();
+  m.switch_mode(MotionMode::kPark);
+  EXPECT_EQ(m.last<MotionModeFeedback>(protocol::kMotionModeFeedbackId).mode_raw, 3);
+  MotionCommand c;
+  c.linear_speed = 0.5;
+  m.drive(c, 500ms);
+  EXPECT_EQ(m.chassis.snapshot().twist.vx, 0.0) << "parked";
+  // Mode 4 is side slip elsewhere; here it is no mode: ignored.
+  CanFrame four;
+  four.id = protocol::kMotionModeCommandId;
+  four.dlc = 1;
+  four.data[0] = 4;
+  m.chassis.on_frame(four, m.t);
+  m.advance(1500ms);
+  EXPECT_EQ(m.chassis.snapshot().motion_mode, MotionMode::kPark);
+}
+
+TEST(ChassisVariantMiniV3, ItsLimitsBound0x111) {
+  Host m(variant("mini_v3"));
+  m.handshake();
+  MotionCommand fast;
+  fast.linear_speed = 2.5;  // beyond the MINI 3.0's 2.0 m/s
+  m.drive(fast, 4s);
+  EXPECT_NEAR(m.chassis.snapshot().twist.vx, 2.0, 1e-9);
+  // Beyond 20 deg of steering: 0.7 m/s.
+  MotionCommand turning;
+  turning.linear_speed = 1.5;
+  turning.steering_angle = interpretation::manual_from_rep103_command_steering(0.5);  // inner
+  m.drive(turning, 4s);
+  EXPECT_NEAR(m.chassis.snapshot().target.speed, 0.7, 1e-9);
+  // Spin: 3.259 rad/s at most.
+  m.switch_mode(MotionMode::kSpin);
+  MotionCommand spin;
+  spin.yaw_rate = 5.0;
+  m.drive(spin, 4s);
+  EXPECT_NEAR(m.chassis.snapshot().twist.wz, 3.259, 0.001);
+}
+
+TEST(ChassisVariantMiniV3, LightsOnOrOffOnlyAndNoUltrasonicAnswer) {
+  Host m(variant("mini_v3"));
+  m.handshake();
+  LightCommand off;
+  off.enable = true;
+  off.front_mode = protocol::LightMode::kOff;
+  m.send(off);
+  m.advance(40ms);
+  const auto state = m.last<LightState>(protocol::kLightStateId);
+  EXPECT_TRUE(state.enable);
+  EXPECT_EQ(state.front_mode, protocol::LightMode::kOff);
+  EXPECT_EQ(m.frames(protocol::kLightStateId).back().data[3], 0) << "no rear light";
+  // 0x451 is not a MINI 3.0 frame: rejected, never answered.
+  const auto rejected = m.chassis.counters().frames_rejected;
+  m.chassis.on_frame(*encode(UltrasonicSettingCommand{true}), m.t);
+  m.advance(40ms);
+  EXPECT_EQ(m.chassis.counters().frames_rejected, rejected + 1);
+  EXPECT_TRUE(m.frames(protocol::kUltrasonicSettingFeedbackId).empty());
 }
 
 }  // namespace

@@ -378,7 +378,7 @@ TEST(CliDecode, ProtocolOptions) {
   const Outcome value = run({kAgxLog, "--set", "error_word=agx32"});
   EXPECT_EQ(value.rc, 2);
   EXPECT_NE(value.err.find("protocol setting error_word = 'agx32' is invalid (valid: "
-                           "manual32|agx16)"),
+                           "manual32|agx16|mini32)"),
             std::string::npos)
       << value.err;
   const Outcome name = run({kAgxLog, "--set", "counter=yes"});

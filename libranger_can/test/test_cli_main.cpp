@@ -56,7 +56,7 @@ TEST(CliMain, HelpListsEveryCommandWithItsSummary) {
     EXPECT_NE(r.out.find("  " + c->name + " "), std::string::npos) << c->name;
   EXPECT_TRUE(std::regex_search(
       r.out, std::regex("\n  send +send one command: mode, park, lights, version, control, "
-                        "clear-errors, ultrasonic, motion\n")))
+                        "clear-errors, ultrasonic, motion, drive_mode\n")))
       << r.out;
   EXPECT_EQ(run({"-h"}).out, r.out);
   EXPECT_EQ(run({"help"}).out, r.out);

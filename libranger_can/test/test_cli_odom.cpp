@@ -102,6 +102,7 @@ const BundledLog kBundledLogs[] = {
     {"sample_padded.log", "manual", "8", false},
     {"sample_agx_v2.log", "agx_v2", "8", true},
     {"sample_agx_v2_unpadded.log", "agx_v2", "0", true},
+    {"sample_mini_v3.log", "mini_v3", "0", true},  // the RANGER MINI 3.0's manual
 };
 const FinalPose kDriveEnd = {0.0, 0.5 + 2.0 * std::sin(0.5) - 0.3 * std::cos(0.5),
                              2.0 * (1.0 - std::cos(0.5)) - 0.3 * std::sin(0.5), 0.5 + M_PI / 2};
@@ -155,15 +156,16 @@ std::string sample_log(const BundledLog& b) {
     std::memcpy(v.text.data(), "V2.3.1", 6);
     v.length = 6;
     tour(v);
+    const bool on_off = p.light_modes == LightModes::kOnOff;  // the MINI 3.0: no rear light
     LightCommand light;
     light.enable = true;
     light.front_mode = protocol::LightMode::kOn;
-    light.rear_mode = protocol::LightMode::kBreathing;
+    light.rear_mode = on_off ? protocol::LightMode::kOff : protocol::LightMode::kBreathing;
     tour(light);
     LightState state;
     state.enable = true;
     state.front_mode = protocol::LightMode::kOn;
-    state.rear_mode = protocol::LightMode::kBreathing;
+    state.rear_mode = light.rear_mode;
     state.counter = 1;
     tour(state);
     RemoteControlState rc;
@@ -175,6 +177,12 @@ std::string sample_log(const BundledLog& b) {
     rc.counter = 7;
     tour(rc);
     tour(OdometerFeedback{12345, 12400});
+    if (protocol::find_frame(protocol::kRearOdometerId)->in(p.frame_layout)) {
+      OdometerFeedback rear{12340, 12395};
+      rear.rear = true;
+      tour(rear);
+      tour(DriveModeCommand{protocol::DriveMode::kVoltage});
+    }
   }
   SystemStatus lost;
   lost.control_mode = protocol::ControlMode::kCan;

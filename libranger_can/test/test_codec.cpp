@@ -13,6 +13,7 @@
 #include <limits>
 #include <new>
 #include <random>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -69,6 +70,10 @@ std::string hex(const CanFrame& f) {
 const ProtocolProfile& agx_v2() {
   static const ProtocolProfile kAgx = *protocol_preset("agx_v2");
   return kAgx;
+}
+const ProtocolProfile& mini_v3() {
+  static const ProtocolProfile kMini = *protocol_preset("mini_v3");
+  return kMini;
 }
 ProtocolProfile with(ProtocolProfile p, const char* name, const char* value) {
   const Status st = set_setting(p, name, value);
@@ -257,7 +262,7 @@ long long command_limit(AngleUnit unit) {
   return unit == AngleUnit::kMilliradian ? 1571 : 9000;
 }
 
-// Every layout of either revision as `p` reads it.
+// Every layout of any revision as `p` reads it (a command only where `p`'s frame layout has it).
 std::vector<Layout> layouts(const ProtocolProfile& p = manual_profile()) {
   const Field i16a{0, 2, true, kI16Min, kI16Max}, i16b{2, 2, true, kI16Min, kI16Max},
       i16c{4, 2, true, kI16Min, kI16Max}, i16d{6, 2, true, kI16Min, kI16Max};
@@ -266,30 +271,36 @@ std::vector<Layout> layouts(const ProtocolProfile& p = manual_profile()) {
   const long long a111 = command_limit(p.steering_unit_111);
   const long long spin = p.spin_field == SpinField::kWheelSpeed ? 1000 : kI16Max;
   const auto modes = static_cast<long long>(protocol::motion_modes(p.mode_numbering).size());
+  const bool on_off = p.light_modes == LightModes::kOnOff;
+  const Field light_mode_byte = on_off ? Field{1, 1, false, 0, 1} : Field{1, 1, false, 0, 3};
+  std::vector<Field> light_command = {{0, 1, false, 0, 1}, light_mode_byte};
+  if (!on_off) {
+    light_command.insert(
+        light_command.end(),
+        {{2, 1, false, 0, 255}, {3, 1, false, 0, 3}, {4, 1, false, 0, 255}, {7, 1, false, 0, 255}});
+  }
+  std::vector<Field> motion_mode = {{0, 1, false, 0, 255}, {1, 1, false, 0, 1}};
+  if (proto::layout_dlc(0x291, p.frame_layout) >= 3) motion_mode.push_back({2, 1, false, 0, 255});
   std::vector<Layout> all = {
       {0x111,
        {{0, 2, true, -2600, 2600}, i16b, {4, 2, true, -spin, spin}, {6, 2, true, -a111, a111}}},
-      {0x121,
-       {{0, 1, false, 0, 1},
-        {1, 1, false, 0, 3},
-        {2, 1, false, 0, 255},
-        {3, 1, false, 0, 3},
-        {4, 1, false, 0, 255},
-        {7, 1, false, 0, 255}}},
+      {0x121, light_command},
       {0x141, {{0, 1, false, 0, modes - 1}}},
       {0x421, {{0, 1, false, 0, 1}}},
       {0x441, {{0, 1, false, 0, 0x10}}},
       {0x451, {{0, 1, false, 0, 1}}},
       {0x4A1, {{0, 1, false, 2, 255}}},  // an answer (the request: VersionRequestBothLengths)
       {0x221, {i16a, i16b, i16c, {6, 2, true, -a221, a221}}},
-      // Light state: any mode byte is kept.
+      // Light state: any mode byte is kept (under on_off, bytes 2-6 are reserved).
       {0x231,
-       {{0, 1, false, 0, 1},
-        {1, 1, false, 0, 255},
-        {2, 1, false, 0, 255},
-        {3, 1, false, 0, 255},
-        {4, 1, false, 0, 255},
-        {7, 1, false, 0, 255}}},
+       on_off
+           ? std::vector<Field>{{0, 1, false, 0, 1}, {1, 1, false, 0, 255}, {7, 1, false, 0, 255}}
+           : std::vector<Field>{{0, 1, false, 0, 1},
+                                {1, 1, false, 0, 255},
+                                {2, 1, false, 0, 255},
+                                {3, 1, false, 0, 255},
+                                {4, 1, false, 0, 255},
+                                {7, 1, false, 0, 255}}},
       {0x241,
        {{0, 1, false, 0, 255},
         {1, 1, true, -128, 127},
@@ -304,8 +315,9 @@ std::vector<Layout> layouts(const ProtocolProfile& p = manual_profile()) {
         {4, 2, true, -a271, a271},
         {6, 2, true, -a271, a271}}},
       {0x281, {i16a, i16b, i16c, i16d}},
-      {0x291, {{0, 1, false, 0, 255}, {1, 1, false, 0, 1}}},
+      {0x291, motion_mode},
       {0x311, {{0, 4, true, INT32_MIN, INT32_MAX}, {4, 4, true, INT32_MIN, INT32_MAX}}},
+      {0x312, {{0, 4, true, INT32_MIN, INT32_MAX}, {4, 4, true, INT32_MIN, INT32_MAX}}},
       {0x342, {i16a, i16b, i16c, i16d}},
       {0x343, {i16a, i16b, i16c, i16d}},
       {0x45A, {{0, 1, false, 0, 1}}},
@@ -341,13 +353,16 @@ std::vector<Layout> layouts(const ProtocolProfile& p = manual_profile()) {
                     {2, 1, false, 0, 255},
                     {3, 1, false, 0, 255}}});
   }
+  if (proto::find_frame(0x423)->in(p.frame_layout)) all.push_back({0x423, {{0, 1, false, 0, 1}}});
   std::sort(all.begin(), all.end(), [](const Layout& a, const Layout& b) { return a.id < b.id; });
   return all;
 }
 
-// The profiles the round trips run under: both presets, and mixes of their settings.
+// The profiles the round trips run under: the three presets, and mixes of their settings.
 std::vector<ProtocolProfile> profiles() {
-  std::vector<ProtocolProfile> out = {manual_profile(), agx_v2()};
+  std::vector<ProtocolProfile> out = {manual_profile(), agx_v2(), mini_v3()};
+  out.push_back(with(with(mini_v3(), "tx_dlc", "8"), "odometer_unit", "unknown"));
+  out.push_back(with(with(manual_profile(), "frame_layout", "mini_v3"), "error_word", "mini32"));
   out.push_back(with(with(agx_v2(), "tx_dlc", "0"), "steering_unit_271", "centideg"));
   out.push_back(with(with(manual_profile(), "tx_dlc", "8"), "mode_numbering", "mini_v1"));
   out.push_back(
@@ -375,14 +390,16 @@ void expect_round_trip(const CanFrame& f, const ProtocolProfile& p = manual_prof
 
 // The DLC an encoder under `p` gives `id` (its layout, or 8 under tx_dlc 8).
 std::uint8_t tx_dlc_of(std::uint32_t id, const ProtocolProfile& p) {
-  return static_cast<std::uint8_t>(p.tx_dlc == 8 ? 8 : proto::layout_dlc(id));
+  return static_cast<std::uint8_t>(p.tx_dlc == 8 ? 8 : proto::layout_dlc(id, p.frame_layout));
 }
 
 TEST(CodecRoundTrip, CoversEveryProtocolId) {
-  std::vector<std::uint32_t> ids;
-  for (const auto& l : layouts())
-    ids.push_back(l.id);
-  EXPECT_EQ(ids, proto::all_ids());
+  std::set<std::uint32_t> ids;
+  for (const ProtocolProfile& p : {manual_profile(), agx_v2(), mini_v3()}) {
+    for (const auto& l : layouts(p))
+      ids.insert(l.id);
+  }
+  EXPECT_EQ(std::vector<std::uint32_t>(ids.begin(), ids.end()), proto::all_ids());
 }
 
 TEST(CodecRoundTrip, EveryFieldAtItsLimitsAndRandomValuesUnderEveryProfile) {
@@ -660,9 +677,9 @@ TEST(CodecInvalid, IndicesAndCommandsOutsideTheProtocol) {
 // ---- Decoding errors --------------------------------------------------------------------------
 
 TEST(CodecDecodeErrors, ShorterThanItsLayoutForEveryId) {
-  for (const ProtocolProfile& p : {manual_profile(), agx_v2()}) {
+  for (const ProtocolProfile& p : {manual_profile(), agx_v2(), mini_v3()}) {
     for (std::uint32_t id : proto::all_ids()) {
-      const int want = proto::layout_dlc(id);
+      const int want = proto::layout_dlc(id, p.frame_layout);
       for (int dlc = 0; dlc < want; ++dlc) {
         CanFrame f;
         f.id = id;
@@ -700,10 +717,13 @@ TEST(CodecDecode, LongerFramesDecodeTheirLeadingBytes) {
   // The vendor's software pads to 8 and never checks a length. Every ID, every longer
   // DLC, random padding: the message is the one of the leading bytes.
   std::mt19937 rng(14);
-  for (const ProtocolProfile& p : {manual_profile(), agx_v2()}) {
+  for (const ProtocolProfile& p : {manual_profile(), agx_v2(), mini_v3()}) {
     for (std::uint32_t id : proto::all_ids()) {
       if (id == proto::kVersionId) continue;  // an answer's text is the whole frame: below
-      const int layout = proto::layout_dlc(id);
+      const proto::FrameInfo* row = proto::find_frame(id);
+      // A command of another revision decodes, but is not sent under `p` (0x423 outside mini_v3).
+      if (row->direction == proto::Direction::kToChassis && !row->in(p.frame_layout)) continue;
+      const int layout = proto::layout_dlc(id, p.frame_layout);
       CanFrame exact = frame(id, std::vector<std::uint8_t>(static_cast<std::size_t>(layout), 0));
       for (int i = 0; i < layout; ++i)  // small values: plausible angles, sendable modes
         exact.data[i] = static_cast<std::uint8_t>(rng() & 0x01);
@@ -716,7 +736,7 @@ TEST(CodecDecode, LongerFramesDecodeTheirLeadingBytes) {
         longer.dlc = static_cast<std::uint8_t>(dlc);
         for (int i = layout; i < dlc; ++i)
           longer.data[i] = static_cast<std::uint8_t>(rng());
-        EXPECT_EQ(proto::extra_bytes(longer), dlc - layout);
+        EXPECT_EQ(proto::extra_bytes(longer, p.frame_layout), dlc - layout);
         const auto r = decode(longer, p);
         ASSERT_TRUE(r.ok()) << "ID 0x" << std::hex << id << " DLC " << dlc << ": "
                             << r.error().message;
@@ -922,13 +942,13 @@ TEST(CodecEncode, FramesCarryTheLayoutDlcOrEightAndNoStamp) {
     for (const auto& layout : layouts(p)) {
       CanFrame f;
       f.id = layout.id;
-      f.dlc = static_cast<std::uint8_t>(proto::layout_dlc(layout.id));
+      f.dlc = static_cast<std::uint8_t>(proto::layout_dlc(layout.id, p.frame_layout));
       const auto m = decode(f, p);
       ASSERT_TRUE(m.ok());
       const CanFrame e = encode_ok(*m, p);
-      EXPECT_EQ(e.dlc, p.tx_dlc == 8 ? 8 : proto::layout_dlc(layout.id));
+      EXPECT_EQ(e.dlc, tx_dlc_of(layout.id, p));
       EXPECT_EQ(e.stamp.count(), 0);
-      for (int i = proto::layout_dlc(layout.id); i < 8; ++i)
+      for (int i = proto::layout_dlc(layout.id, p.frame_layout); i < 8; ++i)
         EXPECT_EQ(e.data[i], 0) << "zero padding";
     }
   }

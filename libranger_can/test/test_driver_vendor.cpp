@@ -1,9 +1,12 @@
-// What the vendor's revision adds, through the driver runtime in lock-step with the virtual
-// chassis (sim:agx_v2, sim:mini_v1, sim): park, lights, the remote state and the firmware
-// version, and their refusals by name where the revision or the model lacks them.
+// What the vendor's revisions add, through the driver runtime in lock-step with the virtual
+// chassis (sim:agx_v2, sim:mini_v1, sim:mini_v3, sim): park, lights, the remote state, the
+// firmware version, the MINI 3.0's drive mode, rear odometry and BMS alarms, and their refusals by
+// name where the revision or the model lacks them.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,8 +24,8 @@ using namespace std::chrono_literals;
 DriverConfig config_for(const std::string& variant) {
   DriverConfig c;
   if (variant == "agx_v2") c.controller.profile = *protocol_preset("agx_v2");
-  if (variant == "mini_v1") {
-    const auto model = model_preset("ranger_mini_v1");
+  if (variant == "mini_v1" || variant == "mini_v3") {  // the model's geometry and profile
+    const auto model = model_preset("ranger_" + variant);
     EXPECT_TRUE(model.ok());
     c.controller.geometry = model->geometry;
     c.controller.limits = model->limits;
@@ -33,7 +36,9 @@ DriverConfig config_for(const std::string& variant) {
 
 class Rig {
  public:
-  explicit Rig(const std::string& variant, const std::string& firmware = "") {
+  // `config`: the driver's, instead of the one the variant's `driver` options give.
+  explicit Rig(const std::string& variant, const std::string& firmware = "",
+               std::optional<DriverConfig> config = std::nullopt) {
     sim::SimSourceOptions options;
     options.lock_step = true;
     if (!firmware.empty()) options.chassis.version = firmware;
@@ -41,7 +46,7 @@ class Rig {
         sim::open_bus_source(variant == "manual" ? "sim" : "sim:" + variant, clock_, options);
     EXPECT_TRUE(source.ok());
     sim_ = std::static_pointer_cast<sim::SimBusSource>(*source);
-    driver_ = std::make_unique<Driver>(config_for(variant), *source, clock_);
+    driver_ = std::make_unique<Driver>(config.value_or(config_for(variant)), *source, clock_);
     driver_->set_sent_observer([this](const SentEvent& e) { sent_.push_back(e.sent.frame.id); });
   }
   ~Rig() { driver_.reset(); }  // its shutdown stop is still observed
@@ -271,6 +276,118 @@ TEST(DriverRemote, SticksAreNormalisedAndSaturated) {
   EXPECT_DOUBLE_EQ(r.right_horizontal, -1.0);
   EXPECT_DOUBLE_EQ(r.knob, 1.0);
   EXPECT_EQ(r.swd, protocol::RemoteSwitch::kDown);
+}
+
+// ---- the RANGER MINI 3.0 (sim:mini_v3, model ranger_mini_v3, protocol mini_v3) ------------------
+
+TEST(DriverMiniV3, TheDriveModeIsSetAndReported) {
+  Rig rig("mini_v3");
+  ASSERT_TRUE(rig.ready());
+  ASSERT_TRUE(rig.run_until([&] { return rig.snap()->drive_mode.has_value(); }, 1s));
+  EXPECT_EQ(*rig.snap()->drive_mode, protocol::DriveMode::kCurrent);
+  const RequestOutcome voltage =
+      rig.outcome(rig.driver().set_drive_mode(protocol::DriveMode::kVoltage));
+  ASSERT_EQ(voltage.state, RequestOutcome::State::kAnswered) << voltage.message;
+  EXPECT_EQ(voltage.message, "the chassis reports drive mode voltage");
+  EXPECT_EQ(voltage.what, "drive_mode voltage");
+  EXPECT_EQ(*rig.snap()->drive_mode, protocol::DriveMode::kVoltage);
+  EXPECT_EQ(rig.chassis().drive_mode, protocol::DriveMode::kVoltage);
+  const RequestOutcome current =
+      rig.outcome(rig.driver().set_drive_mode(protocol::DriveMode::kCurrent));
+  EXPECT_EQ(current.state, RequestOutcome::State::kAnswered) << current.message;
+  EXPECT_EQ(*rig.snap()->drive_mode, protocol::DriveMode::kCurrent);
+}
+
+TEST(DriverMiniV3, NoDriveModeOnTheVendorsReading) {
+  // The vendor's revision has no 0x423: refused by name, nothing sent; 0x291's third byte is
+  // not read, so no drive mode is reported either.
+  Rig rig("agx_v2");
+  ASSERT_TRUE(rig.ready());
+  const RequestOutcome r = rig.outcome(rig.driver().set_drive_mode(protocol::DriveMode::kVoltage));
+  EXPECT_EQ(r.state, RequestOutcome::State::kFailed);
+  EXPECT_EQ(r.message,
+            "drive modes: unsupported by protocol agx_v2 (its frame layout agx_v2 has no 0x423 "
+            "drive mode command)");
+  EXPECT_FALSE(rig.snap()->drive_mode.has_value());
+  // The same on a MINI 3.0 read the vendor's way.
+  DriverConfig agx = config_for("mini_v3");
+  agx.controller.profile = *protocol_preset("agx_v2");
+  Rig agx_on_mini("mini_v3", "", agx);
+  ASSERT_TRUE(agx_on_mini.ready());
+  agx_on_mini.drive({}, 200ms);
+  EXPECT_FALSE(agx_on_mini.snap()->drive_mode.has_value());
+  EXPECT_EQ(
+      agx_on_mini.outcome(agx_on_mini.driver().set_drive_mode(protocol::DriveMode::kVoltage)).state,
+      RequestOutcome::State::kFailed);
+}
+
+TEST(DriverMiniV3, RearOdometryAndTheBmsAlarmsReachTheSnapshot) {
+  Rig rig("mini_v3");
+  ASSERT_TRUE(rig.ready());
+  rig.drive({0.5, 0, 0}, 2s);
+  rig.drive({}, 1s);
+  const auto s = rig.snap();
+  ASSERT_TRUE(s->feedback.rear_odometer && s->feedback.odometer);
+  const OdometerFeedback& rear = s->feedback.rear_odometer->value;
+  EXPECT_TRUE(rear.rear);
+  ASSERT_TRUE(rear.left_distance && rear.right_distance);
+  const double travelled = rig.chassis().distance_travelled;
+  EXPECT_GT(travelled, 0.5);
+  EXPECT_NEAR(*rear.left_distance, travelled, 0.002);
+  EXPECT_NEAR(*s->feedback.odometer->value.right_distance, travelled, 0.002);
+  // The pack's alarm frame (0x362, 4 bytes): under-voltage below 10 % SOC.
+  rig.sim().with_chassis([](sim::VirtualChassis& c) {
+    c.set_battery_soc(8.0);
+    return 0;
+  });
+  rig.run_until(
+      [&] {
+        const auto& a = rig.snap()->feedback.bms_alarm[0];
+        return a && (a->value.alarm1 & protocol::bms_status::kUnderVoltage) != 0;
+      },
+      2s);
+  const auto& alarm = rig.snap()->feedback.bms_alarm[0];
+  ASSERT_TRUE(alarm);
+  EXPECT_EQ(protocol::bms_status_names(alarm->value.alarm1, alarm->value.alarm2),
+            std::vector<std::string>{"under_voltage"});
+  // The fault word by meaning: under-voltage is the MINI 3.0's bit 0.
+  EXPECT_TRUE(rig.run_until(
+      [&] {
+        const auto& f = rig.snap()->controller.faults;
+        return std::find(f.begin(), f.end(), "battery_under_voltage") != f.end();
+      },
+      1s));
+}
+
+TEST(DriverMiniV3, LightsOnOrOffParkAndTheRefusalsThatNameWhatItLacks) {
+  Rig rig("mini_v3");
+  ASSERT_TRUE(rig.ready());
+  LightsRequest off;
+  off.front = protocol::LightMode::kOff;
+  off.rear = protocol::LightMode::kOff;
+  const RequestOutcome lights = rig.outcome(*rig.driver().set_lights(off));
+  ASSERT_EQ(lights.state, RequestOutcome::State::kAnswered) << lights.message;
+  EXPECT_EQ(rig.snap()->lights->front, protocol::LightMode::kOff);
+  LightsRequest rear = off;
+  rear.rear = protocol::LightMode::kOn;
+  const RequestOutcome no_rear = rig.outcome(*rig.driver().set_lights(rear));
+  EXPECT_EQ(no_rear.state, RequestOutcome::State::kFailed);
+  EXPECT_EQ(no_rear.message,
+            "a rear light: unsupported by protocol mini_v3 (light_modes on_off: the lights on or "
+            "off only)");
+  LightsRequest breathing = off;
+  breathing.front = protocol::LightMode::kBreathing;
+  const RequestOutcome no_breathing = rig.outcome(*rig.driver().set_lights(breathing));
+  EXPECT_EQ(no_breathing.state, RequestOutcome::State::kFailed);
+  EXPECT_NE(no_breathing.message.find("breathing lights: unsupported by protocol mini_v3"),
+            std::string::npos)
+      << no_breathing.message;
+  // Park is the MINI 3.0's mode 3.
+  const RequestOutcome park = rig.outcome(rig.driver().set_park(true));
+  ASSERT_EQ(park.state, RequestOutcome::State::kAnswered) << park.message;
+  EXPECT_EQ(rig.chassis().motion_mode, protocol::MotionMode::kPark);
+  EXPECT_EQ(rig.snap()->feedback.motion_mode->value.mode_raw, 3);
+  EXPECT_EQ(rig.outcome(rig.driver().set_park(false)).state, RequestOutcome::State::kAnswered);
 }
 
 }  // namespace

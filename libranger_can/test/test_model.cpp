@@ -105,18 +105,33 @@ TEST(Model, MiniV2AndV3) {
     const ModelPreset m = preset(name);
     EXPECT_DOUBLE_EQ(m.geometry.wheelbase, 0.494);
     EXPECT_DOUBLE_EQ(m.geometry.track, 0.364);
-    EXPECT_DOUBLE_EQ(m.limits.max_linear_speed, 1.5);
     EXPECT_DOUBLE_EQ(m.limits.max_ackermann_steering, 0.698);
-    EXPECT_DOUBLE_EQ(m.limits.max_oblique_steering, 1.570);
     EXPECT_DOUBLE_EQ(m.limits.max_spin_wheel_speed, kMaxSpinSpeedMps);  // 4.8 rad/s is beyond it
-    EXPECT_EQ(m.protocol, "agx_v2");
   }
   const ModelPreset v2 = preset("ranger_mini_v2");
+  EXPECT_DOUBLE_EQ(v2.limits.max_linear_speed, 1.5);
+  EXPECT_DOUBLE_EQ(v2.limits.max_oblique_steering, 1.570);
+  EXPECT_EQ(v2.protocol, "agx_v2");
   EXPECT_DOUBLE_EQ(v2.profile.bms_voltage_scale, 0.01);
   EXPECT_EQ(v2.profile.spin_field, SpinField::kWheelSpeed);
   EXPECT_EQ(describe(v2.profile), "agx_v2 with spin_field=wheel_speed,bms_voltage_scale=0.01");
+}
+
+TEST(Model, MiniV3SpeaksItsOwnManualWithItsLimits) {
+  // The RANGER MINI 3.0's manual (PROTOCOL_MINI_V3.md): linear +-2.0 m/s, +-0.7 m/s beyond 20 deg
+  // of steering, spin +-3.259 rad/s, Ackermann inner angle +-0.698 rad, oblique +-1.571 rad.
   const ModelPreset v3 = preset("ranger_mini_v3");
-  EXPECT_EQ(v3.profile, *protocol_preset("agx_v2"));
+  EXPECT_EQ(v3.protocol, "mini_v3");
+  EXPECT_EQ(v3.profile, *protocol_preset("mini_v3"));
+  EXPECT_DOUBLE_EQ(v3.limits.max_linear_speed, 2.0);
+  EXPECT_DOUBLE_EQ(v3.limits.max_speed_at_large_steering, 0.7);
+  EXPECT_DOUBLE_EQ(v3.limits.max_ackermann_steering, 0.698);
+  EXPECT_NEAR(v3.limits.max_oblique_steering, 1.571, 0.0005);
+  EXPECT_LE(v3.limits.max_oblique_steering, kMaxObliqueSteeringRad);
+  const double spin_radius = std::hypot(v3.geometry.wheelbase / 2, v3.geometry.track / 2);
+  EXPECT_NEAR(v3.limits.max_spin_wheel_speed / spin_radius, 3.259, 0.001);
+  EXPECT_EQ(v3.profile.steering_reference, SteeringReference::kInnerFront);
+  EXPECT_EQ(v3.profile.spin_field, SpinField::kYawRate);
 }
 
 TEST(Model, EmbeddedPresetsEqualTheFiles) {

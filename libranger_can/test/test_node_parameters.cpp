@@ -61,7 +61,7 @@ TEST(NodeParameters, EachTypeIsCheckedAndTheProblemNamesTheRange) {
   EXPECT_EQ(problem(*find_node_parameter("publish_odom_tf"), 1), "= 1: expected true or false");
   EXPECT_EQ(problem(*find_node_parameter("protocol"), true), "= true: expected a string");
   EXPECT_EQ(problem(*find_node_parameter("protocol"), "agx_v3"),
-            "= \"agx_v3\": expected one of auto, manual, agx_v2");
+            "= \"agx_v3\": expected one of auto, manual, agx_v2, mini_v3");
   EXPECT_EQ(problem(*find_node_parameter("odometry_source"), "gps"),
             "= \"gps\": expected \"wheels\" or \"motion\"");
   // A setting takes a number or a bool as its text.
@@ -114,9 +114,10 @@ TEST(NodeParameters, ReadmeRowsSayDefaultValidAndMeaning) {
     const std::string row = markdown_row(*find_node_parameter(name));
     return row.rfind(prefix, 0) == 0 ? prefix : row;
   };
-  const std::string protocol = "| `protocol` | `auto` | `auto`, `manual`, `agx_v2` |";
+  const std::string protocol = "| `protocol` | `auto` | `auto`, `manual`, `agx_v2`, `mini_v3` |";
   EXPECT_EQ(starts("protocol", protocol), protocol);
-  const std::string spin = "| `spin_sign` | unset: manual `ccw`, agx_v2 `ccw` | `ccw`, `cw` |";
+  const std::string spin =
+      "| `spin_sign` | unset: manual `ccw`, agx_v2 `ccw`, mini_v3 `ccw` | `ccw`, `cw` |";
   EXPECT_EQ(starts("spin_sign", spin), spin);
 }
 

@@ -1,5 +1,6 @@
-// The protocol profile: the two presets field by field, every setting by name (its valid values,
-// its default per revision, a rejected value with the message), validation and descriptions.
+// The protocol profile: the three presets field by field, every setting by name (its valid
+// values, its default per revision, a rejected value with the message), validation and
+// descriptions.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -73,14 +74,42 @@ TEST(ProfilePresets, AgxV2FollowsTheVendorsSoftware) {
   EXPECT_NE(v, preset("manual"));
 }
 
+TEST(ProfilePresets, MiniV3FollowsTheMini30Manual) {
+  const ProtocolProfile m = preset("mini_v3");
+  EXPECT_EQ(m.revision, "mini_v3");
+  // As agx_v2: 0x111 i16 x 0.001 (m/s, spin rad/s in bytes 2-3, inner angle rad, left positive).
+  EXPECT_EQ(m.steering_unit_111, AngleUnit::kMilliradian);
+  EXPECT_EQ(m.steering_unit_221, AngleUnit::kMilliradian);
+  EXPECT_EQ(m.steering_unit_271, AngleUnit::kMilliradian);
+  EXPECT_EQ(m.steering_sign_111, SteeringSign::kLeftPositive);
+  EXPECT_EQ(m.steering_sign_221, SteeringSign::kLeftPositive);
+  EXPECT_EQ(m.steering_sign_271, SteeringSign::kLeftPositive);
+  EXPECT_EQ(m.steering_reference, SteeringReference::kInnerFront);
+  EXPECT_EQ(m.spin_field, SpinField::kYawRate);
+  EXPECT_EQ(m.spin_sign, +1);
+  EXPECT_EQ(m.bms_voltage_scale, 0.1);
+  // Its own: the 32-bit fault word without a counter, park as 3 and no side slip, 0x291 of 3
+  // bytes with 0x312 and 0x423, odometers in mm, lights on/off, each command's own length.
+  EXPECT_EQ(m.error_word, ErrorWordLayout::kMini32);
+  EXPECT_EQ(m.mode_numbering, ModeNumbering::kMiniV3);
+  EXPECT_EQ(m.frame_layout, FrameLayout::kMiniV3);
+  EXPECT_EQ(m.odometer_unit, OdometerUnit::kMillimetre);
+  EXPECT_EQ(m.light_modes, LightModes::kOnOff);
+  EXPECT_EQ(m.tx_dlc, 0);
+  EXPECT_TRUE(m.validate().ok());
+  EXPECT_NE(m, preset("agx_v2"));
+  EXPECT_EQ(describe(m), "mini_v3");
+}
+
 TEST(ProfilePresets, RevisionNamesAndUnknownRevision) {
-  EXPECT_EQ(protocol_revision_names(), (std::vector<std::string>{"manual", "agx_v2"}));
+  EXPECT_EQ(protocol_revision_names(), (std::vector<std::string>{"manual", "agx_v2", "mini_v3"}));
   for (const auto& name : protocol_revision_names())
     EXPECT_EQ(preset(name.c_str()).revision, name);
   const auto bad = protocol_preset("agx_v3");
   ASSERT_FALSE(bad.ok());
   EXPECT_EQ(bad.error().code, Errc::kInvalidArgument);
-  EXPECT_EQ(bad.error().message, "unknown protocol revision 'agx_v3' (valid: manual, agx_v2)");
+  EXPECT_EQ(bad.error().message,
+            "unknown protocol revision 'agx_v3' (valid: manual, agx_v2, mini_v3)");
   EXPECT_FALSE(protocol_preset("").ok());
   EXPECT_FALSE(protocol_preset("Manual").ok());  // names are exact
 }
@@ -92,6 +121,7 @@ struct SettingCase {
   std::vector<std::string> values;
   const char* manual_default;
   const char* agx_v2_default;
+  const char* mini_v3_default;
 };
 
 std::ostream& operator<<(std::ostream& os, const SettingCase& c) {
@@ -100,26 +130,46 @@ std::ostream& operator<<(std::ostream& os, const SettingCase& c) {
 
 const std::vector<SettingCase>& setting_cases() {
   static const std::vector<SettingCase> kCases = {
-      {"steering_unit_111", {"centideg", "millirad"}, "centideg", "millirad"},
-      {"steering_unit_221", {"centideg", "millirad"}, "centideg", "millirad"},
-      {"steering_unit_271", {"centideg", "millirad"}, "centideg", "millirad"},
-      {"steering_sign_111", {"right_positive", "left_positive"}, "right_positive", "left_positive"},
-      {"steering_sign_221", {"right_positive", "left_positive"}, "right_positive", "left_positive"},
-      {"steering_sign_271", {"right_positive", "left_positive"}, "right_positive", "left_positive"},
-      {"steering_reference", {"mean_front", "inner_front"}, "mean_front", "inner_front"},
-      {"spin_field", {"wheel_speed", "yaw_rate"}, "wheel_speed", "yaw_rate"},
-      {"spin_sign", {"ccw", "cw"}, "ccw", "ccw"},
-      {"feedback_speed", {"mean_wheel", "body_centre"}, "mean_wheel", "body_centre"},
-      {"error_word", {"manual32", "agx16"}, "manual32", "agx16"},
-      {"vehicle_status_1_is_estop", {"true", "false"}, "true", "true"},
-      {"bms_voltage_scale", {"0.01", "0.1"}, "0.01", "0.1"},
+      {"steering_unit_111", {"centideg", "millirad"}, "centideg", "millirad", "millirad"},
+      {"steering_unit_221", {"centideg", "millirad"}, "centideg", "millirad", "millirad"},
+      {"steering_unit_271", {"centideg", "millirad"}, "centideg", "millirad", "millirad"},
+      {"steering_sign_111",
+       {"right_positive", "left_positive"},
+       "right_positive",
+       "left_positive",
+       "left_positive"},
+      {"steering_sign_221",
+       {"right_positive", "left_positive"},
+       "right_positive",
+       "left_positive",
+       "left_positive"},
+      {"steering_sign_271",
+       {"right_positive", "left_positive"},
+       "right_positive",
+       "left_positive",
+       "left_positive"},
+      {"steering_reference",
+       {"mean_front", "inner_front"},
+       "mean_front",
+       "inner_front",
+       "inner_front"},
+      {"spin_field", {"wheel_speed", "yaw_rate"}, "wheel_speed", "yaw_rate", "yaw_rate"},
+      {"spin_sign", {"ccw", "cw"}, "ccw", "ccw", "ccw"},
+      {"feedback_speed", {"mean_wheel", "body_centre"}, "mean_wheel", "body_centre", "body_centre"},
+      {"error_word", {"manual32", "agx16", "mini32"}, "manual32", "agx16", "mini32"},
+      {"vehicle_status_1_is_estop", {"true", "false"}, "true", "true", "true"},
+      {"bms_voltage_scale", {"0.01", "0.1"}, "0.01", "0.1", "0.1"},
       {"bms_current_sign",
        {"discharge_positive", "charge_positive"},
        "charge_positive",
+       "charge_positive",
        "charge_positive"},
-      {"mode_numbering", {"manual", "agx_v2", "mini_v1"}, "manual", "agx_v2"},
-      {"driver_status_bit6", {"disabled", "enabled"}, "disabled", "enabled"},
-      {"tx_dlc", {"0", "8"}, "0", "8"},
+      {"mode_numbering", {"manual", "agx_v2", "mini_v1", "mini_v3"}, "manual", "agx_v2", "mini_v3"},
+      {"driver_status_bit6", {"disabled", "enabled"}, "disabled", "enabled", "enabled"},
+      {"frame_layout", {"manual", "agx_v2", "mini_v3"}, "manual", "agx_v2", "mini_v3"},
+      {"odometer_unit", {"unknown", "mm"}, "unknown", "unknown", "mm"},
+      {"light_modes", {"front_rear", "on_off"}, "front_rear", "front_rear", "on_off"},
+      {"tx_dlc", {"0", "8"}, "0", "8", "0"},
   };
   return kCases;
 }
@@ -155,11 +205,12 @@ TEST_P(EverySetting, HasItsDefaultPerRevision) {
   const SettingCase& c = GetParam();
   EXPECT_EQ(*get_setting(preset("manual"), c.name), c.manual_default);
   EXPECT_EQ(*get_setting(preset("agx_v2"), c.name), c.agx_v2_default);
+  EXPECT_EQ(*get_setting(preset("mini_v3"), c.name), c.mini_v3_default);
 }
 
 TEST_P(EverySetting, AcceptsEachValidValueAndChangesOnlyItself) {
   const SettingCase& c = GetParam();
-  for (const char* base : {"manual", "agx_v2"}) {
+  for (const char* base : {"manual", "agx_v2", "mini_v3"}) {
     for (const auto& value : c.values) {
       ProtocolProfile p = preset(base);
       const Status st = set_setting(p, c.name, value);
@@ -250,7 +301,7 @@ TEST(ProfileValidate, NamesTheSettingAndItsValidValues) {
   EXPECT_EQ(message(p), "bms_voltage_scale = 0.05: valid 0.01 or 0.1");
   p = {};
   p.mode_numbering = static_cast<ModeNumbering>(7);
-  EXPECT_EQ(message(p), "mode_numbering = 7: valid manual, agx_v2 or mini_v1");
+  EXPECT_EQ(message(p), "mode_numbering = 7: valid manual, agx_v2, mini_v1 or mini_v3");
   p = {};
   p.steering_unit_271 = static_cast<AngleUnit>(-1);
   EXPECT_EQ(message(p), "steering_unit_271 = -1: valid centideg or millirad");
@@ -288,6 +339,15 @@ TEST(ProfileNames, EnumerationsAsTheSettingsSpellThem) {
   EXPECT_EQ(to_string(ModeNumbering::kMiniV1), "mini_v1");
   EXPECT_EQ(to_string(DriverStatusBit6::kDisabled), "disabled");
   EXPECT_EQ(to_string(DriverStatusBit6::kEnabled), "enabled");
+  EXPECT_EQ(to_string(ErrorWordLayout::kMini32), "mini32");
+  EXPECT_EQ(to_string(ModeNumbering::kMiniV3), "mini_v3");
+  EXPECT_EQ(to_string(FrameLayout::kManual), "manual");
+  EXPECT_EQ(to_string(FrameLayout::kAgxV2), "agx_v2");
+  EXPECT_EQ(to_string(FrameLayout::kMiniV3), "mini_v3");
+  EXPECT_EQ(to_string(OdometerUnit::kUnknown), "unknown");
+  EXPECT_EQ(to_string(OdometerUnit::kMillimetre), "mm");
+  EXPECT_EQ(to_string(LightModes::kFrontRear), "front_rear");
+  EXPECT_EQ(to_string(LightModes::kOnOff), "on_off");
   EXPECT_EQ(to_string(static_cast<ModeNumbering>(9)), "unknown");
 }
 
@@ -326,11 +386,12 @@ TEST(ProfileDocs, TheSettingsTableMatchesTheCode) {
                                   [&](const std::string& r) { return r.rfind(key, 0) == 0; });
     ASSERT_NE(row, rows.end()) << "no row for the setting";
     const auto c = cells(*row);
-    ASSERT_GE(c.size(), 7u) << *row;
+    ASSERT_GE(c.size(), 8u) << *row;
     for (const auto& v : s.values)
       EXPECT_NE(c[2].find("`" + std::string(v) + "`"), std::string::npos) << c[2];
     EXPECT_EQ(c[3], "`" + *get_setting(preset("manual"), s.name) + "`");
     EXPECT_EQ(c[4], "`" + *get_setting(preset("agx_v2"), s.name) + "`");
+    EXPECT_EQ(c[5], "`" + *get_setting(preset("mini_v3"), s.name) + "`");
     // Per model: "ranger_mini_v1 `centideg`" for every model whose preset differs from its
     // revision's there, "—" when none does.
     bool any = false;
@@ -339,11 +400,11 @@ TEST(ProfileDocs, TheSettingsTableMatchesTheCode) {
       const std::string value = *get_setting(model.profile, s.name);
       const bool differs = value != *get_setting(preset(model.protocol.c_str()), s.name);
       any = any || differs;
-      EXPECT_EQ(c[5].find(name + " `" + value + "`") != std::string::npos, differs)
-          << name << ": " << c[5];
+      EXPECT_EQ(c[6].find(name + " `" + value + "`") != std::string::npos, differs)
+          << name << ": " << c[6];
     }
-    if (!any) EXPECT_EQ(c[5], "—");
-    EXPECT_FALSE(c[6].empty()) << "evidence";
+    if (!any) EXPECT_EQ(c[6], "—");
+    EXPECT_FALSE(c[7].empty()) << "evidence";
   }
 }
 

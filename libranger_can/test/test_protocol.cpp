@@ -152,8 +152,9 @@ TEST(ProtocolUltrasonic, Codes) {
 TEST(ProtocolIds, AllIdsAscendingWithTheirLayoutLength) {
   const auto ids = all_ids();
   const auto manual = manual_ids();
-  // 39 frames in the manual, 5 more in agx_v2 (0x121, 0x231, 0x241, 0x311, 0x4A1).
-  EXPECT_EQ(ids.size(), 39u + 5u);
+  // 39 frames in the manual, 5 more in agx_v2 (0x121, 0x231, 0x241, 0x311, 0x4A1), 2 more in
+  // mini_v3 (0x312, 0x423).
+  EXPECT_EQ(ids.size(), 39u + 5u + 2u);
   EXPECT_EQ(manual.size(), 39u);
   EXPECT_TRUE(std::is_sorted(ids.begin(), ids.end()));
   EXPECT_TRUE(std::is_sorted(manual.begin(), manual.end()));
@@ -313,9 +314,16 @@ TEST(ProtocolFrames, EveryIdentifierHasOneRowAndTheRowsAgreeWithTheLists) {
     EXPECT_EQ(rows == 1, is_known_id(id)) << std::hex << id;
   }
   for (const FrameInfo& f : kFrameTable) {
-    EXPECT_GT(f.length, 0) << f.name;
-    EXPECT_LE(f.length, 8) << f.name;
-    EXPECT_NE(f.revisions & kInAgxV2, 0) << f.name << ": the vendor's revision has every frame";
+    bool somewhere = false;
+    for (const FrameLayout l : kFrameLayoutNames.values()) {
+      EXPECT_LE(f.length(l), 8) << f.name;
+      somewhere = somewhere || f.in(l);
+    }
+    EXPECT_TRUE(somewhere) << f.name << ": a frame of no revision";
+    EXPECT_GT(f.length(FrameLayout::kManual), 0) << f.name;
+    if (f.in(FrameLayout::kManual)) {
+      EXPECT_TRUE(f.in(FrameLayout::kAgxV2)) << f.name << ": agx_v2 has every manual frame";
+    }
     EXPECT_TRUE(f.period_ms == 0 || f.direction != Direction::kBoth) << f.name;
   }
   // Periods: the manual's feedback rates, 0x231/0x241 at the fast rate, the host's keep-alive.
@@ -436,7 +444,7 @@ TEST(ProtocolFaults, EveryFaultHasANameAndEveryBitIsNamedInItsLayout) {
     const auto f = static_cast<Fault>(i);
     EXPECT_NE(to_string(f), "unknown");
     EXPECT_TRUE(names.insert(std::string(to_string(f))).second);
-    for (const auto layout : {ErrorWordLayout::kManual32, ErrorWordLayout::kAgxV2_16}) {
+    for (const auto layout : kErrorWordLayoutNames.values()) {
       for (int motor = 0; motor <= 8; ++motor) {
         const std::uint32_t b = fault_bit(f, layout, motor);
         if (b == 0) continue;
@@ -454,10 +462,11 @@ TEST(ProtocolFaults, TheTableHasOneRowPerMeaningAndOneBitPerRowAndLayout) {
   std::set<std::string_view> names;
   for (const FaultInfo& f : kFaultTable) {
     EXPECT_TRUE(names.insert(f.name).second) << f.name;
-    EXPECT_TRUE(f.manual_bit != kNoBit || f.agx16_bit != kNoBit) << f.name;
+    EXPECT_TRUE(f.manual_bit != kNoBit || f.agx16_bit != kNoBit || f.mini32_bit != kNoBit)
+        << f.name;
     EXPECT_EQ(find_fault(f.name), &f);
     EXPECT_EQ(find_fault(f.fault, f.motor), &f) << f.name;
-    for (const auto layout : {ErrorWordLayout::kManual32, ErrorWordLayout::kAgxV2_16}) {
+    for (const auto layout : kErrorWordLayoutNames.values()) {
       if (f.bit(layout) == kNoBit) continue;
       EXPECT_LT(f.bit(layout), error_word_bits(layout)) << f.name;
       EXPECT_EQ(fault_at(layout, f.bit(layout)), &f) << f.name << ": two rows on one bit";

@@ -90,6 +90,7 @@ TEST(EnumNames, EveryTableHoldsEveryEnumerator) {
   expect_table_complete(protocol::kVehicleStatusNames, "VehicleStatus");
   expect_table_complete(protocol::kRemoteSwitchNames, "RemoteSwitch");
   expect_table_complete(protocol::kLightModeNames, "LightMode");
+  expect_table_complete(protocol::kDriveModeNames, "DriveMode");
   expect_table_complete(protocol::kFaultNames, "Fault");
   expect_table_complete(protocol::kUltrasonicCodeNames, "UltrasonicCode");
   expect_table_complete(kAngleUnitNames, "AngleUnit");
@@ -100,6 +101,9 @@ TEST(EnumNames, EveryTableHoldsEveryEnumerator) {
   expect_table_complete(kErrorWordLayoutNames, "ErrorWordLayout");
   expect_table_complete(kModeNumberingNames, "ModeNumbering");
   expect_table_complete(kDriverStatusBit6Names, "DriverStatusBit6");
+  expect_table_complete(kFrameLayoutNames, "FrameLayout");
+  expect_table_complete(kOdometerUnitNames, "OdometerUnit");
+  expect_table_complete(kLightModesNames, "LightModes");
   expect_table_complete(kProtocolSettingNames, "ProtocolSetting");
   expect_table_complete(kBusStateNames, "BusState");
   expect_table_complete(kMotionRefusalNames, "MotionRefusal");
@@ -139,7 +143,7 @@ TEST(EnumNames, ToStringParseAndValuesComeFromTheTable) {
   EXPECT_EQ(std::vector<LinkState>(values.begin(), values.end()),
             (std::vector<LinkState>{LinkState::kNeverConnected, LinkState::kConnected,
                                     LinkState::kStale}));
-  EXPECT_EQ(protocol::kFaultCount, 14);
+  EXPECT_EQ(protocol::kFaultCount, 16);  // 14, and the MINI 3.0's over-voltage and e-stop bits
 }
 
 // The settings table is in kProtocolSettingNames's order, each row named by its enumerator.

@@ -194,6 +194,8 @@ void RangerNode::start() {
       service_nh_.advertiseService("set_motion_mode", &RangerNode::on_set_motion_mode, this);
   set_lights_srv_ = service_nh_.advertiseService("set_lights", &RangerNode::on_set_lights, this);
   park_srv_ = service_nh_.advertiseService("park", &RangerNode::on_park, this);
+  set_drive_mode_srv_ =
+      service_nh_.advertiseService("set_drive_mode", &RangerNode::on_set_drive_mode, this);
 
   service_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &service_queue_);
   service_spinner_->start();
@@ -441,6 +443,27 @@ bool RangerNode::on_park(std_srvs::SetBool::Request& req, std_srvs::SetBool::Res
                     ? std::string(req.data ? "park" : "release") + " not confirmed in time (" +
                           std::string(ranger::to_string(outcome.state)) + ")"
                     : outcome.message;
+  return true;
+}
+
+bool RangerNode::on_set_drive_mode(ranger_msgs::SetDriveMode::Request& req,
+                                   ranger_msgs::SetDriveMode::Response& res) {
+  res.success = false;
+  const auto mode = ranger::drive_mode_from_wire(req.mode);
+  if (!mode) {
+    res.message = "drive mode " + std::to_string(req.mode) +
+                  " is not one of 0 (CURRENT), 1 (VOLTAGE): nothing sent";
+  } else {
+    const auto outcome = wait_for(driver_->set_drive_mode(*mode), Kind::kDriveMode);
+    res.success = outcome.state == State::kAnswered;
+    res.message = outcome.message.empty() ? "drive mode not confirmed in time (" +
+                                                std::string(ranger::to_string(outcome.state)) + ")"
+                                          : outcome.message;
+  }
+  const auto reported = driver_->snapshot()->drive_mode;
+  res.drive_mode = ranger_msgs::SystemState::DRIVE_MODE_NONE;
+  if (reported) res.drive_mode = static_cast<std::uint8_t>(*reported);
+  if (!res.success) ROS_WARN("set_drive_mode: %s", res.message.c_str());
   return true;
 }
 

@@ -22,6 +22,7 @@
 #include <nav_msgs/Odometry.h>
 #include <ranger_msgs/ClearErrors.h>
 #include <ranger_msgs/RemoteState.h>
+#include <ranger_msgs/SetDriveMode.h>
 #include <ranger_msgs/SetLights.h>
 #include <ranger_msgs/SetMotionMode.h>
 #include <ranger_msgs/SetUltrasonic.h>
@@ -794,6 +795,139 @@ TEST_F(MiniV1, SideSlipThroughSetMotionModeMovesSidewaysWithOdometry) {
       << p.response.message;
 }
 
+// ---- the RANGER MINI 3.0 (node_sim_mini_v3.test) ----------------------------------------------
+
+class MiniV3 : public NodeSim {
+ protected:
+  // The odometry against the ground truth since `start`: within 1 % of the distance + 2 cm.
+  static void expect_odometry_within_budget(const nav_msgs::Odometry& odom0,
+                                            const nav_msgs::Odometry& truth0, double distance) {
+    const auto odom = *odom_.get();
+    const auto truth = *truth_.get();
+    const double tolerance = 0.02 + 0.01 * distance;
+    const double dx_odom = odom.pose.pose.position.x - odom0.pose.pose.position.x;
+    const double dy_odom = odom.pose.pose.position.y - odom0.pose.pose.position.y;
+    const double dx_truth = truth.pose.pose.position.x - truth0.pose.pose.position.x;
+    const double dy_truth = truth.pose.pose.position.y - truth0.pose.pose.position.y;
+    EXPECT_LE(std::hypot(dx_odom - dx_truth, dy_odom - dy_truth), tolerance)
+        << "odometry off by more than 1 % of " << distance << " m + 2 cm";
+    const double turned_odom = std::remainder(yaw_of(odom) - yaw_of(odom0), 2 * M_PI);
+    const double turned_truth = std::remainder(yaw_of(truth) - yaw_of(truth0), 2 * M_PI);
+    EXPECT_LT(std::abs(std::remainder(turned_odom - turned_truth, 2 * M_PI)), M_PI / 180.0);
+  }
+  static std::string drive_mode_diagnostic() {
+    const auto d = diagnostic(std::string(ranger::kDiagControl));
+    return d ? value_of(*d, "Drive mode") : "<no diagnostics>";
+  }
+};
+
+TEST_F(MiniV3, TheDriveModeIsSetThroughItsServiceAndReported) {
+  ASSERT_TRUE(wait_for([] { return state_.get()->drive_mode_name == "current"; }));
+  EXPECT_EQ(state_.get()->drive_mode, SystemState::DRIVE_MODE_CURRENT);
+  ros::ServiceClient drive = nh_->serviceClient<ranger_msgs::SetDriveMode>("set_drive_mode");
+  ASSERT_TRUE(drive.waitForExistence(ros::Duration(10.0)));
+  ranger_msgs::SetDriveMode srv;
+  srv.request.mode = ranger_msgs::SetDriveMode::Request::VOLTAGE;
+  ASSERT_TRUE(drive.call(srv));
+  EXPECT_TRUE(srv.response.success) << srv.response.message;
+  EXPECT_EQ(srv.response.message, "the chassis reports drive mode voltage");
+  EXPECT_EQ(srv.response.drive_mode, SystemState::DRIVE_MODE_VOLTAGE);
+  ASSERT_TRUE(wait_for([] { return state_.get()->drive_mode_name == "voltage"; }));
+  EXPECT_EQ(state_.get()->drive_mode, SystemState::DRIVE_MODE_VOLTAGE);
+  EXPECT_TRUE(wait_for([] { return drive_mode_diagnostic() == "voltage"; }))
+      << drive_mode_diagnostic();
+  srv.request.mode = 7;
+  ASSERT_TRUE(drive.call(srv));
+  EXPECT_FALSE(srv.response.success);
+  EXPECT_NE(srv.response.message.find("nothing sent"), std::string::npos);
+  srv.request.mode = ranger_msgs::SetDriveMode::Request::CURRENT;
+  ASSERT_TRUE(drive.call(srv));
+  EXPECT_TRUE(srv.response.success) << srv.response.message;
+}
+
+TEST_F(MiniV3, DrivesEveryModeWithinTheOdometryBudgetAndReportsRearOdometry) {
+  EXPECT_EQ(state_.get()->protocol_profile, "mini_v3");
+  struct Mode {
+    geometry_msgs::Twist twist;
+    std::uint8_t mode;
+    double distance;  // m the truth should cover (or rad turned, for the spin)
+  } modes[] = {{twist(0.6, 0.0, 0.4), SystemState::MOTION_MODE_ACKERMANN, 1.5},
+               {twist(0.0, 0.4, 0.0), SystemState::MOTION_MODE_OBLIQUE, 1.0},
+               {twist(0.0, 0.0, 0.8), SystemState::MOTION_MODE_SPIN, 2.0}};
+  for (const Mode& m : modes) {
+    const auto odom0 = *odom_.get();
+    const auto truth0 = *truth_.get();
+    double travelled = 0.0, turned = 0.0, last_yaw = yaw_of(truth0);
+    auto last = truth0.pose.pose.position;
+    ASSERT_TRUE(drive_until(
+        m.twist,
+        [&] {
+          const auto t = *truth_.get();
+          travelled += std::hypot(t.pose.pose.position.x - last.x, t.pose.pose.position.y - last.y);
+          turned += std::abs(std::remainder(yaw_of(t) - last_yaw, 2 * M_PI));
+          last = t.pose.pose.position;
+          last_yaw = yaw_of(t);
+          return (m.mode == SystemState::MOTION_MODE_SPIN ? turned : travelled) > m.distance;
+        }))
+        << "mode " << int(m.mode);
+    EXPECT_EQ(state_.get()->motion_mode, m.mode);
+    stop_and_settle();
+    expect_odometry_within_budget(odom0, truth0, travelled);
+  }
+  // The chassis's own odometers, front and rear, in metres.
+  const auto s = *state_.get();
+  for (double d : {s.front_left_distance, s.front_right_distance, s.rear_left_distance,
+                   s.rear_right_distance}) {
+    EXPECT_TRUE(std::isfinite(d));
+    EXPECT_NE(d, 0.0);
+  }
+}
+
+TEST_F(MiniV3, WhatItLacksIsRefusedByName) {
+  ros::ServiceClient lights = nh_->serviceClient<ranger_msgs::SetLights>("set_lights");
+  ranger_msgs::SetLights l;
+  l.request.front_mode = ranger_msgs::SetLights::Request::ON;
+  l.request.rear_mode = ranger_msgs::SetLights::Request::ON;
+  ASSERT_TRUE(lights.call(l));
+  EXPECT_FALSE(l.response.success);
+  EXPECT_NE(l.response.message.find("a rear light: unsupported by protocol mini_v3"),
+            std::string::npos)
+      << l.response.message;
+  l.request.rear_mode = ranger_msgs::SetLights::Request::OFF;
+  l.request.front_mode = ranger_msgs::SetLights::Request::BREATHING;
+  ASSERT_TRUE(lights.call(l));
+  EXPECT_NE(l.response.message.find("breathing lights: unsupported by protocol mini_v3"),
+            std::string::npos)
+      << l.response.message;
+  l.request.front_mode = ranger_msgs::SetLights::Request::OFF;
+  ASSERT_TRUE(lights.call(l));
+  EXPECT_TRUE(l.response.success) << l.response.message;
+  ros::ServiceClient modes = nh_->serviceClient<ranger_msgs::SetMotionMode>("set_motion_mode");
+  ranger_msgs::SetMotionMode m;
+  m.request.mode = ranger_msgs::SetMotionMode::Request::SIDE_SLIP;
+  ASSERT_TRUE(modes.call(m));
+  EXPECT_FALSE(m.response.success);
+  EXPECT_NE(m.response.message.find("side_slip: unsupported by protocol mini_v3"),
+            std::string::npos)
+      << m.response.message;
+}
+
+TEST_F(MiniV3, TheBmsAlarmsReachSystemStateAndDiagnostics) {
+  inject("battery 8");  // below the 10 % cut-off: the pack's under-voltage alarm
+  ASSERT_TRUE(wait_for([] {
+    const auto s = state_.get();  // held: the state may be replaced meanwhile
+    return std::find(s->bms_alarms.begin(), s->bms_alarms.end(), "under_voltage") !=
+           s->bms_alarms.end();
+  }));
+  // The diagnostics come once a second.
+  EXPECT_TRUE(wait_for([] {
+    const auto d = diagnostic(std::string(ranger::kDiagBattery));
+    return d && value_of(*d, "BMS alarms").find("under_voltage") != std::string::npos;
+  }));
+  EXPECT_TRUE(wait_for([] { return state_.get()->errors.battery_under_voltage; }));
+  inject("battery 90");
+}
+
 // ---- safety through ROS: the re-arm latch, resume, sim/inject ------------------------
 
 class Safety : public NodeSim {
@@ -1252,12 +1386,14 @@ TEST_F(Faults, ClearErrorsAnswersThenTheLatchHoldsUntilResume) {
 
 class FaultBits : public Faults {
  protected:
-  // The error-word layout of the chassis (the test's private parameter): "manual" or "agx_v2".
+  // The error-word layout of the chassis (the test's private parameter): "manual", "agx_v2" or
+  // "mini_v3".
   static ranger::ErrorWordLayout layout() {
     std::string name = "manual";
     ros::param::get("~layout", name);
-    return name == "agx_v2" ? ranger::ErrorWordLayout::kAgxV2_16
-                            : ranger::ErrorWordLayout::kManual32;
+    if (name == "agx_v2") return ranger::ErrorWordLayout::kAgxV2_16;
+    return name == "mini_v3" ? ranger::ErrorWordLayout::kMini32
+                             : ranger::ErrorWordLayout::kManual32;
   }
 
   // The value /diagnostics' error status gives `key` (empty when absent).

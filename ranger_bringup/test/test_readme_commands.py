@@ -26,7 +26,7 @@ def test_the_extraction_finds_the_documented_commands():
         ("README.md", "rosrun ranger_bringup bringup_can2usb.bash"),
         ("README.md", "roslaunch ranger_bringup ranger_minimal.launch ns:=robot1"),
         ("README.md", "roslaunch ranger_bringup ranger_minimal.launch sim:=true"),
-        ("README.md", "ranger_can decode [FILE] [--json] [--protocol auto|manual|agx_v2] "
+        ("README.md", "ranger_can decode [FILE] [--json] [--protocol auto|manual|agx_v2|mini_v3] "
                       "[--set NAME=VALUE]..."),
         ("ranger_base/README.md", "rosrun ranger_base ranger_base_node _port_name:=sim"),
         ("ranger_bringup/README.md", "roslaunch ranger_bringup ranger_sim.launch rviz:=true"),

@@ -6,7 +6,8 @@ each signal's range) are written to a candump log, decoded by `ranger_can decode
 --protocol REVISION` and by cantools (installed from PyPI into a virtual environment this script
 creates, or reuses), and every signal is compared with the C++ field it describes. Also checked:
 the DBC's messages are the frame table's of the revision (protocol.hpp's kFrameTable, parsed
-here: identifiers, lengths, sender, GenMsgCycleTime = the nominal period); the DBC and the codec
+here: identifiers, the revision's column of lengths, sender, GenMsgCycleTime = the nominal
+period); the DBC and the codec
 know the same IDs with the same lengths (a DBC length longer than the
 codec's layout shows as extra bytes, a shorter one as an error); every JSON field the codec prints
 for a frame is covered by some DBC signal (or is one the revision leaves reserved); a steering
@@ -18,7 +19,7 @@ mistake planted each (a wrong scale, a flipped sign, two error bits swapped, a m
 must report disagreements; a check that misses one of them proves nothing.
 
 usage: check_dbc.py --cli PATH/ranger_can --dbc ranger_REV.dbc --protocol REV --venv DIR
-                    --work DIR [--other-dbc ranger_OTHER.dbc] [--frames N]
+                    --work DIR [--other-dbc ranger_OTHER.dbc ...] [--frames N]
 Exit status 0 when everything agrees, 1 on any disagreement (each one printed), 2 on set-up errors.
 """
 import argparse
@@ -31,15 +32,18 @@ import subprocess
 import sys
 
 IN_VENV_FLAG = "--in-venv"
+# The revisions in the order of the frame table's length columns (profile.hpp's FrameLayout).
+REVISIONS = ("manual", "agx_v2", "mini_v3")
 
 
 def parse_args(argv):
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--cli", required=True, help="the ranger_can executable")
     p.add_argument("--dbc", required=True, help="the DBC file to check")
-    p.add_argument("--protocol", required=True, choices=["manual", "agx_v2"],
+    p.add_argument("--protocol", required=True, choices=list(REVISIONS),
                    help="the protocol revision the DBC describes (ranger_can --protocol)")
-    p.add_argument("--other-dbc", help="the other revision's DBC: its IDs that this DBC does not "
+    p.add_argument("--other-dbc", action="append", default=[],
+                   help="another revision's DBC (repeatable): its IDs that this DBC does not "
                    "list are known to the codec under every profile and are not checked here")
     p.add_argument("--venv", required=True, help="virtual environment for cantools (created if absent)")
     p.add_argument("--work", required=True, help="directory for the generated log")
@@ -92,8 +96,8 @@ def same(key, index=None):
 
 
 # How a revision's steering angles relate to the codec's convention (rad, positive = right):
-# the manual's are positive right, agx_v2's positive left.
-STEERING_SIGN = {"manual": 1.0, "agx_v2": -1.0}
+# the manual's are positive right, agx_v2's and mini_v3's positive left.
+STEERING_SIGN = {"manual": 1.0, "agx_v2": -1.0, "mini_v3": -1.0}
 
 
 def angle_of(key, unit, sign, index=None):
@@ -123,6 +127,17 @@ def bit_named(list_key, name, inverted=False):
     return rule
 
 
+def odometer_m(key_m, key_raw):
+    """A distance in metres (the MINI 3.0's odometers): the codec's metres, and its raw value the
+    same distance in millimetres."""
+    def rule(v, o):
+        c = o.get(key_m)
+        ok = isinstance(c, (int, float)) and close(v, c) and o.get(key_raw) == round(v * 1000)
+        return c, ok
+    rule.keys = {key_m, key_raw}
+    return rule
+
+
 def version_char(i):
     """0x4A1: char_i of the DBC against the C++ text (trailing NUL bytes are padding), or the
     request (byte 0 = 0x01, nothing else)."""
@@ -141,14 +156,21 @@ WHEELS = ["front_right", "rear_right", "rear_left", "front_left"]
 META = {"t", "iface", "id", "name", "dlc", "data"}
 DERIVED = {"mode_name", "vehicle_status_name", "control_mode_name", "description", "critical",
            "status", "error_bits", "driver_status", "alarm1", "alarm2", "warning1", "warning2",
-           "front_mode_name", "rear_mode_name", "swa_name", "swb_name", "swc_name", "swd_name"}
+           "front_mode_name", "rear_mode_name", "swa_name", "swb_name", "swc_name", "swd_name",
+           "drive_mode_name"}
 # Fields that are not carried by a signal but by the frame ID (checked separately).
-BY_ID = {"motor", "battery", "first_sensor"}
+BY_ID = {"motor", "battery", "first_sensor", "axle"}
 # Fields the codec reads under every profile that a revision leaves reserved (and its DBC does
 # not describe): agx_v2's yaw rate and lateral speed in the manual's reserved bytes.
 RESERVED = {"manual": {"motion_command": {"yaw_rate"},
                        "motion_feedback": {"yaw_rate", "lateral_speed"}},
-            "agx_v2": {}}
+            "agx_v2": {},
+            # The MINI 3.0: 0x111 bytes 4-5 zero, 0x221's lateral speed reserved (zero), the
+            # lights' bytes 2-7 (0x231: 2-6) reserved.
+            "mini_v3": {"motion_command": {"spin_speed"},
+                        "motion_feedback": {"lateral_speed"},
+                        "light_command": {"front_custom", "rear_mode", "rear_custom", "counter"},
+                        "light_state": {"front_custom", "rear_mode", "rear_custom"}}}
 # Signals whose DBC range is the plausible range: outside it the codec refuses the frame.
 PLAUSIBLE = {"MotionFeedback": {"steering_angle"},
              "SteeringAngles": {f"angle_{w}" for w in WHEELS}}
@@ -215,7 +237,12 @@ def rules_for(message, revision):
     if n == "WheelSpeeds":
         return "wheel_speeds", {f"speed_{w}": same("speeds", i) for i, w in enumerate(WHEELS)}, {}
     if n == "MotionModeFeedback":
-        return "motion_mode", {"mode": same("mode"), "switching": flag("switching")}, {}
+        rules = {"mode": same("mode"), "switching": flag("switching")}
+        if "drive_mode" in sigs:  # the MINI 3.0's third byte
+            rules["drive_mode"] = same("drive_mode")
+        return "motion_mode", rules, {}
+    if n == "DriveModeCommand":
+        return "drive_mode_command", {"mode": same("mode")}, {}
     if n.startswith("Ultrasonic") and n[-4:] in ("1to4", "5to8"):
         first = int(n[-4])
         return "ultrasonic", {f"distance_{first + i}": same("raw", i) for i in range(4)}, \
@@ -233,13 +260,18 @@ def rules_for(message, revision):
     if n in ("LightCommand", "LightState"):
         rules = {"enable": flag("enable")}
         rules.update({k: same(k) for k in ("front_mode", "front_custom", "rear_mode",
-                                           "rear_custom", "counter")})
+                                           "rear_custom", "counter") if k in sigs})
         return ("light_command" if n == "LightCommand" else "light_state"), rules, {}
     if n == "RemoteControlState":
         return "remote_control", {s: same(s) for s in sigs}, {}
-    if n == "Odometer":
-        return "odometer", {"left_wheel": same("left_wheel"),
-                            "right_wheel": same("right_wheel")}, {}
+    if n in ("Odometer", "RearOdometer"):
+        name, axle = ("odometer", "front") if n == "Odometer" else ("rear_odometer", "rear")
+        if "left_distance" in sigs:  # in metres (the MINI 3.0's mm)
+            return name, {"left_distance": odometer_m("left_distance", "left_wheel"),
+                          "right_distance": odometer_m("right_distance", "right_wheel")}, \
+                {"axle": axle}
+        return name, {"left_wheel": same("left_wheel"),
+                      "right_wheel": same("right_wheel")}, {"axle": axle}
     if n == "Version":
         return "version", {f"char_{i}": version_char(i) for i in range(8)}, {}
     return None, {}, {}
@@ -407,15 +439,18 @@ def frame_table(header):
     start = text.index("kFrameTable[] = {")
     body = text[start:text.index("};", start)]
     row_re = re.compile(r'\{([^{}",]+),\s*([^,]+),\s*(\d+),\s*"(\w+)",\s*Direction::k(\w+),'
-                        r'\s*(\d+),\s*(\d+),\s*([\w| ]+)\}')
+                        r'\s*(\d+),\s*\{([\d, ]+)\}\}')
     table = {}
     for m in row_re.finditer(body):
         first = eval(m.group(1), {}, dict(consts))  # our own source: constants and + only
         count = eval(m.group(2), {}, dict(consts))
         stride = int(m.group(3))
-        row = {"name": m.group(4), "direction": m.group(5), "length": int(m.group(6)),
-               "period": int(m.group(7)),
-               "revisions": {w.strip() for w in m.group(8).split("|")}}
+        lengths = [int(w) for w in m.group(7).split(",")]
+        if len(lengths) != len(REVISIONS):
+            die(f"{header}: row {m.group(4)} has {len(lengths)} lengths, not one per revision "
+                f"({', '.join(REVISIONS)})")
+        row = {"name": m.group(4), "direction": m.group(5), "period": int(m.group(6)),
+               "lengths": lengths}
         for i in range(count):
             table[first + i * stride] = row
     if not table:
@@ -424,9 +459,10 @@ def frame_table(header):
 
 
 def check_frame_table(messages, table, protocol):
-    """The DBC's messages against the frame table's frames of `protocol`."""
-    revision = "kInManual" if protocol == "manual" else "kInAgxV2"
-    expected = {i: r for i, r in table.items() if revision in r["revisions"]}
+    """The DBC's messages against the frame table's frames of `protocol` (its column of lengths)."""
+    column = REVISIONS.index(protocol)
+    expected = {i: dict(r, length=r["lengths"][column]) for i, r in table.items()
+                if r["lengths"][column] > 0}
     senders = {"ToChassis": "Host", "FromChassis": "Chassis"}
     problems = []
     for m in messages:
@@ -463,8 +499,8 @@ def main():
     rng = random.Random(args.seed)
     messages = sorted(db.messages, key=lambda m: m.frame_id)
     other_ids = set()
-    if args.other_dbc:
-        other_ids = {m.frame_id for m in cantools.database.load_file(args.other_dbc).messages}
+    for other in args.other_dbc:
+        other_ids |= {m.frame_id for m in cantools.database.load_file(other).messages}
 
     table_problems = check_frame_table(messages, frame_table(args.frame_table), args.protocol)
     if table_problems:

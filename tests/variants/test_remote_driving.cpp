@@ -203,7 +203,9 @@ INSTANTIATE_TEST_SUITE_P(LockStep, RemoteDriving,
                                            Case{"agx_v2", OdometrySource::kWheels},
                                            Case{"agx_v2", OdometrySource::kMotion},
                                            Case{"mini_v1", OdometrySource::kWheels},
-                                           Case{"mini_v1", OdometrySource::kMotion}),
+                                           Case{"mini_v1", OdometrySource::kMotion},
+                                           Case{"mini_v3", OdometrySource::kWheels},
+                                           Case{"mini_v3", OdometrySource::kMotion}),
                          [](const ::testing::TestParamInfo<Case>& p) {
                            return p.param.variant + "_" + std::string(to_string(p.param.source));
                          });
@@ -352,7 +354,9 @@ INSTANTIATE_TEST_SUITE_P(
                       AutoCase{"steer_left_positive", "arc"}, AutoCase{"inner_angle", "spin"},
                       AutoCase{"manual", "idle_arc"}, AutoCase{"agx_v2", "idle_arc"},
                       AutoCase{"mini_v1", "idle_arc"}, AutoCase{"manual", "spin_at_rest"},
-                      AutoCase{"agx_v2", "spin_at_rest"}, AutoCase{"mini_v1", "spin_at_rest"}),
+                      AutoCase{"agx_v2", "spin_at_rest"}, AutoCase{"mini_v1", "spin_at_rest"},
+                      AutoCase{"mini_v3", "arc"}, AutoCase{"mini_v3", "spin"},
+                      AutoCase{"mini_v3", "idle_arc"}, AutoCase{"mini_v3", "spin_at_rest"}),
     [](const ::testing::TestParamInfo<AutoCase>& p) {
       return p.param.variant + "_" + p.param.first;
     });

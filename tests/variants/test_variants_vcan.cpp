@@ -1,7 +1,7 @@
-// The variants whose difference is on the wire itself (manual, agx_v2, padded) over real SocketCAN
-// on vcan0: the virtual chassis on its own thread (VirtualChassisRunner), the driver runtime on
-// its own (Driver::start), both on the real clock; the route of variant_route.hpp, shortened, with
-// the wheel odometry. Needs vcan0 (fails, never skips, without it); run by
+// The variants whose difference is on the wire itself (manual, agx_v2, padded, mini_v3) over real
+// SocketCAN on vcan0: the virtual chassis on its own thread (VirtualChassisRunner), the driver
+// runtime on its own (Driver::start), both on the real clock; the route of variant_route.hpp,
+// shortened, with the wheel odometry. Needs vcan0 (fails, never skips, without it); run by
 // scripts/run_vcan_tests.sh natively or inside the throwaway VM. Time limits are generous
 // (timing_slack); the test's thread only re-issues the command and looks.
 #include <thread>
@@ -94,7 +94,8 @@ TEST_P(VcanVariants, DrivesTheRouteWithOdometryWithinBudget) {
               route(config.controller.limits, config.controller.geometry, 0.5));
 }
 
-INSTANTIATE_TEST_SUITE_P(Vcan, VcanVariants, ::testing::Values("manual", "agx_v2", "padded"));
+INSTANTIATE_TEST_SUITE_P(Vcan, VcanVariants,
+                         ::testing::Values("manual", "agx_v2", "padded", "mini_v3"));
 
 }  // namespace
 }  // namespace ranger::variants

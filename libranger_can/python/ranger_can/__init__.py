@@ -255,6 +255,12 @@ class Driver:
         self._check_open()
         return self._request("park", self._s.set_park(bool(on)), timeout)
 
+    def set_drive_mode(self, mode: str, timeout: Optional[float] = None) -> RequestOutcome:
+        """The motor drivers' drive mode ("current" or "voltage"; 0x423, the RANGER MINI 3.0's);
+        answered once the chassis reports it. RequestFailed on a protocol without drive modes."""
+        self._check_open()
+        return self._request("drive_mode", self._s.set_drive_mode(mode), timeout)
+
     def firmware_version(self, timeout: Optional[float] = None) -> str:
         """Asks the chassis for its firmware version (0x4A1) and returns the text."""
         self._check_open()
@@ -263,7 +269,7 @@ class Driver:
 
     def budget(self, kind: str) -> float:
         """How long a request of `kind` ("resume", "clear_errors", "ultrasonic", "lights",
-        "park", "firmware_version") is waited for by default, in s."""
+        "park", "drive_mode", "firmware_version") is waited for by default, in s."""
         return self._s.budget(kind)
 
     # ---- the virtual chassis ----

@@ -108,6 +108,9 @@ class Snapshot:
     plausibility_warnings: List[str]; plausibility_stop: Optional[str]
     vendor_frames: str; remote: Optional[RemoteState]; lights: Optional[Lights]
     firmware_version: str; firmware_state: str
+    drive_mode: Optional[str]; drive_mode_raw: Optional[int]
+    wheel_odometers: Tuple[float, float, float, float]
+    bms_alarms: List[str]; bms_warnings: List[str]
     frames: List[FrameCount]; requests: List[RequestOutcome]; loop_iterations: int
 
 class _Session:

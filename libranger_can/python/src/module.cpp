@@ -9,7 +9,9 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <array>
 #include <chrono>
+#include <limits>
 #include <sstream>
 #include <string>
 
@@ -320,8 +322,9 @@ PYBIND11_MODULE(_ranger_can, m) {
       .def_readonly("severity", &EventView::severity)
       .def_readonly("text", &EventView::text)
       .def_readonly("json", &EventView::json)
-      .def("__repr__",
-           [](const EventView& e) { return "Event(" + e.severity + " " + e.kind + ": " + e.text + ")"; });
+      .def("__repr__", [](const EventView& e) {
+        return "Event(" + e.severity + " " + e.kind + ": " + e.text + ")";
+      });
   py::class_<GroundTruthView>(m, "GroundTruth")
       .def_readonly("x", &GroundTruthView::x)
       .def_readonly("y", &GroundTruthView::y)
@@ -398,10 +401,9 @@ PYBIND11_MODULE(_ranger_can, m) {
                              [](const S& s) { return name_of(s.c().mode_override); })
       .def_property_readonly("refusal",
                              [](const S& s) { return std::string(to_string(s.c().refusal)); })
-      .def_property_readonly("refusal_detail",
-                             [](const S& s) {
-                               return describe_refusal(s.c(), s.s().identification.get());
-                             })
+      .def_property_readonly(
+          "refusal_detail",
+          [](const S& s) { return describe_refusal(s.c(), s.s().identification.get()); })
       .def_property_readonly("rearm_required", [](const S& s) { return s.c().rearm_required(); })
       .def_property_readonly("latched_causes",
                              [](const S& s) { return cause_names(s.c().latched_causes); })
@@ -471,6 +473,39 @@ PYBIND11_MODULE(_ranger_can, m) {
                              [](const S& s) { return std::string(to_string(s.s().vendor_frames)); })
       .def_property_readonly("remote", [](const S& s) { return remote_view(s.s()); })
       .def_property_readonly("lights", [](const S& s) { return lights_view(s.s()); })
+      .def_property_readonly("drive_mode", [](const S& s) { return name_of(s.s().drive_mode); })
+      .def_property_readonly("drive_mode_raw",
+                             [](const S& s) -> std::optional<int> {
+                               if (!s.s().drive_mode) return std::nullopt;
+                               return static_cast<int>(*s.s().drive_mode);
+                             })
+      .def_property_readonly("wheel_odometers",
+                             [](const S& s) {
+                               // front left, front right, rear left, rear right (m; NaN: none)
+                               const auto& fb = s.s().feedback;
+                               std::array<double, 4> out{};
+                               const auto fill = [&](const auto& o, double& l, double& r) {
+                                 const double nan = std::numeric_limits<double>::quiet_NaN();
+                                 l = o ? o->value.left_distance.value_or(nan) : nan;
+                                 r = o ? o->value.right_distance.value_or(nan) : nan;
+                               };
+                               fill(fb.odometer, out[0], out[1]);
+                               fill(fb.rear_odometer, out[2], out[3]);
+                               return out;
+                             })
+      .def_property_readonly("bms_alarms",
+                             [](const S& s) {
+                               const auto& a = s.s().feedback.bms_alarm[0];
+                               if (!a) return std::vector<std::string>{};
+                               return protocol::bms_status_names(a->value.alarm1, a->value.alarm2);
+                             })
+      .def_property_readonly("bms_warnings",
+                             [](const S& s) {
+                               const auto& a = s.s().feedback.bms_alarm[0];
+                               if (!a) return std::vector<std::string>{};
+                               return protocol::bms_status_names(a->value.warning1,
+                                                                 a->value.warning2);
+                             })
       .def_property_readonly("firmware_version", [](const S& s) { return s.s().firmware.text; })
       .def_property_readonly(
           "firmware_state", [](const S& s) { return std::string(to_string(s.s().firmware.state)); })
@@ -580,6 +615,17 @@ PYBIND11_MODULE(_ranger_can, m) {
           py::arg("front"), py::arg("front_brightness"), py::arg("rear"),
           py::arg("rear_brightness"))
       .def("set_park", [](PySession& p, bool on) { return p.s().driver().set_park(on); })
+      .def(
+          "set_drive_mode",
+          [](PySession& p, const std::string& mode) {
+            const auto m = protocol::kDriveModeNames.parse(mode);
+            if (!m) {
+              invalid("drive mode \"" + mode + "\" unknown: one of " +
+                      text::join(protocol::kDriveModeNames.names()));
+            }
+            return p.s().driver().set_drive_mode(*m);
+          },
+          py::arg("mode"))
       .def("request_firmware_version",
            [](PySession& p) { return p.s().driver().request_firmware_version(); })
       .def(

@@ -86,7 +86,7 @@ def test_readme_example_runs_as_written():
     assert refusal in ("none", "cmd_timeout")
 
 
-@pytest.mark.parametrize("port", ["sim", "sim:agx_v2"])
+@pytest.mark.parametrize("port", ["sim", "sim:agx_v2", "sim:mini_v3"])
 def test_drives_every_mode_with_odometry_following_the_ground_truth(port):
     with ranger_can.Driver(port) as d:
         s = d.wait_ready(timeout=30)
@@ -189,11 +189,31 @@ def test_park_and_lights_on_agx_v2():
         assert d.firmware_version() == "ranger_sim 0.1.0"
 
 
+def test_drive_mode_and_wheel_odometers_on_the_mini_v3():
+    with ranger_can.Driver("sim:mini_v3") as d:
+        d.wait_ready(timeout=30)
+        assert d.snapshot().protocol == "mini_v3"
+        outcome = d.set_drive_mode("voltage")
+        assert outcome.state == "answered"
+        s = d.snapshot()
+        assert (s.drive_mode, s.drive_mode_raw) == ("voltage", 1)
+        d.set_drive_mode("current")
+        assert d.snapshot().drive_mode == "current"
+        with pytest.raises(RangerError, match="drive mode \"torque\" unknown: one of current"):
+            d.set_drive_mode("torque")
+        d.command(vx=0.3)
+        d.wait_until(lambda s: all(abs(x) > 0.05 for x in s.wheel_odometers), timeout=10)
+        d.command(vx=0.0)
+
+
 def test_vendor_features_refused_by_name_on_the_manuals_chassis(sim):
     with pytest.raises(RequestFailed, match="unsupported by protocol"):
         sim.set_lights(front="on", rear="on")
     with pytest.raises(RequestFailed, match="park: unsupported"):
         sim.park(True)
+    with pytest.raises(RequestFailed, match="unsupported by protocol manual"):
+        sim.set_drive_mode("voltage")
+    assert sim.snapshot().drive_mode is None
     with pytest.raises(RangerError, match="side_slip: unsupported by protocol manual"):
         sim.set_motion_mode("side_slip")
 

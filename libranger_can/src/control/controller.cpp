@@ -319,6 +319,21 @@ Status ChassisController::clear_errors(std::uint8_t code, Timestamp now) {
   return ok_status();
 }
 
+Status ChassisController::refuse_unsupported(const Message& command) const {
+  const auto missing = unsupported_feature(command, config_.profile);
+  if (!missing) return ok_status();
+  return Error{Errc::kInvalidArgument, missing->feature + ": unsupported by protocol " +
+                                           config_.profile.revision + " (" + missing->reason + ")"};
+}
+
+Status ChassisController::set_drive_mode(protocol::DriveMode mode, Timestamp now) {
+  state_.now = now;
+  const DriveModeCommand command{mode};
+  if (Status st = refuse_unsupported(command); !st) return st;
+  if (!send(command, now)) return Error{Errc::kIoError, state_.last_error};
+  return ok_status();
+}
+
 Status ChassisController::set_ultrasonic(bool enable, Timestamp now) {
   state_.now = now;
   state_.ultrasonic_requested = enable;
@@ -355,6 +370,7 @@ Status ChassisController::request_park(bool on, Timestamp now) {
 
 Status ChassisController::set_lights(const LightCommand& lights, Timestamp now) {
   state_.now = now;
+  if (Status st = refuse_unsupported(lights); !st) return st;
   LightCommand c = lights;
   c.counter = light_counter_++;
   ++state_.counters.light_commands;

@@ -33,6 +33,18 @@ std::string name_or_unknown(const std::optional<Enum>& v, const char* unknown = 
   return v ? std::string(to_string(*v)) : std::string(unknown);
 }
 
+// The drive mode and the wheels' own odometers, where the chassis reports them (the RANGER MINI
+// 3.0's 0x291 byte 2, 0x311/0x312 in metres).
+void add_drive_mode_and_odometers(const DriverSnapshot& s, DiagnosticGroup& out) {
+  if (s.drive_mode) out.add("Drive mode", std::string(to_string(*s.drive_mode)));
+  for (const auto* o : {&s.feedback.odometer, &s.feedback.rear_odometer}) {
+    if (!*o || !(*o)->value.left_distance || !(*o)->value.right_distance) continue;
+    const auto& v = (*o)->value;
+    out.add(v.rear ? "Odometer rear left / right (m)" : "Odometer front left / right (m)",
+            text::fixed(*v.left_distance, 3) + " / " + text::fixed(*v.right_distance, 3));
+  }
+}
+
 // The link group's summary from the bus state and the chassis link (the values are added).
 void summarise_link(const DriverSnapshot& s, DiagnosticGroup& out) {
   switch (s.bus.state) {
@@ -219,6 +231,7 @@ DiagnosticGroup diagnose_control(const DriverSnapshot& s) {
   out.add("Motion mode pinned", name_or_unknown(c.mode_override, "automatic"));
   out.add("Mode switch", std::string(to_string(c.mode_switch.phase)));
   out.add("Park", c.park_requested ? (c.parked() ? "parked" : "parking") : "released");
+  add_drive_mode_and_odometers(s, out);
   if (s.lights) {
     out.add("Lights", describe(s.lights->front, s.lights->front_brightness, s.lights->rear,
                                s.lights->rear_brightness) +
@@ -324,6 +337,8 @@ DiagnosticGroup diagnose_battery(const DriverSnapshot& s) {
   }
   if (const auto& alarm = fb.bms_alarm[0]) {
     const auto& a = alarm->value;
+    out.add("BMS alarms", join(bms_status_names(a.alarm1, a.alarm2)));
+    out.add("BMS warnings", join(bms_status_names(a.warning1, a.warning2)));
     if (a.alarm1 != 0 || a.alarm2 != 0) {
       out.merge_summary(L::kError, "BMS alarm " + hex(a.alarm1, 2) + " " + hex(a.alarm2, 2));
     } else if (a.warning1 != 0 || a.warning2 != 0) {

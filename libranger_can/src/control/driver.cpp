@@ -175,6 +175,18 @@ std::uint64_t Driver::set_park(bool on) {
   return post(RequestOutcome::Kind::kPark, std::string("park ") + (on ? "on" : "off"), on, 0);
 }
 
+std::uint64_t Driver::set_drive_mode(protocol::DriveMode mode) {
+  const std::uint64_t id =
+      requests_.add(RequestOutcome::Kind::kDriveMode,
+                    "drive_mode " + std::string(protocol::to_string(mode)), false, {}, mode);
+  mailbox_.post([&](DriverMail& m) {
+    m.actions.push_back(
+        {RequestOutcome::Kind::kDriveMode, id, static_cast<std::uint8_t>(mode), false});
+  });
+  waker_.wake();
+  return id;
+}
+
 void Driver::standstill_probe(std::optional<StandstillProbe> probe) {
   mailbox_.post([&](DriverMail& m) { m.probe = probe; });
   waker_.wake();
@@ -232,6 +244,7 @@ std::chrono::nanoseconds Driver::answer_budget(RequestOutcome::Kind kind) const 
     case RequestOutcome::Kind::kResume:
       return answer;
     case RequestOutcome::Kind::kClearErrors:
+    case RequestOutcome::Kind::kDriveMode:
       return answer + kMargin;
     case RequestOutcome::Kind::kUltrasonic:
       return c.ultrasonic_confirm_timeout * (c.ultrasonic_max_attempts + 1);
@@ -283,7 +296,8 @@ void Driver::handle_frame(const CanFrame& frame, Timestamp now) {
     return;
   }
   Result<Message> message = decode(frame, profile_);
-  if (frames_.record(frame.id, now, message.ok(), protocol::extra_bytes(frame))) {
+  if (frames_.record(frame.id, now, message.ok(),
+                     protocol::extra_bytes(frame, profile_.frame_layout))) {
     tracker_.frames_padded(frame.id, now, step_events_);
   }
   // While listening, nothing reaches the controller: read under settings not decided yet, a
@@ -334,6 +348,9 @@ void Driver::apply_action(const DriverMail::Action& a, Timestamp now) {
       break;
     case RequestOutcome::Kind::kPark:
       st = controller_->request_park(a.enable, now);
+      break;
+    case RequestOutcome::Kind::kDriveMode:
+      st = controller_->set_drive_mode(static_cast<protocol::DriveMode>(a.code), now);
       break;
     case RequestOutcome::Kind::kResume:
       settings_.resume(*controller_);
@@ -391,6 +408,10 @@ void Driver::publish(Timestamp now) {
   s->remote = vendor_.remote();
   s->lights = vendor_.lights();
   s->firmware = vendor_.firmware();
+  const auto& mode = s->feedback.motion_mode;
+  s->drive_mode = mode && mode->value.drive_mode
+                      ? protocol::drive_mode_from_wire(*mode->value.drive_mode)
+                      : std::nullopt;
   requests_.copy_to(s->requests);
   snapshots_.publish(std::move(s));
 }

@@ -41,7 +41,7 @@ bool ChassisFeedback::record(const Message& message, Timestamp stamp, Timestamp 
         } else if constexpr (std::is_same_v<T, RemoteControlState>) {
           remote_control_state = s;
         } else if constexpr (std::is_same_v<T, OdometerFeedback>) {
-          odometer = s;
+          (m.rear ? rear_odometer : odometer) = s;
         } else if constexpr (std::is_same_v<T, VersionResponse>) {
           constexpr std::size_t kMaxVersion = 64;
           const std::string_view text = m.view();

@@ -301,8 +301,9 @@ Status IdentificationConfig::validate() const {
 std::string unidentified_message(const std::string& reason, std::chrono::nanoseconds timeout) {
   return "the chassis could not be identified within " + duration_text(timeout) +
          " (identify_timeout): " + reason +
-         ". The robot stays at rest. Set the protocol instead of `auto` (protocol: manual or "
-         "protocol: agx_v2, and single settings such as steering_unit_111: millirad), or "
+         ". The robot stays at rest. Set the protocol instead of `auto` (protocol: manual, "
+         "protocol: agx_v2 or protocol: mini_v3, and single settings such as "
+         "steering_unit_111: millirad), or "
          "commission it once with the wheels off the ground: `ranger_can commission IFACE "
          "--wheels-lifted --output FILE`, then load FILE with the parameter commissioning_file";
 }
@@ -393,15 +394,11 @@ void ChassisIdentifier::observe_passive(const CanFrame& frame) {
 void ChassisIdentifier::observe_origin(const CanFrame& frame) {
   const std::uint32_t id = frame.id;
   if (!protocol::is_chassis_frame(frame)) return;  // the host's own commands do not count
-  // Frames only the vendor's revision defines, sent by the chassis (the frame table).
-  if ((protocol::find_frame(id)->revisions & protocol::kInManual) == 0) {
-    const std::string what = text::hex(id) + " (" + std::string(protocol::frame_name(id)) + ")";
-    if (std::find(agx_signatures_.begin(), agx_signatures_.end(), what) == agx_signatures_.end()) {
-      agx_signatures_.push_back(what);
-    }
-  }
-  // Padding: a chassis frame longer than its layout.
-  if (protocol::extra_bytes(frame) > 0 &&
+  const protocol::FrameInfo& info = *protocol::find_frame(id);
+  observe_signatures(frame, info);
+  // Padding: a chassis frame longer than its layout in every revision (0x291 of 3 bytes is the
+  // MINI 3.0's layout, not padding).
+  if (padded(frame, info) &&
       std::find(padded_ids_.begin(), padded_ids_.end(), id) == padded_ids_.end()) {
     padded_ids_.push_back(id);
   }
@@ -485,6 +482,32 @@ void ChassisIdentifier::observe_rolling(const CanFrame& frame) {
       r += ex * ex + ey * ey;
     }
     rigid_residual_[h] += r / norm;
+  }
+}
+
+bool ChassisIdentifier::padded(const CanFrame& frame, const protocol::FrameInfo& info) {
+  if (protocol::extra_bytes(frame, FrameLayout::kManual) == 0) return false;
+  for (const FrameLayout layout : kFrameLayoutNames.values()) {
+    if (protocol::extra_bytes(frame, layout) == 0 && info.in(layout)) return false;
+  }
+  return true;
+}
+
+void ChassisIdentifier::observe_signatures(const CanFrame& frame, const protocol::FrameInfo& info) {
+  auto add = [](std::vector<std::string>& list, std::string what) {
+    if (std::find(list.begin(), list.end(), what) == list.end()) list.push_back(std::move(what));
+  };
+  const std::string what =
+      text::hex(frame.id) + " (" + std::string(protocol::frame_name(frame.id)) + ")";
+  // Frames the manual lacks: one of the vendor's family (agx_v2, mini_v3); frames agx_v2 lacks
+  // too: the MINI 3.0's.
+  if (!info.in(FrameLayout::kManual)) add(agx_signatures_, what);
+  if (!info.in(FrameLayout::kManual) && !info.in(FrameLayout::kAgxV2)) add(mini_signatures_, what);
+  // A length only the MINI 3.0's layout has (0x291 of 3 bytes; 8 would be padding).
+  const int dlc = std::min<int>(frame.dlc, static_cast<int>(CanFrame::kMaxDlc));
+  if (info.in(FrameLayout::kMiniV3) && dlc == info.length(FrameLayout::kMiniV3) &&
+      dlc != info.length(FrameLayout::kManual) && dlc != info.length(FrameLayout::kAgxV2)) {
+    add(mini_signatures_, what + " of " + std::to_string(dlc) + " bytes");
   }
 }
 
@@ -578,6 +601,7 @@ void ChassisIdentifier::tick_listening(Timestamp now) {
     return;
   }
   decide_passive(now);
+  if (status_.done()) return;  // the frames fit no revision
   if (read_only_) {
     decide(now);
   } else {
@@ -838,26 +862,44 @@ void ChassisIdentifier::evaluate_steer(Timestamp now) {
   begin_step(IdentificationPhase::kReturning, now);
 }
 
-void ChassisIdentifier::decide_passive(Timestamp now) {
-  const std::string listened = duration_text(now - status_.started);
-  if (!forced_revision_) {
-    if (!agx_signatures_.empty() || uart_seen_) {
-      status_.revision = "agx_v2";
-      std::string what;
-      for (const auto& s : agx_signatures_)
-        what += (what.empty() ? "" : ", ") + s;
-      if (uart_seen_) what += std::string(what.empty() ? "" : ", ") + "0x211 control mode 2 (UART)";
-      note("heard " + what + ": only the vendor's revision sends it: preset agx_v2");
-    } else {
-      status_.revision = "manual";
-      note(
-          "no frame only the vendor's revision sends (0x231, 0x241, 0x311, 0x4A1 answers, "
-          "control mode UART) in " +
-          listened + ": preset manual");
-    }
-  } else {
+bool ChassisIdentifier::byte7_counts() const {
+  return byte7_steps_ >= kMinByte7Steps && byte7_increments_ * 10 >= byte7_steps_ * 9;
+}
+
+bool ChassisIdentifier::decide_revision(Timestamp now) {
+  if (forced_revision_) {
     note("preset " + status_.revision + " given (not identified)");
+    return true;
   }
+  if (!mini_signatures_.empty() && byte7_counts()) {
+    // The MINI 3.0 carries faults in 0x211 byte 7, the vendor's revision a counter: neither fits.
+    fail("the chassis sends " + text::join(mini_signatures_) +
+             ", which only the RANGER MINI 3.0 (mini_v3) has, but its 0x211 byte 7 counts up "
+             "like agx_v2's counter (the MINI 3.0 carries faults there): no revision fits",
+         now);
+    return false;
+  }
+  if (!mini_signatures_.empty()) {
+    status_.revision = "mini_v3";
+    note("heard " + text::join(mini_signatures_) +
+         ": only the RANGER MINI 3.0's manual has it: preset mini_v3");
+  } else if (!agx_signatures_.empty() || uart_seen_) {
+    status_.revision = "agx_v2";
+    std::string what = text::join(agx_signatures_);
+    if (uart_seen_) what += std::string(what.empty() ? "" : ", ") + "0x211 control mode 2 (UART)";
+    note("heard " + what + ": only the vendor's revision sends it: preset agx_v2");
+  } else {
+    status_.revision = "manual";
+    note(
+        "no frame only the vendor's revision sends (0x231, 0x241, 0x311, 0x312, 0x4A1 answers, "
+        "control mode UART) in " +
+        duration_text(now - status_.started) + ": preset manual");
+  }
+  return true;
+}
+
+void ChassisIdentifier::decide_passive(Timestamp now) {
+  if (!decide_revision(now)) return;  // the frames fit no revision
   if (auto p = protocol_preset(status_.revision)) status_.profile = *p;
   // Frame lengths.
   if (!padded_ids_.empty()) {
@@ -872,14 +914,15 @@ void ChassisIdentifier::decide_passive(Timestamp now) {
          std::to_string(status_.profile.tx_dlc));
   }
   // 0x211 byte 7.
-  if (byte7_steps_ >= kMinByte7Steps && byte7_increments_ * 10 >= byte7_steps_ * 9) {
+  if (byte7_counts()) {
     set(S::kErrorWord, "agx16",
         "0x211 byte 7 rose by one in " + std::to_string(byte7_increments_) + " of " +
             std::to_string(byte7_steps_) + " frames: a counter, so bytes 4-5 are the error word");
   } else if (byte7_steps_ >= kMinByte7Steps && byte7_changes_ == 0) {
     set(S::kErrorWord, to_string(status_.profile.error_word),
         "0x211 byte 7 constant over " + std::to_string(byte7_steps_ + 1) +
-            " frames: no counter; the preset's layout stands");
+            " frames: no counter; the preset's layout (" +
+            std::string(to_string(status_.profile.error_word)) + ") stands");
   } else {
     note("0x211 byte 7 neither counts nor stays constant (" + std::to_string(byte7_changes_) +
          " changes in " + std::to_string(byte7_steps_) + " frames): error_word kept");
@@ -965,7 +1008,7 @@ void ChassisIdentifier::finish(Timestamp now) {
     return;
   }
   decide_passive(now);
-  decide(now);
+  if (!status_.done()) decide(now);
 }
 
 bool ChassisIdentifier::adopt(std::string_view name, std::string_view value, std::string evidence) {

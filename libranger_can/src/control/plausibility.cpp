@@ -218,7 +218,7 @@ void PlausibilityMonitor::on_frame(const CanFrame& frame, Timestamp now) {
     if (!m) return;
     const auto& st = std::get<SystemStatus>(*m);
     status_voltage_ = st.battery_voltage;
-    if (profile_.error_word != ErrorWordLayout::kManual32) return;
+    if (profile_.error_word == ErrorWordLayout::kAgxV2_16) return;  // byte 7 is its counter
     const std::uint8_t b7 = st.counter.value_or(0);
     if (byte7_) {
       ++byte7_steps_;
@@ -230,7 +230,8 @@ void PlausibilityMonitor::on_frame(const CanFrame& frame, Timestamp now) {
            finding("error_word", S::kErrorWord, profile_,
                    "0x211 byte 7 rises by one per frame (" + std::to_string(byte7_increments_) +
                        " of " + std::to_string(byte7_steps_) +
-                       "): a counter, read as phantom motor faults under manual32"),
+                       "): a counter, read as phantom motor faults under " +
+                       std::string(to_string(profile_.error_word))),
            now, {}, {});
     } else if (byte7_steps_ >= 10) {
       counter_.clear();

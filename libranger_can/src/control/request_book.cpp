@@ -129,6 +129,27 @@ std::optional<Verdict> settle_ultrasonic(const RequestOutcome& r, const LightsRe
   return std::nullopt;
 }
 
+std::optional<Verdict> settle_drive_mode(const RequestOutcome& r, const LightsRequest&,
+                                         const RequestEvidence& e, const RequestTiming& t) {
+  const auto& mode = e.feedback->motion_mode;
+  const bool fresh = mode && mode->received >= r.sent + kRequestAnswerDelay;
+  const auto reported = fresh && mode->value.drive_mode
+                            ? protocol::drive_mode_from_wire(*mode->value.drive_mode)
+                            : std::nullopt;
+  if (reported && reported == r.drive_mode) {
+    return Verdict{State::kAnswered,
+                   "the chassis reports drive mode " + std::string(protocol::to_string(*reported)),
+                   std::nullopt};
+  }
+  if (e.now - r.sent <= t.answer_timeout) return std::nullopt;
+  return Verdict{
+      State::kFailed,
+      reported ? "the chassis reports drive mode " + std::string(protocol::to_string(*reported))
+               : "the chassis did not report a drive mode (0x291 byte 2) within " +
+                     within(t.answer_timeout),
+      std::nullopt};
+}
+
 // One rule per kind, in the order of RequestOutcome::Kind (resume is answered when applied).
 constexpr Rule kRules[] = {
     settle_clear_errors,  // kClearErrors
@@ -137,18 +158,21 @@ constexpr Rule kRules[] = {
     settle_lights,        // kLights
     settle_park,          // kPark
     settle_firmware,      // kFirmwareVersion
+    settle_drive_mode,    // kDriveMode
 };
 
 }  // namespace
 
 std::uint64_t RequestBook::add(RequestOutcome::Kind kind, std::string what, bool on,
-                               const LightsRequest& lights) {
+                               const LightsRequest& lights,
+                               std::optional<protocol::DriveMode> drive_mode) {
   std::lock_guard<std::mutex> lock(mutex_);
   Entry e;
   e.outcome.id = next_id_++;
   e.outcome.kind = kind;
   e.outcome.on = on;
   e.outcome.what = std::move(what);
+  e.outcome.drive_mode = drive_mode;
   e.lights = lights;
   entries_.push_back(std::move(e));
   while (entries_.size() > kCapacity)

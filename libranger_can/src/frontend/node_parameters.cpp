@@ -282,7 +282,8 @@ void add_protocol(std::vector<Binding>& out) {
   out.push_back(
       Row("protocol", T::kText, "", {}, d.protocol.protocol,
           "`auto`: identified from the chassis before anything moves (see \"How it runs\"); "
-          "`manual` (the user manual) or `agx_v2` (the vendor's software since firmware v5.7): "
+          "`manual` (the user manual), `agx_v2` (the vendor's software since firmware v5.7) or "
+          "`mini_v3` (the RANGER MINI 3.0's manual; the default of `model: ranger_mini_v3`): "
           "that preset, with the model's own settings")
           .choices(protocols)
           .apply(RANGER_SET(protocol.protocol, v.text)));

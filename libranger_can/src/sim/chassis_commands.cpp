@@ -263,8 +263,10 @@ Result<int> parse_error_bit(const std::string& text, ErrorWordLayout layout) {
 Result<int> check_error_bit(const std::string& text) {
   auto manual = parse_error_bit(text, ErrorWordLayout::kManual32);
   if (manual) return manual;
-  auto agx16 = parse_error_bit(text, ErrorWordLayout::kAgxV2_16);
-  return agx16 ? agx16 : manual;
+  for (const ErrorWordLayout layout : kErrorWordLayoutNames.values()) {
+    if (auto other = parse_error_bit(text, layout)) return other;
+  }
+  return manual;
 }
 
 std::string describe_chassis(const sim::ChassisSnapshot& s, ErrorWordLayout layout) {

@@ -54,8 +54,11 @@ double ChassisModel::clamp_speed(MotionMode mode, double speed) const {
 
 void ChassisModel::set_target(const MotionTarget& target) {
   if (switching()) return;
-  target_.speed = clamp_speed(mode_, target.speed);
   target_.steering = clamp_steering(mode_, target.steering);
+  target_.speed = clamp_speed(mode_, target.speed);
+  if (std::fabs(target_.steering) > interpretation::kLargeSteeringThresholdRad) {
+    target_.speed = clamp_abs(target_.speed, limits_.max_speed_at_large_steering);
+  }
   emergency_ = false;
 }
 

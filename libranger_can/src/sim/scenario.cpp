@@ -33,6 +33,8 @@ const char* const kActionsHelp =
     "                           force the motion mode of later commands (auto: chosen per twist;\n"
     "                           side_slip where the mode numbering has it: mini_v1, agx_v2)\n"
     "  park on|off              Driver::set_park(): park (motion refused, \"parked\") or release\n"
+    "  drive_mode current|voltage\n"
+    "                           Driver::set_drive_mode(): 0x423 (the RANGER MINI 3.0's)\n"
     "  clear-errors CODE        the driver sends 0x441 CODE (0-16, or 0x00-0x10)\n"
     "  wait SEC                 advance simulated time by SEC (whole milliseconds, >= 0)\n"
     "  expect ...               a check of the state now (below); a failed one is reported and\n"
@@ -119,6 +121,11 @@ const std::vector<std::string>& motion_mode_names() {
   return names;
 }
 
+const std::vector<std::string>& drive_mode_names() {
+  static const std::vector<std::string> names = names_or_null(protocol::kDriveModeNames);
+  return names;
+}
+
 // The fault table's names (protocol::kFaultTable), in its order.
 std::vector<std::string> fault_table_names() {
   std::vector<std::string> n;
@@ -178,6 +185,8 @@ std::string expect_help() {
          help_entry("  expect motion_mode " + join(motion_mode_names(), "|"),
                     "(the chassis's 0x291)") +
          help_entry("  expect rearm_required true|false", "") +
+         help_entry("  expect drive_mode " + join(drive_mode_names(), "|"),
+                    "(0x291 byte 2, the RANGER MINI 3.0's; null elsewhere)") +
          help_entry("  expect identification NAME",
                     "the identification's phase: " + join(identification_names()) +
                         " (none: the protocol was given)") +
@@ -187,7 +196,7 @@ std::string expect_help() {
          help_entry("  expect fault NAME | no-fault NAME | no-faults", "") +
          help_entry("", "NAME as in the output's faults: the driver's (" +
                             join(kControllerFaultNames.names()) +
-                            "), a 0x211 fault of either error-word layout (" +
+                            "), a 0x211 fault of any error-word layout (" +
                             join(fault_table_names()) + ") or reserved_bit_N") +
          help_entry("  expect FIELD OP NUMBER",
                     "FIELD: t, truth.x|y|yaw|vx|vy|wz|speed, odom.x|y|yaw|vx|vy|wz, "
@@ -240,6 +249,8 @@ const TextField kTextFields[] = {
      [](const ScenarioSample& s) { return std::string(s.rearm_required ? "true" : "false"); }},
     {"identification", identification_names,
      [](const ScenarioSample& s) { return s.identification; }},
+    {"drive_mode", drive_mode_names,
+     [](const ScenarioSample& s) { return s.drive_mode.value_or("null"); }},
 };
 const TextField* find_text_field(std::string_view name) {
   for (const TextField& f : kTextFields) {
@@ -261,8 +272,8 @@ constexpr auto kFaultChecks = text::enum_names<Kind>({
 
 const char* const kExpectUsage =
     "expect: give one of: refusal NAME, control_mode NAME, motion_mode NAME, rearm_required "
-    "true|false, identification PHASE, moving, still, fault NAME, no-fault NAME, no-faults, "
-    "FIELD OP NUMBER";
+    "true|false, identification PHASE, drive_mode NAME, moving, still, fault NAME, no-fault NAME, "
+    "no-faults, FIELD OP NUMBER";
 
 Status need_words(const std::vector<std::string>& w, std::size_t n, const std::string& form) {
   if (w.size() != n) return problem("usage: " + form);
@@ -396,6 +407,16 @@ Status parse_resume(const Words& w, ScenarioAction& a) {
   return ok_status();
 }
 
+Status parse_drive_mode(const Words& w, ScenarioAction& a) {
+  const std::string usage = "drive_mode " + join(protocol::kDriveModeNames.names(), "|");
+  if (w.size() != 2) return problem("usage: " + usage);
+  const auto mode = protocol::kDriveModeNames.parse(w[1]);
+  if (!mode) return not_one_of("drive_mode", w[1], protocol::kDriveModeNames.names());
+  a.kind = ScenarioAction::Kind::kDriveMode;
+  a.code = static_cast<std::uint8_t>(*mode);
+  return ok_status();
+}
+
 Status parse_park(const Words& w, ScenarioAction& a) {
   if (w.size() != 2 || (w[1] != "on" && w[1] != "off")) return problem("usage: park on|off");
   a.kind = ScenarioAction::Kind::kPark;
@@ -457,7 +478,7 @@ const Verb kVerbs[] = {
     {"cmd", parse_cmd},   {"resume", parse_resume},
     {"mode", parse_mode}, {"clear-errors", parse_clear_errors},
     {"wait", parse_wait}, {"expect", parse_expect_action},
-    {"park", parse_park},
+    {"park", parse_park}, {"drive_mode", parse_drive_mode},
 };
 
 const std::vector<std::string>& driver_action_names() {
@@ -652,6 +673,7 @@ void write_sample(JsonWriter& w, const ScenarioSample& s) {
   w.key("latched").strings(s.latched);
   w.key("steer_first_factor").fixed(s.steer_first_factor, kDecimals);
   w.key("identification").string(s.identification);
+  if (s.drive_mode) w.key("drive_mode").string(*s.drive_mode);
 }
 
 // "events":[...] of the driver's events (each one JSON object), none when there are none.
@@ -784,6 +806,7 @@ struct ScenarioRunner::Impl {
     s.steer_first_factor = c.steer_first_factor;
     s.identification =
         snap->identification ? std::string(to_string(snap->identification->phase)) : "none";
+    if (snap->drive_mode) s.drive_mode = std::string(protocol::to_string(*snap->drive_mode));
     return s;
   }
 
@@ -911,6 +934,10 @@ ScenarioResult ScenarioRunner::run(const Scenario& scenario, const ScenarioOutpu
         break;
       case ScenarioAction::Kind::kPark:
         m.pending.push_back({m.driver->set_park(a.enable), a.line});
+        break;
+      case ScenarioAction::Kind::kDriveMode:
+        m.pending.push_back(
+            {m.driver->set_drive_mode(static_cast<protocol::DriveMode>(a.code)), a.line});
         break;
       case ScenarioAction::Kind::kClearErrors: {
         auto id = m.driver->clear_errors(a.code);

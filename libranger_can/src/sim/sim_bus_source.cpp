@@ -30,6 +30,8 @@ const std::vector<VariantInfo>& variants() {
        "--set steering_reference=inner_front"},
       {"mini_v1", "the RANGER MINI V1: geometry, limits and protocol of model ranger_mini_v1",
        "--model ranger_mini_v1"},
+      {"mini_v3", "the RANGER MINI 3.0: model ranger_mini_v3, drive modes, rear odometry",
+       "--model ranger_mini_v3"},
       {"undecidable", "neither revision: the manual's IDs and lengths, agx_v2 values, no 0x271",
        "--protocol agx_v2 --set tx_dlc=0 --set mode_numbering=manual"},
   };
@@ -59,6 +61,7 @@ std::string variants_help() {
 VirtualChassisConfig chassis_for_model(const ModelPreset& model, VirtualChassisConfig config) {
   config.geometry = model.geometry;
   config.limits.max_linear_speed = model.limits.max_linear_speed;
+  config.limits.max_speed_at_large_steering = model.limits.max_speed_at_large_steering;
   config.limits.max_spin_speed = model.limits.max_spin_wheel_speed;
   config.limits.max_ackermann_angle = model.limits.max_ackermann_steering;
   config.limits.max_oblique_angle = model.limits.max_oblique_steering;
@@ -97,6 +100,12 @@ Result<VirtualChassisConfig> apply_variant(std::string_view variant, VirtualChas
     if (!model) return model.error();
     config = chassis_for_model(*model, config);
     config.vendor_frames = true;  // the vendor's protocol family
+  } else if (variant == "mini_v3") {
+    auto model = model_preset("ranger_mini_v3");
+    if (!model) return model.error();
+    config = chassis_for_model(*model, config);
+    config.vendor_frames = true;    // 0x231, 0x241 (its manual), 0x4A1 (the vendor's SDK)
+    config.odometer_frames = true;  // 0x311, 0x312 in mm
   } else if (variant == "undecidable") {
     // Built so that no passive evidence settles the revision, and the steering unit cannot be
     // read at rest: the vendor's units, signs, spin field, error word (byte 7 a counter), BMS

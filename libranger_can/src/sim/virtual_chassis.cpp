@@ -128,7 +128,8 @@ void VirtualChassis::step(Timestamp now) {
       const auto ids = protocol::all_ids();
       f.id = ids[garbage_rng_() % ids.size()];
       // Shorter than its layout (a longer frame is valid: its extra bytes are ignored).
-      f.dlc = static_cast<std::uint8_t>(garbage_rng_() % protocol::layout_dlc(f.id));
+      f.dlc = static_cast<std::uint8_t>(garbage_rng_() %
+                                        protocol::layout_dlc(f.id, config_.profile.frame_layout));
     }
     for (int i = 0; i < f.dlc; ++i)
       f.data[i] = static_cast<std::uint8_t>(garbage_rng_());
@@ -186,7 +187,11 @@ void VirtualChassis::integrate(Timestamp t) {
   const double dt = seconds(t - now_);
   const bool was_switching = motion_.switching();
   const bool powered = !emergency_stop_ && (error_word() & bit(Fault::kBatteryUnderVoltage)) == 0;
+  const WheelStates before = motion_.wheels();
   motion_.advance(dt);
+  const WheelStates after = motion_.wheels();
+  for (int i = 0; i < kWheelCount; ++i)
+    wheel_distance_[i] += (before[i].speed + after[i].speed) / 2.0 * dt;
   drivetrain_.advance(dt, motion_, powered);
   now_ = t;
   if (was_switching && !motion_.switching()) {
@@ -210,7 +215,8 @@ std::uint32_t VirtualChassis::bit(Fault fault, int motor) const {
 
 std::uint32_t VirtualChassis::error_word() const {
   return latched_errors_ | (host_link_lost_ ? bit(Fault::kHostCommunicationLost) : 0u) |
-         (ultrasonic_triggered() ? bit(Fault::kUltrasonicTriggered) : 0u);
+         (ultrasonic_triggered() ? bit(Fault::kUltrasonicTriggered) : 0u) |
+         (emergency_stop_ ? bit(Fault::kEmergencyStop) : 0u);
 }
 
 protocol::VehicleStatus VirtualChassis::vehicle_status() const {
@@ -344,9 +350,9 @@ void VirtualChassis::drive_by_remote() {
 void VirtualChassis::set_remote_swa(protocol::RemoteSwitch position) {
   if (position == remote_.swa) return;
   remote_.swa = position;
-  event("remote SWA " + std::string(protocol::to_string(position)) +
-        (control_mode_ != ControlMode::kRemote ? " (no effect: SWB is not in remote position)"
-                                               : ""));
+  event(
+      "remote SWA " + std::string(protocol::to_string(position)) +
+      (control_mode_ != ControlMode::kRemote ? " (no effect: SWB is not in remote position)" : ""));
   lights_.set_remote(control_mode_ == ControlMode::kRemote, remote_.swa);
   if (lights_.take_changed()) event("lights: " + describe_lights(lights_.report()));
 }
@@ -400,15 +406,7 @@ void VirtualChassis::on_frame(const CanFrame& frame, Timestamp now) {
     return;
   }
   const Message& msg = *decoded;
-  const bool vendor_command =
-      std::holds_alternative<LightCommand>(msg) || std::holds_alternative<VersionRequest>(msg);
-  const bool is_command = std::holds_alternative<MotionCommand>(msg) ||
-                          std::holds_alternative<MotionModeCommand>(msg) ||
-                          std::holds_alternative<ControlModeCommand>(msg) ||
-                          std::holds_alternative<ErrorClearCommand>(msg) ||
-                          std::holds_alternative<UltrasonicSettingCommand>(msg) ||
-                          (vendor_command && config_.vendor_frames);
-  if (!is_command) {  // feedback from another node (or our own echo), or not this chassis's
+  if (!is_own_command(msg, frame.id)) {  // feedback from another node (our echo), or not ours
     ++counters_.frames_rejected;
     return;
   }
@@ -432,12 +430,35 @@ void VirtualChassis::on_frame(const CanFrame& frame, Timestamp now) {
     if (!clear_errors(m->code)) ++counters_.frames_ignored;
   }
   if (auto* m = std::get_if<UltrasonicSettingCommand>(&msg)) handle_ultrasonic_setting(*m);
+  if (auto* m = std::get_if<DriveModeCommand>(&msg)) handle_drive_mode(*m);
   if (auto* m = std::get_if<LightCommand>(&msg)) {
     lights_.command(*m);
     if (lights_.take_changed()) event("lights: " + describe_lights(lights_.report()) + " (0x121)");
   }
   update_conditions(now_);
   apply_motion_policy();
+}
+
+bool VirtualChassis::is_own_command(const Message& msg, std::uint32_t id) const {
+  const protocol::FrameInfo* row = protocol::find_frame(id);
+  if (row == nullptr || row->direction == protocol::Direction::kFromChassis) return false;
+  if (!row->in(config_.profile.frame_layout)) return false;  // another revision's command
+  const bool vendor_command =
+      std::holds_alternative<LightCommand>(msg) || std::holds_alternative<VersionRequest>(msg);
+  return !std::holds_alternative<VersionResponse>(msg) &&
+         (!vendor_command || config_.vendor_frames);
+}
+
+void VirtualChassis::handle_drive_mode(const DriveModeCommand& cmd) {
+  if (!cmd.mode_known) {
+    ++counters_.frames_ignored;
+    event("0x423 with unknown drive mode " + std::to_string(cmd.mode_raw) + " ignored");
+    return;
+  }
+  if (cmd.mode == drive_mode_) return;
+  event("drive mode " + std::string(protocol::to_string(drive_mode_)) + " -> " +
+        std::string(protocol::to_string(cmd.mode)) + " (0x423)");
+  drive_mode_ = cmd.mode;
 }
 
 void VirtualChassis::handle_motion_command(const MotionCommand& cmd) {
@@ -579,6 +600,8 @@ void VirtualChassis::set_error_bit(int index, bool on) {
   const std::uint32_t b = 1u << index;
   if (b == bit(Fault::kHostCommunicationLost)) {
     host_link_lost_ = on;
+  } else if (b == bit(Fault::kEmergencyStop)) {
+    set_emergency_stop(on);  // the bit repeats the e-stop's state
   } else if (b == bit(Fault::kUltrasonicTriggered)) {
     // A condition, not a latch: injected by placing an obstacle in front of sensor 1.
     if (on) {
@@ -712,6 +735,8 @@ void VirtualChassis::send_raw(CanFrame frame, Timestamp t) {
 
 void VirtualChassis::send(const Message& message, Timestamp t) {
   if (silent_) return;
+  const protocol::FrameInfo* row = protocol::find_frame(id_of(message));
+  if (row != nullptr && !row->in(config_.profile.frame_layout)) return;  // not this chassis's
   auto frame = encode(message, config_.profile);
   if (!frame) {
     ++counters_.send_failures;
@@ -775,6 +800,42 @@ Message VirtualChassis::motion_feedback() const {
   return fb;
 }
 
+void VirtualChassis::send_vendor_frames(Timestamp t) {
+  const ProtocolProfile& p = config_.profile;
+  // 0x231 and 0x241, each with its counter.
+  LightState light = lights_.report();
+  if (p.light_modes == LightModes::kOnOff) {  // on/off only: no rear light, no brightness
+    light.rear_mode = protocol::LightMode::kOff;
+    light.front_custom = light.rear_custom = 0;
+  }
+  light.counter = vendor_counter_;
+  send(light, t);
+  // The remote control on, SWB up (command mode) unless the remote is in charge; the
+  // sticks as the operator holds them (centred within the dead band).
+  RemoteControlState rc;
+  rc.swa = remote_.swa;
+  rc.swb = control_mode_ == ControlMode::kRemote ? protocol::RemoteSwitch::kMiddle
+                                                 : protocol::RemoteSwitch::kUp;
+  rc.swc = remote_.swc;
+  rc.swd = remote_.swd;
+  rc.stick_left_v = stick_wire(remote_.left);
+  rc.stick_right_h = stick_wire(remote_.right);
+  rc.counter = vendor_counter_;
+  send(rc, t);
+  ++vendor_counter_;
+}
+
+void VirtualChassis::send_odometers(Timestamp t) {
+  OdometerFeedback front, rear;
+  front.left_distance = wheel_distance_[kLeftFront];
+  front.right_distance = wheel_distance_[kRightFront];
+  rear.rear = true;
+  rear.left_distance = wheel_distance_[kLeftRear];
+  rear.right_distance = wheel_distance_[kRightRear];
+  send(front, t);
+  send(rear, t);
+}
+
 void VirtualChassis::answer_version_request() {
   const std::string& text = config_.version;
   for (std::size_t i = 0; i < text.size(); i += 8) {
@@ -818,26 +879,10 @@ void VirtualChassis::send_due(ScheduleId which, Timestamp t) {
       mm.mode = motion_.mode();  // while switching: the mode being left
       mm.mode_raw = protocol::motion_mode_to_wire(mm.mode, p.mode_numbering).value_or(0);
       mm.switching = motion_.switching();
+      mm.drive_mode = static_cast<std::uint8_t>(drive_mode_);  // where the layout has byte 2
       send(mm, t);
-      if (config_.vendor_frames) {
-        // 0x231 and 0x241, each with its counter.
-        LightState light = lights_.report();
-        light.counter = vendor_counter_;
-        send(light, t);
-        // The remote control on, SWB up (command mode) unless the remote is in charge; the
-        // sticks as the operator holds them (centred within the dead band).
-        RemoteControlState rc;
-        rc.swa = remote_.swa;
-        rc.swb = control_mode_ == ControlMode::kRemote ? protocol::RemoteSwitch::kMiddle
-                                                       : protocol::RemoteSwitch::kUp;
-        rc.swc = remote_.swc;
-        rc.swd = remote_.swd;
-        rc.stick_left_v = stick_wire(remote_.left);
-        rc.stick_right_h = stick_wire(remote_.right);
-        rc.counter = vendor_counter_;
-        send(rc, t);
-        ++vendor_counter_;
-      }
+      if (config_.odometer_frames) send_odometers(t);
+      if (config_.vendor_frames) send_vendor_frames(t);
       break;
     }
     case kUltrasonic: {
@@ -922,6 +967,8 @@ ChassisSnapshot VirtualChassis::snapshot() const {
   s.yaw_travelled = motion_.yaw_travelled();
   s.battery = drivetrain_.pack();
   s.lights = lights_.report();
+  s.drive_mode = drive_mode_;
+  s.wheel_distance = wheel_distance_;
   return s;
 }
 

@@ -1,5 +1,6 @@
-// Byte-exact encoding and decoding of every RANGER frame of either revision (manual 3.2,
-// PROTOCOL.md; the vendor's agx_v2, PROTOCOL_AGX_V2.md), driven by a protocol profile.
+// Byte-exact encoding and decoding of every RANGER frame of any revision (manual 3.2,
+// PROTOCOL.md; the vendor's agx_v2, PROTOCOL_AGX_V2.md; the RANGER MINI 3.0's mini_v3,
+// PROTOCOL_MINI_V3.md), driven by a protocol profile.
 //
 // Decoding is one switch on the ID after one length check: a frame shorter than its layout is
 // refused, a longer one is read from its leading bytes, so no path reads past `dlc`; nothing on
@@ -46,6 +47,9 @@ std::int8_t saturate_i8(double scaled) {
 }
 std::uint8_t saturate_u8(double scaled) {
   return saturate<std::uint8_t>(scaled);
+}
+std::int32_t saturate_i32(double scaled) {
+  return saturate<std::int32_t>(scaled);
 }
 
 }  // namespace wire
@@ -288,6 +292,11 @@ Message decode_motion_mode_command(const std::uint8_t* d, const ProtocolProfile&
   return m;
 }
 
+// Whether the profile's frame layout gives 0x291 its third byte, the drive mode (mini_v3).
+bool has_drive_mode_byte(const ProtocolProfile& p) {
+  return protocol::layout_dlc(protocol::kMotionModeFeedbackId, p.frame_layout) >= 3;
+}
+
 Message decode_motion_mode_feedback(const std::uint8_t* d, const ProtocolProfile& p) {
   MotionModeFeedback m;
   m.mode_raw = d[0];
@@ -295,7 +304,29 @@ Message decode_motion_mode_feedback(const std::uint8_t* d, const ProtocolProfile
   m.mode_known = mode.has_value();
   m.mode = mode.value_or(MotionMode::kAckermann);
   m.switching = d[1] != 0;  // anything but "switch complete" is treated as still switching
+  if (has_drive_mode_byte(p)) m.drive_mode = d[2];
   return m;
+}
+
+Message decode_drive_mode_command(const std::uint8_t* d) {
+  DriveModeCommand m;
+  m.mode_raw = d[0];
+  const auto mode = protocol::drive_mode_from_wire(d[0]);
+  m.mode_known = mode.has_value();
+  m.mode = mode.value_or(static_cast<protocol::DriveMode>(0xFF));
+  return m;
+}
+
+Message decode_odometer(std::uint32_t id, const std::uint8_t* d, const ProtocolProfile& p) {
+  OdometerFeedback o;
+  o.left_wheel = get_i32(d);
+  o.right_wheel = get_i32(d + 4);
+  o.rear = id == protocol::kRearOdometerId;
+  if (p.odometer_unit == OdometerUnit::kMillimetre) {
+    o.left_distance = o.left_wheel / kMillis;
+    o.right_distance = o.right_wheel / kMillis;
+  }
+  return o;
 }
 
 Message decode_ultrasonic(int first_sensor, const std::uint8_t* d) {
@@ -327,15 +358,20 @@ Message decode_bms(std::uint32_t id, const std::uint8_t* d, const ProtocolProfil
   return a;
 }
 
+// 0x121 / 0x231. Under light_modes on_off (the MINI 3.0) byte 1 is the lights' on/off and the
+// other bytes are reserved (zero; 0x231 keeps its counter in byte 7): they decode as off / 0.
 template <typename Light>
-Message decode_light(const std::uint8_t* d) {
+Message decode_light(const std::uint8_t* d, const ProtocolProfile& p) {
   Light l;
   l.enable = d[0] != 0;
   l.front_mode = static_cast<protocol::LightMode>(d[1]);
-  l.front_custom = d[2];
-  l.rear_mode = static_cast<protocol::LightMode>(d[3]);
-  l.rear_custom = d[4];
-  l.counter = d[7];
+  const bool on_off = p.light_modes == LightModes::kOnOff;
+  if (!on_off) {
+    l.front_custom = d[2];
+    l.rear_mode = static_cast<protocol::LightMode>(d[3]);
+    l.rear_custom = d[4];
+  }
+  if (!on_off || std::is_same_v<Light, LightState>) l.counter = d[7];
   return l;
 }
 
@@ -366,12 +402,12 @@ Message decode_version(const CanFrame& f) {
 
 // Whether `f` is a RANGER frame its decoder can read: not an error frame, a known ID, at least its
 // layout's length (the one length check: every decoder reads its layout's leading bytes only).
-std::optional<Error> check_decodable(const CanFrame& f) {
+std::optional<Error> check_decodable(const CanFrame& f, const ProtocolProfile& p) {
   if (f.is_error) {
     return Error{Errc::kInvalidArgument,
                  "error frame (class " + hex(f.id, 8) + ") carries no RANGER message"};
   }
-  const int layout = protocol::layout_dlc(f.id);
+  const int layout = protocol::layout_dlc(f.id, p.frame_layout);
   if (layout < 0) {
     return Error{Errc::kUnknownId, "ID " + hex(f.id) + " is not part of the RANGER protocol (DLC " +
                                        std::to_string(f.dlc) + ")"};
@@ -384,7 +420,7 @@ std::optional<Error> check_decodable(const CanFrame& f) {
 }  // namespace
 
 Result<Message> decode(const CanFrame& f, const ProtocolProfile& p) {
-  if (auto error = check_decodable(f)) return std::move(*error);
+  if (auto error = check_decodable(f, p)) return std::move(*error);
   const std::uint8_t* d = f.data.data();
   // The motors' frames: one layout each for the eight motors.
   if (f.id >= kHighSpeedFirst && f.id < kHighSpeedFirst + protocol::kMotorCount) {
@@ -397,11 +433,13 @@ Result<Message> decode(const CanFrame& f, const ProtocolProfile& p) {
     case protocol::kMotionCommandId:
       return decode_motion_command(d, p);
     case protocol::kLightCommandId:
-      return decode_light<LightCommand>(d);
+      return decode_light<LightCommand>(d, p);
     case protocol::kMotionModeCommandId:
       return decode_motion_mode_command(d, p);
     case protocol::kControlModeCommandId:
       return Message{ControlModeCommand{static_cast<ControlMode>(d[0])}};
+    case protocol::kDriveModeCommandId:
+      return decode_drive_mode_command(d);
     case protocol::kErrorClearCommandId:
       return Message{ErrorClearCommand{d[0]}};
     case protocol::kUltrasonicSettingId:
@@ -413,7 +451,7 @@ Result<Message> decode(const CanFrame& f, const ProtocolProfile& p) {
     case protocol::kMotionFeedbackId:
       return decode_motion_feedback(f.id, d, p);
     case protocol::kLightStateId:
-      return decode_light<LightState>(d);
+      return decode_light<LightState>(d, p);
     case protocol::kRemoteControlStateId:
       return decode_remote_control(d);
     case protocol::kSteeringAnglesId:
@@ -423,7 +461,8 @@ Result<Message> decode(const CanFrame& f, const ProtocolProfile& p) {
     case protocol::kMotionModeFeedbackId:
       return decode_motion_mode_feedback(d, p);
     case protocol::kOdometerId:
-      return Message{OdometerFeedback{get_i32(d), get_i32(d + 4)}};
+    case protocol::kRearOdometerId:
+      return decode_odometer(f.id, d, p);
     case protocol::kUltrasonic1to4Id:
       return decode_ultrasonic(1, d);
     case protocol::kUltrasonic5to8Id:
@@ -483,7 +522,7 @@ class Encoder {
   CanFrame frame_for(std::uint32_t id, int length = -1) const {
     CanFrame f;
     f.id = id;
-    const int layout = length >= 0 ? length : protocol::layout_dlc(id);
+    const int layout = length >= 0 ? length : protocol::layout_dlc(id, p_.frame_layout);
     f.dlc = static_cast<std::uint8_t>(p_.tx_dlc == 8 ? 8 : layout);
     return f;
   }
@@ -529,6 +568,23 @@ class Encoder {
     return f;
   }
 
+  Result<CanFrame> operator()(const DriveModeCommand& m) const {
+    const protocol::FrameInfo* row = protocol::find_frame(protocol::kDriveModeCommandId);
+    if (!row->in(p_.frame_layout)) {
+      return Error{Errc::kInvalidArgument,
+                   "drive_mode_command: 0x423 is not a frame of frame layout " +
+                       std::string(to_string(p_.frame_layout)) +
+                       " (drive modes: the RANGER MINI 3.0's, frame layout mini_v3)"};
+    }
+    if (!protocol::kDriveModeNames.contains(m.mode)) {
+      return invalid("drive_mode_command", "mode", static_cast<long>(m.mode),
+                     "0 current, 1 voltage");
+    }
+    CanFrame f = frame_for(protocol::kDriveModeCommandId);
+    f.data[0] = static_cast<std::uint8_t>(m.mode);
+    return f;
+  }
+
   Result<CanFrame> operator()(const ErrorClearCommand& m) const {
     if (m.code > protocol::kMaxErrorClearCode) {
       return invalid("error_clear_command", "code", m.code, "0x00..0x10");
@@ -553,6 +609,9 @@ class Encoder {
     if (static_cast<long>(m.rear_mode) > max_mode) {
       return invalid("light_command", "rear_mode", static_cast<long>(m.rear_mode),
                      "0 off, 1 on, 2 breathing, 3 custom");
+    }
+    if (p_.light_modes == LightModes::kOnOff) {
+      if (Status st = on_off_only(m); !st) return st.error();
     }
     return light(protocol::kLightCommandId, m);
   }
@@ -669,6 +728,7 @@ class Encoder {
     CanFrame f = frame_for(protocol::kMotionModeFeedbackId);
     f.data[0] = value;
     f.data[1] = m.switching ? 0x01 : 0x00;
+    if (has_drive_mode_byte(p_)) f.data[2] = m.drive_mode.value_or(0);
     return f;
   }
 
@@ -740,9 +800,24 @@ class Encoder {
   }
 
   Result<CanFrame> operator()(const OdometerFeedback& o) const {
-    CanFrame f = frame_for(protocol::kOdometerId);
-    put_u32(&f.data[0], static_cast<std::uint32_t>(o.left_wheel));
-    put_u32(&f.data[4], static_cast<std::uint32_t>(o.right_wheel));
+    std::int32_t left = o.left_wheel, right = o.right_wheel;
+    if (p_.odometer_unit == OdometerUnit::kMillimetre) {
+      if (o.left_distance) {
+        if (!std::isfinite(*o.left_distance)) {
+          return not_finite("odometer", "left_distance", *o.left_distance);
+        }
+        left = wire::saturate_i32(*o.left_distance * kMillis);
+      }
+      if (o.right_distance) {
+        if (!std::isfinite(*o.right_distance)) {
+          return not_finite("odometer", "right_distance", *o.right_distance);
+        }
+        right = wire::saturate_i32(*o.right_distance * kMillis);
+      }
+    }
+    CanFrame f = frame_for(o.rear ? protocol::kRearOdometerId : protocol::kOdometerId);
+    put_u32(&f.data[0], static_cast<std::uint32_t>(left));
+    put_u32(&f.data[4], static_cast<std::uint32_t>(right));
     return f;
   }
 
@@ -761,6 +836,25 @@ class Encoder {
   }
 
  private:
+  // Light modes on_off (the MINI 3.0): byte 1 off or on, bytes 2-7 zero.
+  static Status on_off_only(const LightCommand& m) {
+    const char* kValid = "under light_modes on_off (the lights on or off only)";
+    if (m.front_mode != protocol::LightMode::kOff && m.front_mode != protocol::LightMode::kOn) {
+      return invalid("light_command", "front_mode", static_cast<long>(m.front_mode),
+                     std::string("0 off, 1 on ") + kValid + ": no breathing, no custom brightness");
+    }
+    if (m.rear_mode != protocol::LightMode::kOff) {
+      return invalid("light_command", "rear_mode", static_cast<long>(m.rear_mode),
+                     std::string("0 ") + kValid + ": no rear light");
+    }
+    if (m.front_custom != 0 || m.rear_custom != 0) {
+      return invalid("light_command", m.front_custom != 0 ? "front_custom" : "rear_custom",
+                     m.front_custom != 0 ? m.front_custom : m.rear_custom,
+                     std::string("0 ") + kValid + ": no brightness");
+    }
+    return ok_status();
+  }
+
   template <typename Light>
   CanFrame light(std::uint32_t id, const Light& m) const {
     CanFrame f = frame_for(id);
@@ -769,7 +863,9 @@ class Encoder {
     f.data[2] = m.front_custom;
     f.data[3] = static_cast<std::uint8_t>(m.rear_mode);
     f.data[4] = m.rear_custom;
-    f.data[7] = m.counter;
+    // Light modes on_off: 0x121's bytes 2-7 are zero (0x231 keeps its counter in byte 7).
+    const bool reserved = p_.light_modes == LightModes::kOnOff && id == protocol::kLightCommandId;
+    f.data[7] = reserved ? 0 : m.counter;
     return f;
   }
 
@@ -824,7 +920,10 @@ struct IdOf {
   std::uint32_t operator()(const RemoteControlState&) const {
     return protocol::kRemoteControlStateId;
   }
-  std::uint32_t operator()(const OdometerFeedback&) const { return protocol::kOdometerId; }
+  std::uint32_t operator()(const OdometerFeedback& o) const {
+    return o.rear ? protocol::kRearOdometerId : protocol::kOdometerId;
+  }
+  std::uint32_t operator()(const DriveModeCommand&) const { return protocol::kDriveModeCommandId; }
   std::uint32_t operator()(const VersionRequest&) const { return protocol::kVersionId; }
   std::uint32_t operator()(const VersionResponse&) const { return protocol::kVersionId; }
 };
@@ -841,6 +940,36 @@ Result<CanFrame> encode(const Message& message) {
 
 std::uint32_t id_of(const Message& message) {
   return std::visit(IdOf{}, message);
+}
+
+std::optional<UnsupportedFeature> unsupported_feature(const Message& command,
+                                                      const ProtocolProfile& p) {
+  if (const auto* m = std::get_if<MotionModeCommand>(&command)) {
+    if (protocol::motion_mode_to_wire(m->mode, p.mode_numbering)) return std::nullopt;
+    const std::string mode(protocol::to_string(m->mode));
+    return UnsupportedFeature{mode, "its motion-mode numbering " +
+                                        std::string(to_string(p.mode_numbering)) + " has no " +
+                                        mode + " mode"};
+  }
+  if (std::holds_alternative<DriveModeCommand>(command)) {
+    if (protocol::find_frame(protocol::kDriveModeCommandId)->in(p.frame_layout))
+      return std::nullopt;
+    return UnsupportedFeature{"drive modes", "its frame layout " +
+                                                 std::string(to_string(p.frame_layout)) +
+                                                 " has no 0x423 drive mode command"};
+  }
+  const auto* l = std::get_if<LightCommand>(&command);
+  if (l == nullptr || p.light_modes != LightModes::kOnOff) return std::nullopt;
+  const std::string reason = "light_modes on_off: the lights on or off only";
+  if (l->front_mode == protocol::LightMode::kBreathing) {
+    return UnsupportedFeature{"breathing lights", reason};
+  }
+  if (l->rear_mode != protocol::LightMode::kOff) return UnsupportedFeature{"a rear light", reason};
+  if (l->front_mode == protocol::LightMode::kCustom || l->front_custom != 0 ||
+      l->rear_custom != 0) {
+    return UnsupportedFeature{"brightness", reason};
+  }
+  return std::nullopt;
 }
 
 }  // namespace ranger

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <vector>
 
@@ -69,9 +70,11 @@ std::uint32_t critical_error_mask(ErrorWordLayout layout) {
     }
     return mask;
   };
-  static const std::uint32_t manual = build(ErrorWordLayout::kManual32);
-  static const std::uint32_t agx = build(ErrorWordLayout::kAgxV2_16);
-  return layout == ErrorWordLayout::kAgxV2_16 ? agx : manual;
+  static const std::uint32_t kMasks[] = {build(ErrorWordLayout::kManual32),
+                                         build(ErrorWordLayout::kAgxV2_16),
+                                         build(ErrorWordLayout::kMini32)};
+  static_assert(std::size(kMasks) == kErrorWordLayoutNames.size(), "one mask per layout");
+  return kMasks[static_cast<std::size_t>(layout)];
 }
 
 }  // namespace ranger::interpretation

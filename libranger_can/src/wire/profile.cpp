@@ -97,8 +97,8 @@ const std::vector<Row>& rows() {
           "what the 0x221 speed is in Ackermann mode: the mean of the four wheel speeds or the "
           "body centre's speed"),
       row(S::kErrorWord, &P::error_word, choices(kErrorWordLayoutNames),
-          "layout of 0x211 bytes 4-7: one 32-bit error word, or a 16-bit word in bytes 4-5 and a "
-          "counter in byte 7"),
+          "layout of 0x211 bytes 4-7: the manual's 32-bit error word, a 16-bit word in bytes 4-5 "
+          "and a counter in byte 7, or the MINI 3.0's 32-bit fault word"),
       row(S::kVehicleStatus1IsEstop, &P::vehicle_status_1_is_estop,
           Choices<bool>{{true, "true"}, {false, "false"}},
           "whether 0x211 byte 0 = 0x01 is an emergency stop (else: abnormal)"),
@@ -111,6 +111,13 @@ const std::vector<Row>& rows() {
           "wire values of the motion modes in 0x141 and 0x291"),
       row(S::kDriverStatusBit6, &P::driver_status_bit6, choices(kDriverStatusBit6Names),
           "what bit 6 of the 0x261-0x268 driver status set means"),
+      row(S::kFrameLayout, &P::frame_layout, choices(kFrameLayoutNames),
+          "which frames the chassis has and each one's length (the frame table's column): 0x291 "
+          "of 3 bytes with the drive mode and 0x423 in mini_v3"),
+      row(S::kOdometerUnit, &P::odometer_unit, choices(kOdometerUnitNames),
+          "unit of the 0x311/0x312 wheel odometers: not stated (raw counts) or millimetres"),
+      row(S::kLightModes, &P::light_modes, choices(kLightModesNames),
+          "what 0x121 can ask: front and rear light off/on/breathing/custom, or on/off only"),
       row(S::kTxDlc, &P::tx_dlc, Choices<int>{{0, "0"}, {8, "8"}},
           "DLC of encoded frames: 0 = each frame's layout length, 8 = zero-padded to 8"),
   };
@@ -152,7 +159,23 @@ ProtocolProfile make_agx_v2() {
   p.bms_current_sign = -1;  // assumed: unknown, as for the manual
   p.mode_numbering = ModeNumbering::kAgxV2;
   p.driver_status_bit6 = DriverStatusBit6::kEnabled;
+  p.frame_layout = FrameLayout::kAgxV2;
   p.tx_dlc = 8;  // the vendor's SDK pads every command
+  return p;
+}
+
+// The RANGER MINI 3.0's manual as transcribed (PROTOCOL_MINI_V3.md): the vendor's units, signs,
+// spin field and BMS scale (which its manual states alike), its own fault word, mode numbering,
+// frames and lengths.
+ProtocolProfile make_mini_v3() {
+  ProtocolProfile p = make_agx_v2();
+  p.revision = "mini_v3";
+  p.error_word = ErrorWordLayout::kMini32;      // bytes 4-7 a 32-bit fault word, no counter
+  p.mode_numbering = ModeNumbering::kMiniV3;    // 0-2, 3 park, no side slip
+  p.frame_layout = FrameLayout::kMiniV3;        // 0x291 of 3 bytes, 0x312, 0x423
+  p.odometer_unit = OdometerUnit::kMillimetre;  // 0x311 / 0x312: left, right in mm
+  p.light_modes = LightModes::kOnOff;           // on/off only
+  p.tx_dlc = 0;  // its manual gives each command's length (0x141, 0x421, 0x423, 0x441: 1)
   return p;
 }
 
@@ -182,13 +205,14 @@ const ProtocolProfile& manual_profile() {
 }
 
 const std::vector<std::string>& protocol_revision_names() {
-  static const std::vector<std::string> kNames = {"manual", "agx_v2"};
+  static const std::vector<std::string> kNames = {"manual", "agx_v2", "mini_v3"};
   return kNames;
 }
 
 Result<ProtocolProfile> protocol_preset(std::string_view revision) {
   if (revision == "manual") return manual_profile();
   if (revision == "agx_v2") return make_agx_v2();
+  if (revision == "mini_v3") return make_mini_v3();
   return Error{Errc::kInvalidArgument, "unknown protocol revision '" + std::string(revision) +
                                            "' (valid: " + text::join(protocol_revision_names()) +
                                            ")"};

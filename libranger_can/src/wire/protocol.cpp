@@ -12,10 +12,12 @@ namespace ranger::protocol {
 
 namespace {
 
-std::vector<std::uint32_t> ids_of(std::uint8_t revisions) {
+// The identifiers of the rows `wanted` accepts, in ascending order.
+template <typename Wanted>
+std::vector<std::uint32_t> ids_where(Wanted wanted) {
   std::vector<std::uint32_t> ids;
   for (const FrameInfo& f : kFrameTable) {
-    if ((f.revisions & revisions) == 0) continue;
+    if (!wanted(f)) continue;
     for (int i = 0; i < f.count; ++i)
       ids.push_back(f.id + static_cast<std::uint32_t>(i * f.stride));
   }
@@ -25,21 +27,29 @@ std::vector<std::uint32_t> ids_of(std::uint8_t revisions) {
 
 }  // namespace
 
+std::vector<std::uint32_t> ids_of(FrameLayout layout) {
+  return ids_where([layout](const FrameInfo& f) { return f.in(layout); });
+}
+
 std::vector<std::uint32_t> manual_ids() {
-  return ids_of(kInManual);
+  return ids_of(FrameLayout::kManual);
 }
 
 std::vector<std::uint32_t> all_ids() {
-  return ids_of(kInManual | kInAgxV2);
+  return ids_where([](const FrameInfo&) { return true; });
 }
 
 bool is_known_id(std::uint32_t id) {
   return find_frame(id) != nullptr;
 }
 
-int layout_dlc(std::uint32_t id) {
+int layout_dlc(std::uint32_t id, FrameLayout layout) {
   const FrameInfo* f = find_frame(id);
-  return f != nullptr ? f->length : -1;
+  return f != nullptr ? f->length(layout) : -1;
+}
+
+int layout_dlc(std::uint32_t id) {
+  return layout_dlc(id, FrameLayout::kManual);
 }
 
 bool is_version_request(const CanFrame& f) {
@@ -58,13 +68,17 @@ bool is_chassis_frame(const CanFrame& frame) {
          (f->direction == Direction::kBoth && !is_version_request(frame));
 }
 
-int extra_bytes(const CanFrame& frame) {
+int extra_bytes(const CanFrame& frame, FrameLayout frame_layout) {
   if (frame.is_error) return 0;
-  const int layout = layout_dlc(frame.id);
+  const int layout = layout_dlc(frame.id, frame_layout);
   if (layout < 0) return 0;
   if (frame.id == kVersionId && !is_version_request(frame)) return 0;  // an answer: all text
   const int dlc = std::min<int>(frame.dlc, static_cast<int>(CanFrame::kMaxDlc));
   return dlc > layout ? dlc - layout : 0;
+}
+
+int extra_bytes(const CanFrame& frame) {
+  return extra_bytes(frame, FrameLayout::kManual);
 }
 
 std::string_view frame_name(std::uint32_t id) {
@@ -84,6 +98,8 @@ constexpr MotionMode kAgxV2Modes[] = {MotionMode::kAckermann, MotionMode::kObliq
                                       MotionMode::kSpin, MotionMode::kPark, MotionMode::kSideSlip};
 constexpr MotionMode kMiniV1Modes[] = {MotionMode::kAckermann, MotionMode::kOblique,
                                        MotionMode::kSpin, MotionMode::kSideSlip};
+constexpr MotionMode kMiniV3Modes[] = {MotionMode::kAckermann, MotionMode::kOblique,
+                                       MotionMode::kSpin, MotionMode::kPark};
 
 struct ModeTable {
   const MotionMode* modes;
@@ -98,6 +114,8 @@ ModeTable mode_table(ModeNumbering numbering) {
       return {kAgxV2Modes, std::size(kAgxV2Modes)};
     case ModeNumbering::kMiniV1:
       return {kMiniV1Modes, std::size(kMiniV1Modes)};
+    case ModeNumbering::kMiniV3:
+      return {kMiniV3Modes, std::size(kMiniV3Modes)};
   }
   return {nullptr, 0};
 }
@@ -180,7 +198,15 @@ std::vector<std::string> names_of_set_bits(std::uint32_t word, int width,
 const std::vector<NamedBit>& system_error_bits(ErrorWordLayout layout) {
   static const std::vector<NamedBit> manual = layout_bits(ErrorWordLayout::kManual32);
   static const std::vector<NamedBit> agx16 = layout_bits(ErrorWordLayout::kAgxV2_16);
-  return layout == ErrorWordLayout::kAgxV2_16 ? agx16 : manual;
+  static const std::vector<NamedBit> mini32 = layout_bits(ErrorWordLayout::kMini32);
+  switch (layout) {
+    case ErrorWordLayout::kAgxV2_16:
+      return agx16;
+    case ErrorWordLayout::kMini32:
+      return mini32;
+    default:
+      return manual;
+  }
 }
 
 const std::vector<NamedBit>& system_error_bits() {

@@ -55,6 +55,15 @@ int mode_wire_value(const MotionModeCommand& m, const ProtocolProfile& p) {
 std::string_view mode_name(proto::MotionMode mode, bool known) {
   return known ? proto::to_string(mode) : std::string_view("unknown");
 }
+// The wire value of a 0x423 (the raw byte when decoding found no drive mode).
+std::uint8_t drive_mode_wire_value(const DriveModeCommand& m) {
+  return m.mode_known ? static_cast<std::uint8_t>(m.mode) : m.mode_raw;
+}
+// A drive mode's name from its wire value ("unknown" for an undefined one).
+std::string_view drive_mode_name(std::uint8_t raw) {
+  const auto mode = proto::drive_mode_from_wire(raw);
+  return mode ? proto::to_string(*mode) : std::string_view("unknown");
+}
 
 // Whether the agx_v2 fields of 0x111/0x221 (bytes 2-5) are worth a place on a text line.
 bool show_v2_fields(const ProtocolProfile& p, std::initializer_list<double> values) {
@@ -135,6 +144,14 @@ struct JsonFields {
     w.key("mode").integer(m.mode_raw);
     w.key("mode_name").string(mode_name(m.mode, m.mode_known));
     w.key("switching").boolean(m.switching);
+    if (m.drive_mode) {
+      w.key("drive_mode").integer(*m.drive_mode);
+      w.key("drive_mode_name").string(drive_mode_name(*m.drive_mode));
+    }
+  }
+  void operator()(const DriveModeCommand& m) const {
+    w.key("mode").integer(drive_mode_wire_value(m));
+    w.key("mode_name").string(drive_mode_name(drive_mode_wire_value(m)));
   }
   void operator()(const UltrasonicFeedback& m) const {
     w.key("first_sensor").integer(m.first_sensor);
@@ -193,8 +210,11 @@ struct JsonFields {
     w.key("counter").integer(r.counter);
   }
   void operator()(const OdometerFeedback& o) const {
+    w.key("axle").string(o.rear ? "rear" : "front");
     w.key("left_wheel").integer(o.left_wheel);
     w.key("right_wheel").integer(o.right_wheel);
+    if (o.left_distance) w.key("left_distance").number(*o.left_distance);
+    if (o.right_distance) w.key("right_distance").number(*o.right_distance);
   }
   void operator()(const VersionRequest&) const { w.key("request").boolean(true); }
   void operator()(const VersionResponse& v) const { w.key("text").string(v.view()); }
@@ -262,6 +282,14 @@ struct TextFields {
   void operator()(const MotionModeFeedback& m) const {
     out += format("mode=%d (%s) switching=%s", m.mode_raw,
                   std::string(mode_name(m.mode, m.mode_known)).c_str(), m.switching ? "yes" : "no");
+    if (m.drive_mode) {
+      out += format(" drive=%d (%s)", *m.drive_mode,
+                    std::string(drive_mode_name(*m.drive_mode)).c_str());
+    }
+  }
+  void operator()(const DriveModeCommand& m) const {
+    const std::uint8_t v = drive_mode_wire_value(m);
+    out += format("mode=%d (%s)", v, std::string(drive_mode_name(v)).c_str());
   }
   void operator()(const UltrasonicFeedback& m) const {
     for (int i = 0; i < 4; ++i) {
@@ -304,8 +332,13 @@ struct TextFields {
         r.stick_right_v, r.stick_left_v, r.stick_left_h, r.var_a, r.counter);
   }
   void operator()(const OdometerFeedback& o) const {
-    out += format("left=%d right=%d (raw)", static_cast<int>(o.left_wheel),
-                  static_cast<int>(o.right_wheel));
+    // The frame's name says which axle (odometer: the front, rear_odometer: the rear).
+    if (o.left_distance && o.right_distance) {
+      out += format("left=%.3f m right=%.3f m", *o.left_distance, *o.right_distance);
+    } else {
+      out += format("left=%d right=%d (raw)", static_cast<int>(o.left_wheel),
+                    static_cast<int>(o.right_wheel));
+    }
   }
   void operator()(const VersionRequest&) const { out += "request"; }
   void operator()(const VersionResponse& v) const {
@@ -349,7 +382,9 @@ void append_frame_json(std::string& out, const CanFrame& frame, std::string_view
   std::string hex;
   append_hex_data(hex, frame, '\0');
   w.string(hex);
-  if (const int extra = proto::extra_bytes(frame); extra > 0) w.key("extra_bytes").integer(extra);
+  if (const int extra = proto::extra_bytes(frame, profile.frame_layout); extra > 0) {
+    w.key("extra_bytes").integer(extra);
+  }
   const Result<Message> decoded = decode(frame, profile);
   if (decoded) {
     write_message_json(w, *decoded, profile);
@@ -373,7 +408,7 @@ void append_frame_text(std::string& out, const CanFrame& frame, std::string_view
   const Result<Message> decoded = decode(frame, profile);
   if (decoded) {
     append_message_text(out, *decoded, profile);
-    if (const int extra = proto::extra_bytes(frame); extra > 0) {
+    if (const int extra = proto::extra_bytes(frame, profile.frame_layout); extra > 0) {
       out += format("  [+%d byte%s ignored]", extra, extra == 1 ? "" : "s");
     }
   } else {

@@ -45,6 +45,33 @@ std::string wheel_angle_text(double manual_rad) {
   return format("%6.2f deg ", std::abs(rep)) + (rep > 0 ? "left " : "right");
 }
 
+// A drive mode's name from 0x291 byte 2 ("current", "voltage", "unknown (7)").
+std::string drive_mode_text(std::uint8_t raw) {
+  const auto mode = protocol::drive_mode_from_wire(raw);
+  return mode ? std::string(protocol::to_string(*mode)) : "unknown (" + std::to_string(raw) + ")";
+}
+
+// One axle's odometers as JSON: {"left","right"} in metres where the profile gives the unit, else
+// {"left_raw","right_raw"}.
+void write_odometer(JsonWriter& w, const OdometerFeedback& v) {
+  w.key(v.rear ? "rear_odometer" : "front_odometer").begin_object();
+  if (v.left_distance && v.right_distance) {
+    w.key("left").number(*v.left_distance).key("right").number(*v.right_distance);
+  } else {
+    w.key("left_raw").integer(v.left_wheel).key("right_raw").integer(v.right_wheel);
+  }
+  w.end_object();
+}
+
+// One axle's odometers: in metres where the profile gives the unit, else the raw counts.
+std::string odometer_text(const OdometerFeedback& o) {
+  if (o.left_distance && o.right_distance) {
+    return format("left %.3f m  right %.3f m", *o.left_distance, *o.right_distance);
+  }
+  return format("left %d  right %d (raw, unit not stated)", static_cast<int>(o.left_wheel),
+                static_cast<int>(o.right_wheel));
+}
+
 std::string age_text(Timestamp received, Timestamp now) {
   const double ms = std::chrono::duration<double, std::milli>(now - received).count();
   if (ms < 1000) return format("%.0f ms ago", ms);
@@ -86,7 +113,7 @@ void ChassisMonitor::on_frame(const CanFrame& frame, Timestamp now) {
     return;
   }
   auto decoded = decode(frame, profile_);
-  stats_.record(frame.id, now, decoded.ok(), protocol::extra_bytes(frame));
+  stats_.record(frame.id, now, decoded.ok(), protocol::extra_bytes(frame, profile_.frame_layout));
   if (!decoded) {
     ++decode_errors_;
     return;
@@ -162,6 +189,7 @@ std::string ChassisMonitor::text_motion(bool color) const {
     const auto& m = fb_.motion_mode->value;
     motion += std::string(protocol::to_string(m.mode));
     motion += m.switching ? "   " + st.yellow("SWITCHING") : "   switching no";
+    if (m.drive_mode) motion += "   drive " + drive_mode_text(*m.drive_mode);
   } else {
     motion += "?";
   }
@@ -274,9 +302,15 @@ std::string ChassisMonitor::text_ultrasonic() const {
   return us + "\n";
 }
 
-// The vendor's additions (agx_v2): the remote control, the lights, the firmware version.
+// The vendor's additions (agx_v2, mini_v3): the remote control, the lights, the firmware version,
+// the wheels' odometers (0x311, the MINI 3.0's 0x312 too).
 std::string ChassisMonitor::text_vendor() const {
   std::string out;
+  for (const auto* o : {&fb_.odometer, &fb_.rear_odometer}) {
+    if (!*o) continue;
+    out += std::string((*o)->value.rear ? "Odometer rear   " : "Odometer front  ") +
+           odometer_text((*o)->value) + "\n";
+  }
   if (fb_.remote_control_state) {
     const RemoteState r =
         remote_state_from(fb_.remote_control_state->value, fb_.remote_control_state->received);
@@ -360,6 +394,12 @@ std::string ChassisMonitor::render_json(std::string_view iface, const BusStatus&
   if (fb_.motion_mode) {
     w.key("motion_mode").string(protocol::to_string(fb_.motion_mode->value.mode));
     w.key("switching").boolean(fb_.motion_mode->value.switching);
+    if (const auto& d = fb_.motion_mode->value.drive_mode) {
+      w.key("drive_mode").string(drive_mode_text(*d));
+    }
+  }
+  for (const auto* o : {&fb_.odometer, &fb_.rear_odometer}) {
+    if (*o) write_odometer(w, (*o)->value);
   }
   if (fb_.motion) {
     w.key("speed").number(fb_.motion->value.speed);

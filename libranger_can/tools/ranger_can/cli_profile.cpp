@@ -47,12 +47,14 @@ OptionSpec protocol_option(bool with_auto) {
                 with_auto
                     ? "the protocol revision the chassis speaks: auto (the default) identifies "
                       "it from the chassis's own frames (a log's frames when reading one); "
-                      "manual (the user manual) or agx_v2 (the vendor's current software) "
-                      "force a preset; docs/PROTOCOL_INTERPRETATIONS.md lists what each one "
-                      "sets and how auto decides"
-                    : "the protocol revision: manual (the user manual) or agx_v2 (the "
-                      "vendor's current software); default: the model's, else manual; "
-                      "docs/PROTOCOL_INTERPRETATIONS.md lists what each one sets",
+                      "manual (the user manual), agx_v2 (the vendor's current software) or "
+                      "mini_v3 (the RANGER MINI 3.0's manual) force a preset; "
+                      "docs/PROTOCOL_INTERPRETATIONS.md lists what each one sets and how auto "
+                      "decides"
+                    : "the protocol revision: manual (the user manual), agx_v2 (the vendor's "
+                      "current software) or mini_v3 (the RANGER MINI 3.0's manual); default: "
+                      "the model's, else manual; docs/PROTOCOL_INTERPRETATIONS.md lists what "
+                      "each one sets",
                 one_of(choices));
 }
 

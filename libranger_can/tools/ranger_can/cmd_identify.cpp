@@ -122,10 +122,11 @@ const CommandSpec& identify_command() {
       "Runs the driver with --protocol auto until it has identified the chassis, then prints the\n"
       "decision: every protocol setting (decided from evidence, or kept at the preset's value),\n"
       "the confidence and the evidence, one line each, then the chassis's firmware version\n"
-      "(0x4A1, asked once the settings are decided; agx_v2 chassis only).\n"
+      "(0x4A1, asked once the settings are decided; agx_v2 and mini_v3 chassis only).\n"
       "\n"
-      "The driver first listens without sending anything (the IDs only the vendor's revision\n"
-      "sends, frame lengths, the 0x211 byte-7 counter, the BMS voltage scale), then takes CAN\n"
+      "The driver first listens without sending anything (the IDs only the vendor's revisions\n"
+      "send, the IDs and lengths only the RANGER MINI 3.0 has, padding, the 0x211 byte-7\n"
+      "counter, the BMS voltage scale), then takes CAN\n"
       "command mode and checks the steering at standstill: a switch to spin mode (every wheel at\n"
       "+-atan(wheelbase/track)) and a few degrees of steering at zero speed, read back from\n"
       "0x271 and 0x221. No wheel rolls. IFACE is any bus: can0, sim, sim:VARIANT (simulated\n"
@@ -136,8 +137,8 @@ const CommandSpec& identify_command() {
        option("--timeout", "S", "give up after S seconds (default 10): the node's identify_timeout",
               number_in(2.0, 600.0)),
        flag("--no-spin-check", "skip the spin-mode check of the 0x271 unit and sign")},
-      "With --protocol manual or agx_v2 the identification starts from that preset instead of\n"
-      "deciding it; --set values are applied after it.\n"
+      "With --protocol manual, agx_v2 or mini_v3 the identification starts from that preset\n"
+      "instead of deciding it; --set values are applied after it.\n"
       "Exit status: 0 identified; 1 not identified (the message says what to set instead), the\n"
       "bus could not be opened, or interrupted; 2 on a usage error.",
       identify_main,

@@ -78,10 +78,18 @@ Result<Message> parse_lights(const Words& w) {
     c.enable = false;  // the chassis's own lights again
     return Message{c};
   }
-  if (w.size() != 2) return bad("usage: send IFACE lights FRONT REAR | release");
   if (Status st = parse_light("FRONT", w[0], c.front_mode, c.front_custom); !st) return st.error();
+  // One word: the lights (the MINI 3.0's on or off), no rear light asked for.
+  if (w.size() == 1) return Message{c};
   if (Status st = parse_light("REAR", w[1], c.rear_mode, c.rear_custom); !st) return st.error();
   return Message{c};
+}
+
+Result<Message> parse_drive_mode(const Words& w) {
+  const auto mode = protocol::kDriveModeNames.parse(w[0]);
+  if (mode) return Message{DriveModeCommand{*mode}};
+  return bad("drive_mode: unknown drive mode '" + w[0] + "' (" +
+             text::join(protocol::kDriveModeNames.names()) + ")");
 }
 
 Result<Message> parse_version(const Words&) {
@@ -142,12 +150,13 @@ const std::vector<SendCommand>& send_commands() {
       {"mode", text::join(mode_names(), "|"), 1, 1,
        "0x141 motion mode (side_slip: MINI V1 and agx_v2 numbering only)", parse_mode},
       {"park", "on|off", 1, 1,
-       "0x141 park (on) or dual Ackermann (off); agx_v2 numbering only (the manual and the MINI "
-       "V1 have no park)",
+       "0x141 park (on) or dual Ackermann (off); agx_v2 and mini_v3 numbering only (the manual "
+       "and the MINI V1 have no park)",
        parse_park},
-      {"lights", "FRONT REAR|release", 1, 2,
-       "0x121 lights (agx_v2): FRONT and REAR each off, on, breathing or custom:PCT (brightness "
-       "0-100); release hands the lights back to the chassis",
+      {"lights", "FRONT [REAR]|release", 1, 2,
+       "0x121 lights (agx_v2, mini_v3): FRONT and REAR each off, on, breathing or custom:PCT "
+       "(brightness 0-100; mini_v3: FRONT on or off alone); release hands the lights back to "
+       "the chassis",
        parse_lights},
       {"version", "", 0, 0, "0x4A1 firmware version request (agx_v2; the answer is not waited for)",
        parse_version},
@@ -168,6 +177,8 @@ const std::vector<SendCommand>& send_commands() {
            number_text(kMaxSpinSpeedMps) +
            "). The chassis stops again 500 ms later unless repeated.",
        parse_motion},
+      {"drive_mode", text::join(protocol::kDriveModeNames.names(), "|"), 1, 1,
+       "0x423 drive mode of the motor drivers (mini_v3 only)", parse_drive_mode},
   };
   return commands;
 }
@@ -214,11 +225,9 @@ int send_main(const ParsedArgs& args, Io io) {
   auto message = parse_command(*args.get("COMMAND"), args.all("ARGS"));
   if (!message) return usage_error(send_command(), io, message.error().message);
   apply_spin_field(*message, *vehicle);
-  if (const auto* m = std::get_if<MotionModeCommand>(&*message);
-      m && !protocol::motion_mode_to_wire(m->mode, vehicle->profile.mode_numbering)) {
-    io.err << "ranger_can send: " << protocol::to_string(m->mode) << ": unsupported by protocol "
-           << vehicle->profile.revision << " (its motion-mode numbering has no "
-           << protocol::to_string(m->mode) << " mode)\n";
+  if (const auto missing = unsupported_feature(*message, vehicle->profile)) {
+    io.err << "ranger_can send: " << missing->feature << ": unsupported by protocol "
+           << vehicle->profile.revision << " (" << missing->reason << ")\n";
     return 1;
   }
   auto frame = encode(*message, vehicle->profile);

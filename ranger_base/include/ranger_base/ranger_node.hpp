@@ -31,6 +31,7 @@
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <geometry_msgs/Twist.h>
 #include <ranger_msgs/ClearErrors.h>
+#include <ranger_msgs/SetDriveMode.h>
 #include <ranger_msgs/SetLights.h>
 #include <ranger_msgs/SetMotionMode.h>
 #include <ranger_msgs/SetUltrasonic.h>
@@ -102,6 +103,8 @@ class RangerNode {
                           ranger_msgs::SetMotionMode::Response& res);
   bool on_set_lights(ranger_msgs::SetLights::Request& req, ranger_msgs::SetLights::Response& res);
   bool on_park(std_srvs::SetBool::Request& req, std_srvs::SetBool::Response& res);
+  bool on_set_drive_mode(ranger_msgs::SetDriveMode::Request& req,
+                         ranger_msgs::SetDriveMode::Response& res);
   // The outcome of request `id` (of `kind`) once answered or failed, after the driver's budget
   // for it, or at shutdown.
   ranger::RequestOutcome wait_for(std::uint64_t id, ranger::RequestOutcome::Kind kind) {
@@ -142,7 +145,7 @@ class RangerNode {
       ground_truth_pub_, tf_pub_, remote_state_pub_;
   std::array<ros::Publisher, 8> range_pubs_;
   ros::ServiceServer resume_srv_, clear_errors_srv_, set_ultrasonic_srv_, set_motion_mode_srv_,
-      set_lights_srv_, park_srv_;
+      set_lights_srv_, park_srv_, set_drive_mode_srv_;
 
   diagnostic_updater::Updater updater_;
   std::unique_ptr<ChassisDiagnostics> diagnostics_;

@@ -135,6 +135,13 @@ def to_system_state(s, stamp, detail: str) -> SystemState:
     msg.parked = s.parked
     msg.firmware_version = s.firmware_version
     msg.firmware_version_state = s.firmware_state
+    raw = s.drive_mode_raw
+    msg.drive_mode = SystemState.DRIVE_MODE_NONE if raw is None else raw
+    msg.drive_mode_name = s.drive_mode or ""
+    (msg.front_left_distance, msg.front_right_distance, msg.rear_left_distance,
+     msg.rear_right_distance) = s.wheel_odometers
+    msg.bms_alarms = list(s.bms_alarms)
+    msg.bms_warnings = list(s.bms_warnings)
     return msg
 
 

@@ -35,7 +35,7 @@ from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 from ranger_msgs.msg import (ActuatorStateArray, BmsStateArray, RemoteState, SystemState,
                              UltrasonicState)
-from ranger_msgs.srv import ClearErrors, SetLights, SetMotionMode, SetUltrasonic
+from ranger_msgs.srv import ClearErrors, SetDriveMode, SetLights, SetMotionMode, SetUltrasonic
 from sensor_msgs.msg import BatteryState, JointState, Range
 from std_msgs.msg import String
 from std_srvs.srv import SetBool, Trigger
@@ -50,6 +50,7 @@ MOTION_MODES = {SetMotionMode.Request.ACKERMANN: "ackermann",
                 SetMotionMode.Request.OBLIQUE: "oblique", SetMotionMode.Request.SPIN: "spin",
                 SetMotionMode.Request.SIDE_SLIP: "side_slip",
                 SetMotionMode.Request.AUTOMATIC: None}
+DRIVE_MODES = {SetDriveMode.Request.CURRENT: "current", SetDriveMode.Request.VOLTAGE: "voltage"}
 LIGHT_MODES = {SetLights.Request.OFF: "off", SetLights.Request.ON: "on",
                SetLights.Request.BREATHING: "breathing", SetLights.Request.CUSTOM: "custom"}
 LIGHT_CODES = {v: k for k, v in LIGHT_MODES.items()}
@@ -133,6 +134,8 @@ class RangerNode(Node):
                                 callback_group=g),
             self.create_service(SetLights, "set_lights", self._on_set_lights, callback_group=g),
             self.create_service(SetBool, "park", self._on_park, callback_group=g),
+            self.create_service(SetDriveMode, "set_drive_mode", self._on_set_drive_mode,
+                                callback_group=g),
         ]
         self._thread = threading.Thread(target=self._publication_loop, name="ranger_publish",
                                         daemon=True)
@@ -319,6 +322,23 @@ class RangerNode(Node):
         response.success = ok
         response.message = message
         self._log_answer("park", ok, message)
+        return response
+
+    def _on_set_drive_mode(self, request, response):
+        mode = DRIVE_MODES.get(request.mode)
+        if mode is None:
+            response.success = False
+            response.message = (f"drive mode {request.mode} is not one of 0 (CURRENT), "
+                                "1 (VOLTAGE): nothing sent")
+        else:
+            ok, message, _ = self._answer("set_drive_mode",
+                                          lambda: self.driver.set_drive_mode(mode))
+            response.success = ok
+            response.message = message
+        reported = self.driver.snapshot().drive_mode_raw
+        response.drive_mode = SystemState.DRIVE_MODE_NONE if reported is None else reported
+        if not response.success:
+            self.get_logger().warn(f"set_drive_mode: {response.message}")
         return response
 
     # ---- publication (a thread of the node's own) ----

@@ -12,7 +12,8 @@ import time
 
 import pytest
 import rclpy
-from ranger_msgs.srv import SetLights
+from ranger_msgs.msg import SystemState
+from ranger_msgs.srv import SetDriveMode, SetLights
 from std_srvs.srv import SetBool, Trigger
 
 from support import Client, Robot, node_executable, ros_args, yaw
@@ -74,12 +75,14 @@ def assert_odometry_follows(robot):
     assert yaw_error <= 0.01 * turned + 0.02, (yaw_error, turned)
 
 
-@pytest.mark.parametrize("port", ["sim", "sim:agx_v2"])
-def test_drives_every_mode_with_odometry_following_the_ground_truth(robots, port):
-    r = robots(port)
+@pytest.mark.parametrize("port,model,profile", [("sim", "ranger", "manual"),
+                                                ("sim:agx_v2", "ranger", "agx_v2"),
+                                                ("sim:mini_v3", "ranger_mini_v3", "mini_v3")])
+def test_drives_every_mode_with_odometry_following_the_ground_truth(robots, port, model, profile):
+    r = robots(port, model=model)
     s = r.wait_ready()
     assert s.protocol == "auto" and s.identification == "decided"
-    assert s.protocol_profile == ("agx_v2" if port == "sim:agx_v2" else "manual")
+    assert s.protocol_profile == profile
     drive(r, vx=0.6, wz=0.2, distance=1.0)
     assert r.state().motion_mode_name == "ackermann"
     assert_odometry_follows(r)
@@ -226,3 +229,23 @@ def test_shutdown_stops_the_chassis(robots, sig):
         last = r.client.history[f"{r.ns}/cmd_vel_out"][-1]
         return last.twist.linear.x == 0.0 and last.twist.angular.z == 0.0
     r.client.wait_for(last_is_zero, 10, "the stop on cmd_vel_out")
+
+
+def test_drive_mode_on_the_mini_v3_and_refused_by_name_elsewhere(robots, client):
+    r = robots("sim:mini_v3", model="ranger_mini_v3")
+    r.wait_ready()
+    answer = client.call(SetDriveMode, f"{r.ns}/set_drive_mode",
+                         SetDriveMode.Request(mode=SetDriveMode.Request.VOLTAGE))
+    assert answer.success, answer.message
+    assert answer.drive_mode == SystemState.DRIVE_MODE_VOLTAGE
+    s = r.wait_state(lambda s: s.drive_mode_name == "voltage", 10, "voltage")
+    assert s.drive_mode == SystemState.DRIVE_MODE_VOLTAGE
+    bad = client.call(SetDriveMode, f"{r.ns}/set_drive_mode", SetDriveMode.Request(mode=7))
+    assert not bad.success and "not one of 0 (CURRENT), 1 (VOLTAGE)" in bad.message
+    other = robots("sim")
+    other.wait_ready()
+    refused = client.call(SetDriveMode, f"{other.ns}/set_drive_mode",
+                          SetDriveMode.Request(mode=SetDriveMode.Request.CURRENT))
+    assert not refused.success and "unsupported by protocol manual" in refused.message
+    assert refused.drive_mode == SystemState.DRIVE_MODE_NONE
+    assert other.state().drive_mode_name == ""

@@ -395,6 +395,9 @@ class ChassisController {
 
   // Sends 0x441 with `code` (protocol::ErrorClearCode, 0x00..0x10); kInvalidArgument otherwise.
   Status clear_errors(std::uint8_t code, Timestamp now);
+  // Sends 0x423 (the motor drivers' drive mode, the RANGER MINI 3.0's); kInvalidArgument, naming
+  // the reading, where the profile has no drive modes. 0x291 byte 2 reports the mode.
+  Status set_drive_mode(protocol::DriveMode mode, Timestamp now);
 
   // Sends 0x451; confirmed when 0x45A reports the same, resent up to ultrasonic_max_attempts.
   Status set_ultrasonic(bool enable, Timestamp now);
@@ -447,6 +450,9 @@ class ChassisController {
   const ControllerConfig& config() const { return config_; }
 
  private:
+  // kInvalidArgument "FEATURE: unsupported by protocol REVISION (why)" for a command the
+  // profile's chassis lacks (unsupported_feature), else ok.
+  Status refuse_unsupported(const Message& command) const;
   bool send(const Message& message, Timestamp now, const KinematicsSolution* solution = nullptr,
             bool shutdown = false);
   void send_motion(const MotionCommand& command, const KinematicsSolution* solution, Timestamp now,

@@ -165,6 +165,11 @@ class Driver {
   // off: motion allowed again, answered once the chassis has left park. Failed, naming why,
   // where the mode numbering has no park (manual, MINI V1).
   std::uint64_t set_park(bool on);
+  // Drive mode (0x423, the RANGER MINI 3.0's: the motor drivers' current or voltage loop).
+  // Answered once 0x291 reports it; failed, naming the reading, where the profile has no drive
+  // modes ("drive modes: unsupported by protocol agx_v2 ..."), or when 0x291 reports another
+  // after request_answer_timeout.
+  std::uint64_t set_drive_mode(protocol::DriveMode mode);
   // Asks for the firmware version again (it is asked once by itself); answered with the text.
   std::uint64_t request_firmware_version();
   // While set (after the identification, if any): speed is refused (kIdentifying, with

@@ -35,9 +35,9 @@ struct DriverMail {
   std::optional<std::optional<protocol::MotionMode>> mode;
   std::optional<std::optional<StandstillProbe>> probe;
   struct Action {
-    RequestOutcome::Kind kind;  // kClearErrors, kUltrasonic, kPark or kResume
+    RequestOutcome::Kind kind;  // kClearErrors, kUltrasonic, kPark, kResume or kDriveMode
     std::uint64_t id;
-    std::uint8_t code;
+    std::uint8_t code;  // kClearErrors: the 0x441 code; kDriveMode: the drive mode
     bool enable;
   };
   std::vector<Action> actions;

@@ -77,6 +77,9 @@ struct DriverSnapshot {
   std::optional<RemoteState> remote;
   std::optional<LightsState> lights;
   FirmwareVersion firmware;
+  // The drive mode the chassis reports (0x291 byte 2, the RANGER MINI 3.0's); nullopt where the
+  // profile's 0x291 has no such byte, or before the chassis is heard.
+  std::optional<protocol::DriveMode> drive_mode;
 
   // The outcome of request `id`, if it is still in the list.
   const RequestOutcome* request(std::uint64_t id) const;

@@ -45,10 +45,11 @@ struct ChassisFeedback {
   std::array<std::optional<Stamped<BmsAlarm>>, protocol::kBatteryCount + 1> bms_alarm;
   std::array<std::optional<Stamped<UltrasonicFeedback>>, 2> ultrasonic;  // 0x342, 0x343
   std::optional<Stamped<UltrasonicSettingFeedback>> ultrasonic_setting;  // 0x45A
-  // The vendor's revision only (agx_v2): what a manual chassis never sends.
+  // The vendor's revisions only (agx_v2, mini_v3): what a manual chassis never sends.
   std::optional<Stamped<LightState>> light_state;                   // 0x231
   std::optional<Stamped<RemoteControlState>> remote_control_state;  // 0x241
-  std::optional<Stamped<OdometerFeedback>> odometer;                // 0x311
+  std::optional<Stamped<OdometerFeedback>> odometer;                // 0x311, the front wheels
+  std::optional<Stamped<OdometerFeedback>> rear_odometer;           // 0x312 (mini_v3)
   std::string version;         // 0x4A1 answers, concatenated (at most 64 characters kept)
   std::uint64_t messages = 0;  // chassis -> host messages recorded
 

@@ -8,9 +8,12 @@
 // `decode` and `odom` use the same class (the last two on a log, passively: identify_log()).
 //
 // 1. Listening (nothing is sent): the chassis's periodic frames say what they can at rest —
-//    * IDs only the vendor's revision has (0x231 light state, 0x241 remote control, 0x311
-//      odometer, 0x4A1 version answers): the agx_v2 preset, else the manual's;
-//    * frames longer than their layout (padding): tx_dlc 8;
+//    * IDs only the vendor's revisions have (0x231 light state, 0x241 remote control, 0x311
+//      odometer, 0x4A1 version answers): the agx_v2 preset, else the manual's; IDs and lengths
+//      only the RANGER MINI 3.0 has (0x312 rear odometer, 0x291 of 3 bytes with the drive mode):
+//      the mini_v3 preset, unless 0x211 byte 7 counts (agx_v2's counter, where the MINI 3.0 has
+//      faults): then no revision fits and the identification fails, naming what to set;
+//    * frames longer than their layout in every revision (padding): tx_dlc 8;
 //    * 0x211 byte 7 rising by one per frame: a counter, so the error word is agx16 (under the
 //      manual's 32-bit word it would be a changing set of phantom motor faults); a constant byte 7
 //      keeps the preset's layout;
@@ -124,7 +127,7 @@ struct IdentificationStatus {
   IdentificationPhase phase = IdentificationPhase::kListening;
   // The decision (kDecided), else the current proposal (the preset and what was seen so far).
   ProtocolProfile profile;
-  std::string revision;  // the preset it started from: "manual" or "agx_v2"
+  std::string revision;  // the preset it started from: "manual", "agx_v2" or "mini_v3"
   // Human-readable evidence, one line per observation, in the order found (for logs).
   std::vector<std::string> evidence;
   std::vector<IdentifiedSetting> decided;  // settings the evidence decided
@@ -156,7 +159,8 @@ struct IdentificationRequest {
 
 class ChassisIdentifier {
  public:
-  // `forced_revision`: start from that preset ("manual", "agx_v2") instead of deciding it; the
+  // `forced_revision`: start from that preset ("manual", "agx_v2", "mini_v3") instead of deciding
+  // it; the
   // rest is identified all the same. `read_only`: a log or a listen-only bus: no probe, the
   // decision comes from the frames alone (at listen_time, or at finish()).
   explicit ChassisIdentifier(IdentificationConfig config = {}, VehicleGeometry geometry = {},
@@ -194,13 +198,17 @@ class ChassisIdentifier {
     SteeringSign sign;
   };
   void start(Timestamp now);
-  // The passive evidence, frame by frame: what only agx_v2 sends and padding (every chassis
+  // The passive evidence, frame by frame: what only some revisions send and padding (every chassis
   // frame), 0x211, 0x291, 0x361 and the rolling wheels (0x271 + 0x281).
   void observe_passive(const CanFrame& frame);
   void observe_origin(const CanFrame& frame);
   void observe_status(const CanFrame& frame);
   void observe_bms(const CanFrame& frame);
   void observe_rolling(const CanFrame& frame);
+  // What a chassis frame says about the revision: IDs and lengths only some revisions have.
+  void observe_signatures(const CanFrame& frame, const protocol::FrameInfo& info);
+  // Longer than its layout in every revision that defines it (padding, not another layout).
+  static bool padded(const CanFrame& frame, const protocol::FrameInfo& info);
   void observe_probe(const CanFrame& frame, Timestamp now);
   // The phases, tick by tick; why the identification timed out in the phase it is in.
   std::string timeout_reason() const;
@@ -208,6 +216,10 @@ class ChassisIdentifier {
   void tick_awaiting_control(Timestamp now);
   void tick_step(Timestamp now);
   void decide_passive(Timestamp now);
+  // The revision preset from the frames' signatures (or the forced one); false when they fit no
+  // revision (the identification has failed).
+  bool decide_revision(Timestamp now);
+  bool byte7_counts() const;  // 0x211 byte 7 rose by one in >= 90 % of >= 10 frames
   void begin_step(IdentificationPhase phase, Timestamp now);
   bool settled(Timestamp now) const;
   void evaluate_spin(Timestamp now);
@@ -238,8 +250,9 @@ class ChassisIdentifier {
   // ---- passive evidence
   std::uint64_t status_frames_ = 0;
   Timestamp first_status_{0};
-  std::vector<std::string> agx_signatures_;  // what only agx_v2 sends
-  std::vector<std::uint32_t> padded_ids_;    // chassis frames longer than their layout
+  std::vector<std::string> agx_signatures_;   // what only the vendor's revisions send
+  std::vector<std::string> mini_signatures_;  // what only mini_v3 sends
+  std::vector<std::uint32_t> padded_ids_;     // chassis frames longer than their layout
   std::optional<std::uint8_t> last_byte7_;
   int byte7_steps_ = 0;       // consecutive 0x211 pairs
   int byte7_increments_ = 0;  // ... where byte 7 rose by one

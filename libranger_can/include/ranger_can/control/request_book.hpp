@@ -29,7 +29,15 @@ namespace ranger {
 
 // What became of a request posted through the mailbox.
 struct RequestOutcome {
-  enum class Kind { kClearErrors, kUltrasonic, kResume, kLights, kPark, kFirmwareVersion };
+  enum class Kind {
+    kClearErrors,
+    kUltrasonic,
+    kResume,
+    kLights,
+    kPark,
+    kFirmwareVersion,
+    kDriveMode
+  };
   enum class State { kPending, kSent, kAnswered, kFailed };
   std::uint64_t id = 0;
   Kind kind = Kind::kResume;
@@ -39,6 +47,8 @@ struct RequestOutcome {
   std::string message;  // why it failed, or what the answer was
   // clear_errors: the 0x211 error word the chassis reported after it received the 0x441.
   std::optional<std::uint32_t> error_word;
+  // kDriveMode: the drive mode asked for (0x423), answered once 0x291 reports it.
+  std::optional<protocol::DriveMode> drive_mode;
   Timestamp sent{0};  // driver clock
 
   bool settled() const { return state == State::kAnswered || state == State::kFailed; }
@@ -50,6 +60,7 @@ inline constexpr auto kRequestKindNames = text::enum_names<RequestOutcome::Kind>
     {RequestOutcome::Kind::kLights, "lights"},
     {RequestOutcome::Kind::kPark, "park"},
     {RequestOutcome::Kind::kFirmwareVersion, "firmware_version"},
+    {RequestOutcome::Kind::kDriveMode, "drive_mode"},
 });
 inline constexpr auto kRequestStateNames = text::enum_names<RequestOutcome::State>({
     {RequestOutcome::State::kPending, "pending"},
@@ -87,10 +98,12 @@ class RequestBook {
 
   explicit RequestBook(RequestTiming timing = {}) : timing_(timing) {}
 
-  // Records a new request (`what` says it for people; `lights`: what a lights request asks for);
+  // Records a new request (`what` says it for people; `lights`, `drive_mode`: what a lights or a
+  // drive-mode request asks for);
   // returns its id (1, 2, ...).
   std::uint64_t add(RequestOutcome::Kind kind, std::string what, bool on = false,
-                    const LightsRequest& lights = {});
+                    const LightsRequest& lights = {},
+                    std::optional<protocol::DriveMode> drive_mode = std::nullopt);
   // The driver applied request `id` at `now`: sent (or failed with the status's message). A
   // resume that went through is answered at once ("re-armed").
   void applied(std::uint64_t id, Timestamp now, const Status& status);

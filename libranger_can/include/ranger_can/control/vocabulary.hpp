@@ -19,6 +19,8 @@ namespace ranger {
 
 // ---- the vocabulary ---------------------------------------------------------------------------
 using protocol::ControlMode;
+using protocol::DriveMode;
+using protocol::drive_mode_from_wire;  // 0 current, 1 voltage (ranger_msgs' SetDriveMode)
 using protocol::Fault;
 using protocol::LightMode;
 using protocol::MotionMode;
@@ -49,6 +51,9 @@ std::vector<std::string> fault_names(std::uint32_t error_word, ErrorWordLayout l
 // A motor driver's status byte (0x261..0x268) and a BMS alarm or warning pair (0x362..), by name.
 std::vector<NamedFlag> driver_status_flags(std::uint8_t status);
 std::vector<NamedFlag> bms_flags(std::uint8_t status1, std::uint8_t status2);
+// The names of the bits set in a BMS alarm or warning pair, reserved ones as "reserved_bit_N"
+// (status 1) and "status2_reserved_bit_N".
+using protocol::bms_status_names;
 
 // ---- readings ---------------------------------------------------------------------------------
 // Whether battery slot `slot` (0: the whole pack, 1..kBatteryCount) reported recently: a BMS

@@ -37,7 +37,10 @@ namespace ranger::sim {
 
 struct MotionLimits {
   double max_linear_speed = interpretation::kMaxLinearSpeedMps;  // m/s, Ackermann and oblique
-  double max_spin_speed = kMaxSpinSpeedMps;                      // m/s wheel speed (0x111's range)
+  // m/s, Ackermann and oblique while |steering| > interpretation::kLargeSteeringThresholdRad (the
+  // manual's lower limit beyond 20 deg; the MINI 3.0's manual: 0.7 m/s)
+  double max_speed_at_large_steering = interpretation::kMaxLinearSpeedMps;
+  double max_spin_speed = kMaxSpinSpeedMps;               // m/s wheel speed (0x111's range)
   double max_ackermann_angle = kMaxAckermannSteeringRad;  // rad, mean front angle (0x111's range)
   double max_oblique_angle = kMaxObliqueSteeringRad;      // rad (0x111's range)
   double acceleration = 1.0;                              // m/s^2 when speeding up

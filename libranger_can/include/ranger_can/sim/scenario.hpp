@@ -59,7 +59,7 @@ inline constexpr double kStillSpeed = 0.001;  // m/s
 // One `expect` line, checked against the sample at the time it is reached.
 struct Expectation {
   enum class Kind {
-    kEquals,   // a text field equals `text` (refusal, control_mode, motion_mode, rearm_required)
+    kEquals,   // a text field equals `text` (refusal, control_mode, motion_mode, drive_mode, ...)
     kCompare,  // a numeric field compared with `number` (value as printed)
     kMoving,   // truth.speed > kStillSpeed
     kStill,    // truth.speed <= kStillSpeed
@@ -95,6 +95,7 @@ struct ScenarioAction {
     kMode,         // mode auto|ackermann|oblique|spin
     kClearErrors,  // clear-errors CODE
     kPark,         // park on|off
+    kDriveMode,    // drive_mode current|voltage
     kChassis,      // a sim::parse_chassis_command line
     kWait,
     kExpect,
@@ -104,7 +105,7 @@ struct ScenarioAction {
   std::string text;                          // the line without its comment, trimmed
   BodyTwist twist;                           // kCommand
   std::optional<protocol::MotionMode> mode;  // kMode (nullopt: auto)
-  std::uint8_t code = 0;                     // kClearErrors
+  std::uint8_t code = 0;                     // kClearErrors; kDriveMode: the drive mode
   bool enable = false;                       // kPark
   ChassisAction chassis;                     // kChassis
   std::chrono::milliseconds wait{0};         // kWait
@@ -163,6 +164,9 @@ struct ScenarioSample {
   std::vector<std::string> latched;  // the latched stop causes
   double steer_first_factor = 1.0;
   std::string identification = "none";  // its phase under protocol auto, else "none"
+  // The drive mode the chassis reports (0x291 byte 2, the RANGER MINI 3.0's); nullopt where its
+  // protocol has none (then not printed).
+  std::optional<std::string> drive_mode;
 };
 
 // The sample as one JSON object (no newline), with fixed formatting: seconds with 3 decimals,

@@ -47,6 +47,15 @@
 //  * With vendor_frames (the vendor's revision has them, the manual does not): 0x231 light state
 //    (what the last 0x121 set) and 0x241 remote-control state every 20 ms, each with a counter in
 //    byte 7, and an answer to every 0x4A1 version request (`version`, 8 characters a frame).
+//  * It sends only the frames its profile's frame layout has (the frame table's column: a MINI
+//    3.0 sends no ultrasonic frames, no battery slots 1-4) and obeys only the commands it has (the
+//    others are rejected as not this chassis's).
+//  * With odometer_frames (the MINI 3.0): 0x311 and 0x312, the front and the rear wheels' left
+//    and right odometers (each wheel's signed rolled distance since power-on, in the profile's
+//    odometer unit) every 20 ms (reading: no source gives a period).
+//  * Drive modes (a frame layout with 0x423, the MINI 3.0): 0x423 in CAN mode sets the drive mode
+//    (current at power-on: reading), 0x291 byte 2 reports it; the physics does not change with it.
+//  * A fault word with an e-stop bit (the MINI 3.0's) sets it while the e-stop is pressed.
 //  * Under the remote control (control mode remote) the operator drives, per the manual's section
 //    2.3 (RemoteInput below): SWD up is dual Ackermann (left stick the speed, right stick the
 //    steering) and, with the left stick centred, spin (the right stick its direction); SWD down is
@@ -115,7 +124,8 @@ struct VirtualChassisConfig {
   bool vendor_frames = false;                // 0x231, 0x241 every 20 ms and 0x4A1 answers (agx_v2)
   std::string version = "ranger_sim 0.1.0";  // the 0x4A1 answer (vendor_frames only)
   bool steering_angles_frame = true;         // 0x271 (false: never sent)
-  bool spin_angle_reported = true;           // 0x221's angle in spin mode (false: 0, as at rest)
+  bool odometer_frames = false;     // 0x311 / 0x312 front and rear wheel odometers every 20 ms
+  bool spin_angle_reported = true;  // 0x221's angle in spin mode (false: 0, as at rest)
   DrivetrainConfig drivetrain;
   std::chrono::nanoseconds mode_switch_duration = std::chrono::milliseconds(500);
   std::chrono::nanoseconds command_timeout =
@@ -151,9 +161,9 @@ struct ChassisSnapshot {
   std::string motion_refused_reason;  // empty when allowed
   bool silent = false;
   bool ultrasonic_enabled = false;
-  RemoteInput remote;                 // the remote control's switches and sticks
-  MotionTarget target;                // REP-103
-  double speed = 0.0;                 // model speed (see MotionTarget)
+  RemoteInput remote;   // the remote control's switches and sticks
+  MotionTarget target;  // REP-103
+  double speed = 0.0;   // model speed (see MotionTarget)
   double steering = 0.0;
   BodyTwist twist;
   WheelStates wheels{};
@@ -162,6 +172,10 @@ struct ChassisSnapshot {
   double yaw_travelled = 0.0;       // rad, total |rotation| since boot
   BatteryTelemetry battery;
   LightState lights;  // what 0x231 reports (agx_v2 only sends it)
+  protocol::DriveMode drive_mode = protocol::DriveMode::kCurrent;  // 0x291 byte 2 (mini_v3)
+  // Each wheel's signed rolled distance since power-on, m (0x311/0x312), wheel order RF, RR, LR,
+  // LF.
+  std::array<double, 4> wheel_distance{};
 };
 
 struct VirtualChassisCounters {
@@ -266,6 +280,12 @@ class VirtualChassis {
   void handle_motion_mode(const MotionModeCommand& cmd);
   void handle_control_mode(const ControlModeCommand& cmd);
   void handle_ultrasonic_setting(const UltrasonicSettingCommand& cmd);
+  void handle_drive_mode(const DriveModeCommand& cmd);
+  // Whether `message` is a command this chassis obeys (its frame layout has it; the vendor's
+  // commands only with vendor_frames).
+  bool is_own_command(const Message& message, std::uint32_t id) const;
+  void send_odometers(Timestamp t);
+  void send_vendor_frames(Timestamp t);  // 0x231 and 0x241, each with its counter
   void answer_version_request();
   std::uint32_t bit(protocol::Fault fault, int motor = 0) const;
   void set_control_mode(protocol::ControlMode mode, const std::string& why);
@@ -299,7 +319,9 @@ class VirtualChassis {
   std::uint8_t status_counter_ = 0;  // 0x211 byte 7 under agx16: +1 per frame
   std::uint8_t vendor_counter_ = 0;  // 0x231 / 0x241 byte 7: +1 per frame
   ChassisLights lights_;             // what 0x231 reports (0x121, the remote's SWA)
-  RemoteInput remote_;               // the remote control's switches and sticks
+  protocol::DriveMode drive_mode_ = protocol::DriveMode::kCurrent;
+  std::array<double, 4> wheel_distance_{};  // m, per wheel (RF, RR, LR, LF)
+  RemoteInput remote_;                      // the remote control's switches and sticks
   std::string last_refusal_;
 
   VirtualChassisCounters counters_;

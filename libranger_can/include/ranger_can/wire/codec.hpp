@@ -1,10 +1,12 @@
 // Typed RANGER messages in SI units and their byte-exact CAN encoding, in both directions, for
-// any protocol profile (profile.hpp: the manual, the vendor's agx_v2 revision, or any mix).
+// any protocol profile (profile.hpp: the manual, the vendor's agx_v2 revision, the RANGER MINI
+// 3.0's mini_v3, or any mix).
 //
 // One convention for every message, whatever the profile: SI units and the manual's signs
 // (steering positive = right; driver status bit 6 set = disabled). The profile says how the wire
 // carries them (units, signs, the error-word layout, the BMS voltage scale, the motion-mode
-// numbering, the DLC of encoded frames); the codec converts. Spin values (MotionCommand's
+// numbering, the frame layout and its lengths, the odometers' unit, the light modes, the DLC of
+// encoded frames); the codec converts. Spin values (MotionCommand's
 // spin_speed and yaw_rate, MotionFeedback's speed and yaw_rate in spin mode) are passed as they
 // are on the wire: the profile's spin_sign is applied above (interpretation::spin_ccw_from_wire).
 // Conversion to ROS conventions (REP-103) happens in kinematics/odometry through
@@ -64,13 +66,23 @@ struct MotionModeCommand {                                            // 0x141
 struct ControlModeCommand {  // 0x421; the only host-settable modes are standby and CAN
   protocol::ControlMode mode = protocol::ControlMode::kCan;
 };
+struct DriveModeCommand {  // 0x423 (frame layout mini_v3)
+  protocol::DriveMode mode = protocol::DriveMode::kCurrent;
+  // Decoding only: the wire byte, and whether it is a defined drive mode (when not, `mode` holds
+  // no enumerator and the command must not be obeyed). Encoding writes `mode`.
+  std::uint8_t mode_raw = 0;
+  bool mode_known = true;
+};
 struct ErrorClearCommand {  // 0x441
   std::uint8_t code = 0;    // protocol::ErrorClearCode, 0x00..0x10
 };
 struct UltrasonicSettingCommand {  // 0x451
   bool enable = false;
 };
-struct LightCommand {                                          // 0x121 (agx_v2)
+// 0x121 (agx_v2, mini_v3). Under the profile's light_modes on_off (the MINI 3.0) byte 1 is the
+// lights' on/off and bytes 2-7 are zero: the encoder refuses a front mode other than off/on, a rear
+// mode other than off or a brightness, and sends no counter.
+struct LightCommand {
   bool enable = false;                                         // byte 0: lights under CAN control
   protocol::LightMode front_mode = protocol::LightMode::kOff;  // byte 1
   std::uint8_t front_custom = 0;                               // byte 2: custom brightness
@@ -127,6 +139,10 @@ struct MotionModeFeedback {  // 0x291
   // must not be acted on (the switching flag is still valid). Encoding writes mode_raw then.
   bool mode_known = true;
   bool switching = false;
+  // Byte 2 where the profile's frame layout has it (mini_v3: 0x291 of 3 bytes), the drive mode's
+  // wire value as it is (protocol::drive_mode_from_wire); nullopt elsewhere. Encoding writes it
+  // (0 when nullopt) where the layout has the byte, and drops it where not.
+  std::optional<std::uint8_t> drive_mode;
 };
 struct UltrasonicFeedback {  // 0x342 (sensors 1-4) / 0x343 (sensors 5-8)
   int first_sensor = 1;      // 1 or 5
@@ -176,9 +192,17 @@ struct RemoteControlState {  // 0x241 (agx_v2)
   std::int8_t var_a = 0;
   std::uint8_t counter = 0;  // byte 7
 };
-struct OdometerFeedback {        // 0x311 (agx_v2): two int32, unit not stated by any source: raw
-  std::int32_t left_wheel = 0;   // bytes 0-3
+// 0x311 (agx_v2, mini_v3: the front wheels) / 0x312 (mini_v3: the rear wheels): two int32, the
+// left and the right wheel's odometer. Their unit is the profile's odometer_unit: not stated
+// (agx_v2), so raw counts only; millimetres (the MINI 3.0), then decoded in metres as well.
+struct OdometerFeedback {
+  std::int32_t left_wheel = 0;   // bytes 0-3, as on the wire
   std::int32_t right_wheel = 0;  // bytes 4-7
+  bool rear = false;             // 0x312 (else 0x311)
+  // m, under odometer_unit mm (nullopt where the unit is unknown). Encoding under mm writes these
+  // when present (saturated to int32), else the raw values.
+  std::optional<double> left_distance;
+  std::optional<double> right_distance;
 };
 struct VersionResponse {  // 0x4A1 (agx_v2): a chassis's answer, up to 8 ASCII characters a frame
   std::array<char, 8> text{};
@@ -199,10 +223,11 @@ using Message =
                  MotorLowSpeedFeedback, SteeringAnglesFeedback, WheelSpeedsFeedback,
                  MotionModeFeedback, UltrasonicFeedback, UltrasonicSettingFeedback, BmsData,
                  BmsAlarm, LightCommand, LightState, RemoteControlState, OdometerFeedback,
-                 VersionRequest, VersionResponse>;
+                 VersionRequest, VersionResponse, DriveModeCommand>;
 
-// Decodes a frame of any ID of either revision, under `profile`. A frame longer than its layout
-// decodes from its leading bytes. Errors: kUnknownId; kBadDlc for a frame shorter than its
+// Decodes a frame of any ID of any revision, under `profile`; the layout of its ID is the
+// profile's frame layout's (protocol::layout_dlc). A frame longer than its layout decodes from
+// its leading bytes. Errors: kUnknownId; kBadDlc for a frame shorter than its
 // layout, or a DLC above 8 (the message names ID and DLCs); kOutOfRange for content no RANGER
 // model can send under this profile: a 0x221 or 0x271 steering angle beyond
 // interpretation::kMaxPlausibleSteeringRad (the message names ID and value); kInvalidArgument for
@@ -214,24 +239,37 @@ Result<Message> decode(const CanFrame& frame, const ProtocolProfile& profile);
 // The same under the manual's preset (manual_profile()).
 Result<Message> decode(const CanFrame& frame);
 
-// Encodes a message under `profile`; the frame's DLC is its layout's (protocol::layout_dlc), or 8
-// (zero-padded) when the profile's tx_dlc is 8. Values outside the protocol's range saturate
-// (never wrap): 0x111 to its valid ranges (+-interpretation::kMaxLinearSpeedMps, spin +-1 m/s,
-// steering +-90 deg), BMS SOC/SOH to 0..100 %, everything else to its wire type. NaN/inf give
-// kNotFinite naming the field ("motion_command.linear_speed is NaN ..."); out-of-range indices
-// (motor 9, battery 5, sensor group 3) and values a host may not send or the profile cannot carry
-// (0x441 code 0x11, a motion mode the numbering lacks, control mode remote, a light mode above 3,
-// an error word wider than the layout's) give kInvalidArgument. Feedback enums are written as
-// they are, SystemStatus writes vehicle_status_raw when it decodes to vehicle_status (else the
-// enum's value), MotionModeFeedback writes mode_raw when mode_known is false, so decoding then
-// encoding any valid frame under the same profile is byte-exact up to reserved and padding bytes.
-// The frame has stamp 0.
+// Encodes a message under `profile`; the frame's DLC is its layout's under the profile's frame
+// layout (protocol::layout_dlc), or 8 (zero-padded) when the profile's tx_dlc is 8. Values outside
+// the protocol's range saturate (never wrap): 0x111 to its valid ranges
+// (+-interpretation::kMaxLinearSpeedMps, spin +-1 m/s, steering +-90 deg), BMS SOC/SOH to 0..100 %,
+// everything else to its wire type. NaN/inf give kNotFinite naming the field
+// ("motion_command.linear_speed is NaN ..."); out-of-range indices (motor 9, battery 5, sensor
+// group 3) and values a host may not send or the profile cannot carry (0x441 code 0x11, a motion
+// mode the numbering lacks, control mode remote, a light mode above 3 or one light_modes on_off
+// lacks, an error word wider than the layout's, a 0x423 drive mode where the frame layout has no
+// 0x423) give kInvalidArgument, naming what the profile lacks. Feedback enums are written as they
+// are, SystemStatus writes vehicle_status_raw when it decodes to vehicle_status (else the enum's
+// value), MotionModeFeedback writes mode_raw when mode_known is false, so decoding then encoding
+// any valid frame under the same profile is byte-exact up to reserved and padding bytes. The frame
+// has stamp 0.
 Result<CanFrame> encode(const Message& message, const ProtocolProfile& profile);
 // The same under the manual's preset (manual_profile()).
 Result<CanFrame> encode(const Message& message);
 
 // The frame ID a message encodes to (for a valid message).
 std::uint32_t id_of(const Message& message);
+
+// What a command asks for that `profile`'s chassis does not have, for a refusal that names it
+// (encode() refuses the same): `feature` as people call it ("side_slip", "park", "drive modes",
+// "breathing lights", "a rear light", "brightness") and `reason`, the setting that lacks it
+// ("its motion-mode numbering mini_v3 has no side_slip mode"). nullopt when the profile has it.
+struct UnsupportedFeature {
+  std::string feature;
+  std::string reason;
+};
+std::optional<UnsupportedFeature> unsupported_feature(const Message& command,
+                                                      const ProtocolProfile& profile);
 
 // ---- Wire-level helpers (exposed for tests and the DBC cross-check) --------------------------
 namespace wire {
@@ -240,6 +278,7 @@ std::int16_t saturate_i16(double scaled);
 std::uint16_t saturate_u16(double scaled);
 std::int8_t saturate_i8(double scaled);
 std::uint8_t saturate_u8(double scaled);
+std::int32_t saturate_i32(double scaled);
 }  // namespace wire
 
 }  // namespace ranger

@@ -1,17 +1,20 @@
 // A protocol profile: every interpretation of the RANGER protocol as one run-time value.
 //
-// The user manual (revision `manual`) and the vendor's later revision (`agx_v2`,
-// shared/reference/PROTOCOL_AGX_V2.md) use the same identifiers but differ in units, signs, fields
-// and lengths; the manual itself leaves several points open (PROTOCOL.md). Each such point is a
-// field below, with a named setting (parse/print by name, validated) and a default per revision
-// and model. A revision is a preset of these fields, never a copy of the codec: nothing outside
-// profile.cpp branches on a revision's name. docs/PROTOCOL_INTERPRETATIONS.md lists every setting
-// with its values, its default per revision and the evidence for it.
+// The user manual (revision `manual`), the vendor's later revision (`agx_v2`,
+// shared/reference/PROTOCOL_AGX_V2.md) and the RANGER MINI 3.0's manual (`mini_v3`,
+// shared/reference/PROTOCOL_MINI_V3.md) use the same identifiers but differ in units, signs,
+// fields and lengths; the manual itself leaves several points open (PROTOCOL.md). Each such point
+// is a field below, with a named setting (parse/print by name, validated) and a default per
+// revision and model. A revision is a preset of these fields, never a copy of the codec: nothing
+// outside profile.cpp branches on a revision's name. docs/PROTOCOL_INTERPRETATIONS.md lists every
+// setting with its values, its default per revision and the evidence for it.
 //
 // Who applies which field:
 //  * The codec (codec.hpp) applies everything about the wire: steering units and signs per frame,
 //    the error-word layout, the BMS voltage scale, the driver-status enable bit, the meaning of
-//    vehicle status 0x01, the motion-mode numbering and the DLC of the frames it encodes. Decoded
+//    vehicle status 0x01, the motion-mode numbering, the frame layout (which frames exist and each
+//    one's length: 0x291's drive-mode byte), the odometers' unit, the light modes 0x121 can carry
+//    and the DLC of the frames it encodes. Decoded
 //    messages are always in one convention, whatever the profile: SI units and the manual's signs
 //    (steering positive = right; driver status bit 6 set = disabled).
 //  * Not the codec: `spin_sign` (0x111 bytes 2-5 and 0x221 bytes 0-3 carry spin only in spin
@@ -57,16 +60,38 @@ enum class FeedbackSpeed {
   kMeanWheel,   // the mean of the four wheel speeds ("the average value of the four wheels")
   kBodyCentre,  // the speed of the body centre ("that is, the linear speed of the chassis")
 };
-// Layout of 0x211 bytes 4-7.
+// Layout of 0x211 bytes 4-7 (the bits of each: protocol.hpp's fault table).
 enum class ErrorWordLayout {
   kManual32,  // bytes 4-7 one big-endian 32-bit error word (manual)
   kAgxV2_16,  // bytes 4-5 a 16-bit error word, byte 6 reserved, byte 7 a counter (agx_v2)
+  kMini32,    // bytes 4-7 one big-endian 32-bit fault word, the MINI 3.0's bits, no counter
 };
 // Wire values of the motion modes (0x141, 0x291).
 enum class ModeNumbering {
   kManual,  // 0 Ackermann, 1 oblique, 2 spin
   kAgxV2,   // + 3 park, 4 side slip
   kMiniV1,  // + 3 side slip (no park)
+  kMiniV3,  // + 3 park (no side slip)
+};
+// Which frames a chassis has and each one's length: a column of protocol.hpp's frame table. The
+// decoder knows every frame whatever the layout; a frame's layout length is this column's (0x291:
+// 2 bytes in manual and agx_v2, 3 in mini_v3, whose third byte is the drive mode), and the
+// encoder refuses a command the column lacks (0x423 drive mode outside mini_v3).
+enum class FrameLayout {
+  kManual,  // the manual, section 3.2 (PROTOCOL.md)
+  kAgxV2,   // the vendor's revision (PROTOCOL_AGX_V2.md)
+  kMiniV3,  // the RANGER MINI 3.0's manual (PROTOCOL_MINI_V3.md)
+};
+inline constexpr int kFrameLayoutCount = 3;
+// The unit of the 0x311 (front) and 0x312 (rear) wheel odometers.
+enum class OdometerUnit {
+  kUnknown,     // not stated (agx_v2: the SDK discards 0x311): decoded as raw counts only
+  kMillimetre,  // mm (the MINI 3.0's manual): decoded in metres as well
+};
+// What 0x121 (and 0x231) can carry.
+enum class LightModes {
+  kFrontRear,  // front and rear light, each off / on / breathing / custom brightness (agx_v2)
+  kOnOff,      // the lights on or off only: no rear light, no breathing, no brightness (MINI 3.0)
 };
 // Meaning of bit 6 of the motor drivers' status byte (0x261-0x268 byte 5).
 enum class DriverStatusBit6 {
@@ -98,11 +123,26 @@ inline constexpr auto kFeedbackSpeedNames = text::enum_names<FeedbackSpeed>({
 inline constexpr auto kErrorWordLayoutNames = text::enum_names<ErrorWordLayout>({
     {ErrorWordLayout::kManual32, "manual32"},
     {ErrorWordLayout::kAgxV2_16, "agx16"},
+    {ErrorWordLayout::kMini32, "mini32"},
 });
 inline constexpr auto kModeNumberingNames = text::enum_names<ModeNumbering>({
     {ModeNumbering::kManual, "manual"},
     {ModeNumbering::kAgxV2, "agx_v2"},
     {ModeNumbering::kMiniV1, "mini_v1"},
+    {ModeNumbering::kMiniV3, "mini_v3"},
+});
+inline constexpr auto kFrameLayoutNames = text::enum_names<FrameLayout>({
+    {FrameLayout::kManual, "manual"},
+    {FrameLayout::kAgxV2, "agx_v2"},
+    {FrameLayout::kMiniV3, "mini_v3"},
+});
+inline constexpr auto kOdometerUnitNames = text::enum_names<OdometerUnit>({
+    {OdometerUnit::kUnknown, "unknown"},
+    {OdometerUnit::kMillimetre, "mm"},
+});
+inline constexpr auto kLightModesNames = text::enum_names<LightModes>({
+    {LightModes::kFrontRear, "front_rear"},
+    {LightModes::kOnOff, "on_off"},
 });
 inline constexpr auto kDriverStatusBit6Names = text::enum_names<DriverStatusBit6>({
     {DriverStatusBit6::kDisabled, "disabled"},
@@ -110,8 +150,8 @@ inline constexpr auto kDriverStatusBit6Names = text::enum_names<DriverStatusBit6
 });
 
 struct ProtocolProfile {
-  // The preset this profile started from ("manual", "agx_v2"), for logs; changing a field below
-  // does not change it.
+  // The preset this profile started from ("manual", "agx_v2", "mini_v3"), for logs; changing a
+  // field below does not change it.
   std::string revision = "manual";
 
   AngleUnit steering_unit_111 = AngleUnit::kCentidegree;
@@ -135,6 +175,9 @@ struct ProtocolProfile {
   int bms_current_sign = -1;
   ModeNumbering mode_numbering = ModeNumbering::kManual;
   DriverStatusBit6 driver_status_bit6 = DriverStatusBit6::kDisabled;
+  FrameLayout frame_layout = FrameLayout::kManual;
+  OdometerUnit odometer_unit = OdometerUnit::kUnknown;
+  LightModes light_modes = LightModes::kFrontRear;
   // DLC of every frame the codec encodes (commands, and the virtual chassis's feedback): 0 = each
   // frame's own layout length (protocol::layout_dlc), 8 = padded with zero bytes to 8.
   int tx_dlc = 0;
@@ -148,9 +191,10 @@ inline bool operator!=(const ProtocolProfile& a, const ProtocolProfile& b) {
   return !(a == b);
 }
 
-// The preset of a revision: "manual" or "agx_v2". kInvalidArgument lists the valid names.
+// The preset of a revision: "manual", "agx_v2" or "mini_v3". kInvalidArgument lists the valid
+// names.
 Result<ProtocolProfile> protocol_preset(std::string_view revision);
-const std::vector<std::string>& protocol_revision_names();  // {"manual", "agx_v2"}
+const std::vector<std::string>& protocol_revision_names();  // {"manual", "agx_v2", "mini_v3"}
 // The manual's preset, without a Result (the codec's overloads without a profile use it).
 const ProtocolProfile& manual_profile();
 
@@ -175,6 +219,9 @@ enum class ProtocolSetting {
   kBmsCurrentSign,
   kModeNumbering,
   kDriverStatusBit6,
+  kFrameLayout,
+  kOdometerUnit,
+  kLightModes,
   kTxDlc,
 };
 // The settings' names, in the table's order (that of profile_settings()).
@@ -195,6 +242,9 @@ inline constexpr auto kProtocolSettingNames = text::enum_names<ProtocolSetting>(
     {ProtocolSetting::kBmsCurrentSign, "bms_current_sign"},
     {ProtocolSetting::kModeNumbering, "mode_numbering"},
     {ProtocolSetting::kDriverStatusBit6, "driver_status_bit6"},
+    {ProtocolSetting::kFrameLayout, "frame_layout"},
+    {ProtocolSetting::kOdometerUnit, "odometer_unit"},
+    {ProtocolSetting::kLightModes, "light_modes"},
     {ProtocolSetting::kTxDlc, "tx_dlc"},
 });
 inline std::string_view to_string(ProtocolSetting s) {
@@ -246,6 +296,15 @@ inline std::string_view to_string(ModeNumbering v) {
 }
 inline std::string_view to_string(DriverStatusBit6 v) {
   return kDriverStatusBit6Names.name(v);
+}
+inline std::string_view to_string(FrameLayout v) {
+  return kFrameLayoutNames.name(v);
+}
+inline std::string_view to_string(OdometerUnit v) {
+  return kOdometerUnitNames.name(v);
+}
+inline std::string_view to_string(LightModes v) {
+  return kLightModesNames.name(v);
 }
 
 }  // namespace ranger

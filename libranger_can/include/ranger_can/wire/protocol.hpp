@@ -1,8 +1,10 @@
 // The RANGER CAN protocol's vocabulary: identifiers, enumerations and named bits, as the manual
-// (section 3.2, transcribed in shared/reference/PROTOCOL.md) and the vendor's later revision
-// (shared/reference/PROTOCOL_AGX_V2.md) define them. Where the two revisions differ, the facts of
-// both are here, selected by a profile field (profile.hpp): the error-word layout, the motion-mode
-// numbering. Units and scaling live in codec.hpp; the manual's open points in interpretation.hpp.
+// (section 3.2, transcribed in shared/reference/PROTOCOL.md), the vendor's later revision
+// (shared/reference/PROTOCOL_AGX_V2.md) and the RANGER MINI 3.0's manual
+// (shared/reference/PROTOCOL_MINI_V3.md) define them. Where the revisions differ, the facts of
+// each are here, selected by a profile field (profile.hpp): the frame layout (which frames, their
+// lengths), the error-word layout, the motion-mode numbering. Units and scaling live in codec.hpp;
+// the manual's open points in interpretation.hpp.
 #pragma once
 
 #include <array>
@@ -26,6 +28,7 @@ inline constexpr std::uint32_t kMotionCommandId = 0x111;
 inline constexpr std::uint32_t kLightCommandId = 0x121;  // agx_v2
 inline constexpr std::uint32_t kMotionModeCommandId = 0x141;
 inline constexpr std::uint32_t kControlModeCommandId = 0x421;
+inline constexpr std::uint32_t kDriveModeCommandId = 0x423;  // mini_v3
 inline constexpr std::uint32_t kErrorClearCommandId = 0x441;
 inline constexpr std::uint32_t kUltrasonicSettingId = 0x451;
 // Both directions (agx_v2): the host's version request (DLC 1, byte 0 = 0x01) and the chassis's
@@ -42,7 +45,8 @@ inline constexpr std::uint32_t kMotorLowSpeedBaseId = 0x260;   // + motor number
 inline constexpr std::uint32_t kSteeringAnglesId = 0x271;
 inline constexpr std::uint32_t kWheelSpeedsId = 0x281;
 inline constexpr std::uint32_t kMotionModeFeedbackId = 0x291;
-inline constexpr std::uint32_t kOdometerId = 0x311;  // agx_v2
+inline constexpr std::uint32_t kOdometerId = 0x311;      // agx_v2, mini_v3: the front wheels'
+inline constexpr std::uint32_t kRearOdometerId = 0x312;  // mini_v3: the rear wheels'
 inline constexpr std::uint32_t kUltrasonic1to4Id = 0x342;
 inline constexpr std::uint32_t kUltrasonic5to8Id = 0x343;
 inline constexpr std::uint32_t kUltrasonicSettingFeedbackId = 0x45A;
@@ -53,10 +57,11 @@ inline constexpr int kUltrasonicCount = 8;
 inline constexpr int kBatteryCount = 4;  // slots 1..4; index 0 is the whole pack
 
 // ---- The frame table ----------------------------------------------------------------------------
-// Every frame of either revision, once: its identifier(s), name, direction, the length of its
-// layout, its nominal period and the revisions that define it. The ID lists, DLC checks, names,
-// the identification's vendor-only set, the monitor's expected rates, the virtual chassis's send
-// schedule and the DBC cross-check (tests/dbc/check_dbc.py parses this table) all read it.
+// Every frame of any revision, once: its identifier(s), name, direction, nominal period and, per
+// frame layout (profile.hpp: FrameLayout, one column per revision), the length of its layout (0:
+// not a frame of that revision). The ID lists, DLC checks, names, the identification's
+// revision-only sets, the monitor's expected rates, the virtual chassis's send schedule and the DBC
+// cross-check (tests/dbc/check_dbc.py parses this table) all read it.
 enum class Direction : std::uint8_t {
   kToChassis,    // the host's commands
   kFromChassis,  // the chassis's feedback
@@ -71,20 +76,16 @@ inline std::string_view to_string(Direction d) {
   return kDirectionNames.name(d);
 }
 
-// The revisions that define a frame (a bit set).
-inline constexpr std::uint8_t kInManual = 1u << 0;  // the manual, section 3.2 (PROTOCOL.md)
-inline constexpr std::uint8_t kInAgxV2 = 1u << 1;   // the vendor's revision (PROTOCOL_AGX_V2.md)
-
 struct FrameInfo {
   std::uint32_t id;  // the first identifier of the row
   int count;         // identifiers in the row: id, id + stride, ... (motors, batteries)
   int stride;
   std::string_view name;  // snake_case, stable
   Direction direction;
-  int length;     // the layout's length in bytes, the same in every revision that defines the frame
-                  // (a received frame may be longer, never shorter); 0x4A1: the request's
-  int period_ms;  // nominal period; 0: sent on request or on change
-  std::uint8_t revisions;
+  int period_ms;  // nominal period; 0: sent on request or on change (or not stated)
+  // The layout's length in bytes in each frame layout (index: FrameLayout; 0 = not a frame of that
+  // revision). A received frame may be longer, never shorter. 0x4A1: the request's.
+  std::array<std::uint8_t, kFrameLayoutCount> lengths;
 
   constexpr bool holds(std::uint32_t x) const {
     if (x < id) return false;
@@ -92,37 +93,58 @@ struct FrameInfo {
     return offset % static_cast<std::uint32_t>(stride) == 0 &&
            offset / static_cast<std::uint32_t>(stride) < static_cast<std::uint32_t>(count);
   }
+  // Whether the revision of `layout` defines the frame.
+  constexpr bool in(FrameLayout layout) const {
+    return lengths[static_cast<std::size_t>(layout)] > 0;
+  }
+  // The layout's length under `layout`: its own column's, or (a frame of another revision, which
+  // the decoder knows all the same) that of the first revision that defines it.
+  constexpr int length(FrameLayout layout) const {
+    if (in(layout)) return lengths[static_cast<std::size_t>(layout)];
+    for (const std::uint8_t n : lengths) {
+      if (n > 0) return n;
+    }
+    return 0;
+  }
 };
 
 // clang-format off
 inline constexpr FrameInfo kFrameTable[] = {
-  // id                          count stride name                     direction               length period  revisions
-  {kMotionCommandId,               1, 1, "motion_command",              Direction::kToChassis,   8,  20, kInManual | kInAgxV2},
-  {kLightCommandId,                1, 1, "light_command",               Direction::kToChassis,   8,   0, kInAgxV2},
-  {kMotionModeCommandId,           1, 1, "motion_mode_command",         Direction::kToChassis,   1,   0, kInManual | kInAgxV2},
-  {kSystemStatusId,                1, 1, "system_status",               Direction::kFromChassis, 8,  20, kInManual | kInAgxV2},
-  {kMotionFeedbackId,              1, 1, "motion_feedback",             Direction::kFromChassis, 8,  20, kInManual | kInAgxV2},
+  // id                          count stride name                     direction             period  manual agx_v2 mini_v3
+  {kMotionCommandId,               1, 1, "motion_command",              Direction::kToChassis,    20, {8, 8, 8}},
+  {kLightCommandId,                1, 1, "light_command",               Direction::kToChassis,     0, {0, 8, 8}},
+  {kMotionModeCommandId,           1, 1, "motion_mode_command",         Direction::kToChassis,     0, {1, 1, 1}},
+  {kSystemStatusId,                1, 1, "system_status",               Direction::kFromChassis,  20, {8, 8, 8}},
+  {kMotionFeedbackId,              1, 1, "motion_feedback",             Direction::kFromChassis,  20, {8, 8, 8}},
   // 0x231 and 0x241: the period the vendor's manuals of the same family give (assumed here)
-  {kLightStateId,                  1, 1, "light_state",                 Direction::kFromChassis, 8,  20, kInAgxV2},
-  {kRemoteControlStateId,          1, 1, "remote_control",              Direction::kFromChassis, 8,  20, kInAgxV2},
-  {kMotorHighSpeedBaseId + 1, kMotorCount, 1, "motor_high_speed",       Direction::kFromChassis, 8,  20, kInManual | kInAgxV2},
-  {kMotorLowSpeedBaseId + 1,  kMotorCount, 1, "motor_low_speed",        Direction::kFromChassis, 8, 100, kInManual | kInAgxV2},
-  {kSteeringAnglesId,              1, 1, "steering_angles",             Direction::kFromChassis, 8,  20, kInManual | kInAgxV2},
-  {kWheelSpeedsId,                 1, 1, "wheel_speeds",                Direction::kFromChassis, 8,  20, kInManual | kInAgxV2},
-  {kMotionModeFeedbackId,          1, 1, "motion_mode",                 Direction::kFromChassis, 2,  20, kInManual | kInAgxV2},
-  {kOdometerId,                    1, 1, "odometer",                    Direction::kFromChassis, 8,   0, kInAgxV2},
-  {kUltrasonic1to4Id,              2, 1, "ultrasonic",                  Direction::kFromChassis, 8,  50, kInManual | kInAgxV2},
-  {kBmsBaseId,         kBatteryCount + 1, 2, "bms",                     Direction::kFromChassis, 8, 500, kInManual | kInAgxV2},
-  {kBmsBaseId + 1,     kBatteryCount + 1, 2, "bms_alarm",               Direction::kFromChassis, 4, 500, kInManual | kInAgxV2},
-  {kControlModeCommandId,          1, 1, "control_mode_command",        Direction::kToChassis,   1,   0, kInManual | kInAgxV2},
-  {kErrorClearCommandId,           1, 1, "error_clear_command",         Direction::kToChassis,   1,   0, kInManual | kInAgxV2},
-  {kUltrasonicSettingId,           1, 1, "ultrasonic_setting",          Direction::kToChassis,   1,   0, kInManual | kInAgxV2},
-  {kUltrasonicSettingFeedbackId,   1, 1, "ultrasonic_setting_feedback", Direction::kFromChassis, 1,   0, kInManual | kInAgxV2},
-  {kVersionId,                     1, 1, "version",                     Direction::kBoth,        1,   0, kInAgxV2},
+  {kLightStateId,                  1, 1, "light_state",                 Direction::kFromChassis,  20, {0, 8, 8}},
+  {kRemoteControlStateId,          1, 1, "remote_control",              Direction::kFromChassis,  20, {0, 8, 8}},
+  {kMotorHighSpeedBaseId + 1, kMotorCount, 1, "motor_high_speed",       Direction::kFromChassis,  20, {8, 8, 8}},
+  {kMotorLowSpeedBaseId + 1,  kMotorCount, 1, "motor_low_speed",        Direction::kFromChassis, 100, {8, 8, 8}},
+  {kSteeringAnglesId,              1, 1, "steering_angles",             Direction::kFromChassis,  20, {8, 8, 8}},
+  {kWheelSpeedsId,                 1, 1, "wheel_speeds",                Direction::kFromChassis,  20, {8, 8, 8}},
+  // mini_v3: mode, switching flag and drive mode
+  {kMotionModeFeedbackId,          1, 1, "motion_mode",                 Direction::kFromChassis,  20, {2, 2, 3}},
+  // 0x311 / 0x312: no period stated
+  {kOdometerId,                    1, 1, "odometer",                    Direction::kFromChassis,   0, {0, 8, 8}},
+  {kRearOdometerId,                1, 1, "rear_odometer",               Direction::kFromChassis,   0, {0, 0, 8}},
+  {kUltrasonic1to4Id,              2, 1, "ultrasonic",                  Direction::kFromChassis,  50, {8, 8, 0}},
+  // The whole pack (the MINI 3.0 lists it alone), then battery slots 1-4
+  {kBmsBaseId,                     1, 2, "bms",                         Direction::kFromChassis, 500, {8, 8, 8}},
+  {kBmsBaseId + 1,                 1, 2, "bms_alarm",                   Direction::kFromChassis, 500, {4, 4, 4}},
+  {kBmsBaseId + 2,     kBatteryCount, 2, "bms",                         Direction::kFromChassis, 500, {8, 8, 0}},
+  {kBmsBaseId + 3,     kBatteryCount, 2, "bms_alarm",                   Direction::kFromChassis, 500, {4, 4, 0}},
+  {kControlModeCommandId,          1, 1, "control_mode_command",        Direction::kToChassis,     0, {1, 1, 1}},
+  {kDriveModeCommandId,            1, 1, "drive_mode_command",          Direction::kToChassis,     0, {0, 0, 1}},
+  {kErrorClearCommandId,           1, 1, "error_clear_command",         Direction::kToChassis,     0, {1, 1, 1}},
+  {kUltrasonicSettingId,           1, 1, "ultrasonic_setting",          Direction::kToChassis,     0, {1, 1, 0}},
+  {kUltrasonicSettingFeedbackId,   1, 1, "ultrasonic_setting_feedback", Direction::kFromChassis,   0, {1, 1, 0}},
+  // mini_v3: from the vendor's SDK, not in the MINI 3.0's manual
+  {kVersionId,                     1, 1, "version",                     Direction::kBoth,          0, {0, 1, 1}},
 };
 // clang-format on
 
-// The index of `id`'s row in kFrameTable; std::size(kFrameTable) for an identifier of neither
+// The index of `id`'s row in kFrameTable; std::size(kFrameTable) for an identifier of no
 // revision. (An index, not a pointer: constant evaluation under -fsanitize=undefined refuses to
 // compare a pointer into the table with nullptr.)
 constexpr std::size_t frame_index(std::uint32_t id) {
@@ -131,7 +153,7 @@ constexpr std::size_t frame_index(std::uint32_t id) {
   }
   return std::size(kFrameTable);
 }
-// The row of `id`; nullptr for an identifier of neither revision.
+// The row of `id`; nullptr for an identifier of no revision.
 constexpr const FrameInfo* find_frame(std::uint32_t id) {
   const std::size_t i = frame_index(id);
   return i < std::size(kFrameTable) ? &kFrameTable[i] : nullptr;
@@ -142,19 +164,25 @@ constexpr int frame_period_ms(std::uint32_t id) {
   return i < std::size(kFrameTable) ? kFrameTable[i].period_ms : 0;
 }
 
-// Every identifier of either revision, in ascending order (receive filters, frame-rate
-// statistics). The decoder knows all of them whatever the profile.
+// Every identifier of any revision, in ascending order (receive filters, frame-rate statistics).
+// The decoder knows all of them whatever the profile.
 std::vector<std::uint32_t> all_ids();
 // The identifiers of the manual (section 3.2), in ascending order.
 std::vector<std::uint32_t> manual_ids();
+// The identifiers the revision of `layout` defines, in ascending order.
+std::vector<std::uint32_t> ids_of(FrameLayout layout);
 bool is_known_id(std::uint32_t id);
-// The length of `id`'s layout: the bytes its decoder reads (-1 for an unknown ID). A received
-// frame may be longer (its extra bytes are ignored), never shorter. 0x4A1: 1 (the request; an
-// answer's text is as long as the frame).
+// The length of `id`'s layout under `layout` (profile.frame_layout): the bytes its decoder reads
+// (-1 for an unknown ID). A received frame may be longer (its extra bytes are ignored), never
+// shorter. 0x4A1: 1 (the request; an answer's text is as long as the frame). Without a layout:
+// the manual's (for a frame it lacks, that of the first revision that has it).
+int layout_dlc(std::uint32_t id, FrameLayout layout);
 int layout_dlc(std::uint32_t id);
-// Bytes of `frame` past its layout that a decoder ignores (0 for an unknown ID, an error frame, a
-// frame not longer than its layout, or a 0x4A1 answer, whose text is the whole frame).
-int extra_bytes(const CanFrame& frame);
+// Bytes of `frame` past its layout under `layout` that a decoder ignores (0 for an unknown ID, an
+// error frame, a frame not longer than its layout, or a 0x4A1 answer, whose text is the whole
+// frame).
+int extra_bytes(const CanFrame& frame, FrameLayout layout);
+int extra_bytes(const CanFrame& frame);  // the manual's layout
 // A 0x4A1 frame is the host's version request when byte 0 is 0x01 and every further byte is zero
 // (a request padded to 8 bytes); anything else on 0x4A1 is an answer (text).
 bool is_version_request(const CanFrame& frame);
@@ -204,6 +232,10 @@ inline constexpr double kRemoteAxisFullScale = 100.0;
 // 0x121 / 0x231 light modes (wire values).
 enum class LightMode : std::uint8_t { kOff = 0, kOn = 1, kBreathing = 2, kCustom = 3 };
 
+// Drive modes (0x423, 0x291 byte 2; the MINI 3.0's, frame layout mini_v3): the motor drivers'
+// control loop.
+enum class DriveMode : std::uint8_t { kCurrent = 0x00, kVoltage = 0x01 };
+
 // 0x441 payload: which fault to clear. 0x00 clears every fault that is not critical
 // (interpretation::critical_error_mask); a critical fault is cleared by its own code (0x01-0x10)
 // or by the remote control's KEY1.
@@ -246,6 +278,10 @@ inline constexpr auto kRemoteSwitchNames = text::enum_names<RemoteSwitch>({
     {RemoteSwitch::kUp, "up"},
     {RemoteSwitch::kDown, "down"},
 });
+inline constexpr auto kDriveModeNames = text::enum_names<DriveMode>({
+    {DriveMode::kCurrent, "current"},
+    {DriveMode::kVoltage, "voltage"},
+});
 inline constexpr auto kLightModeNames = text::enum_names<LightMode>({
     {LightMode::kOff, "off"},
     {LightMode::kOn, "on"},
@@ -267,20 +303,31 @@ inline std::string_view to_string(RemoteSwitch s) {
 inline std::string_view to_string(LightMode m) {
   return kLightModeNames.name(m);
 }
+inline std::string_view to_string(DriveMode m) {
+  return kDriveModeNames.name(m);
+}
+// The drive mode wire value `raw` stands for; nullopt for an undefined value.
+constexpr std::optional<DriveMode> drive_mode_from_wire(std::uint8_t raw) {
+  return raw <= static_cast<std::uint8_t>(DriveMode::kVoltage)
+             ? std::optional<DriveMode>(static_cast<DriveMode>(raw))
+             : std::nullopt;
+}
 // Describes what a 0x441 code clears ("all non-critical faults", "motor driver 3 communication
 // fault").
 std::string error_clear_description(std::uint8_t code);
 
 // ---- 0x211 error bits -------------------------------------------------------------------------
-// Two layouts (profile.hpp, ErrorWordLayout):
+// Three layouts (profile.hpp, ErrorWordLayout):
 //  * kManual32: bytes 4-7 form one big-endian uint32 (byte 4 is the most significant), so a bit's
 //    position in the word is (7 - byte) * 8 + bit;
-//  * kAgxV2_16: bytes 4-5 form a big-endian uint16, byte 6 is reserved, byte 7 is a counter.
+//  * kAgxV2_16: bytes 4-5 form a big-endian uint16, byte 6 is reserved, byte 7 is a counter;
+//  * kMini32: bytes 4-7 form one big-endian uint32 as under kManual32, with the MINI 3.0's bits
+//    (bit 0 the lowest of byte 7), no counter.
 // SystemStatus::error_bits holds the word of the layout in use.
 constexpr int error_bit_index(int byte, int bit) {
   return (7 - byte) * 8 + bit;
 }
-// Width of the error word, in bits: 32 or 16.
+// Width of the error word, in bits: 32 or 16 (kAgxV2_16).
 int error_word_bits(ErrorWordLayout layout);
 
 struct NamedBit {
@@ -320,6 +367,8 @@ enum class Fault {
   kSafetyEdge,
   kSteeringServoWarning,  // motor-numbered (steering motors 5..8)
   kSteeringEncoder,
+  kBatteryOverVoltage,
+  kEmergencyStop,
 };
 // The names of the faults by meaning (a motor-numbered fault's rows in the fault table below
 // carry the motor in their own names).
@@ -338,6 +387,8 @@ inline constexpr auto kFaultNames = text::enum_names<Fault>({
     {Fault::kSafetyEdge, "safety_edge"},
     {Fault::kSteeringServoWarning, "steering_servo_warning"},
     {Fault::kSteeringEncoder, "steering_encoder"},
+    {Fault::kBatteryOverVoltage, "battery_over_voltage"},
+    {Fault::kEmergencyStop, "emergency_stop"},
 });
 inline constexpr int kFaultCount = static_cast<int>(kFaultNames.size());
 inline std::string_view to_string(Fault f) {
@@ -347,9 +398,9 @@ inline std::string_view to_string(Fault f) {
 // ---- The fault table --------------------------------------------------------------------------
 // One row per fault the chassis reports in 0x211, by meaning: its bit in each error-word layout
 // (kNoBit when the layout has none), its stable snake_case name (ControllerState::faults, the ROS
-// message's SystemErrors field, diagnostics, the scenario language: the same name on both
-// revisions), whether it is critical (the chassis does not drive until it is cleared: our reading,
-// interpretation.hpp) and a description. Every bit position of either layout is written here and
+// message's SystemErrors field, diagnostics, the scenario language: the same name on every
+// revision), whether it is critical (the chassis does not drive until it is cleared: our reading,
+// interpretation.hpp) and a description. Every bit position of any layout is written here and
 // nowhere else.
 inline constexpr int kNoBit = -1;
 struct FaultInfo {
@@ -357,44 +408,60 @@ struct FaultInfo {
   int motor;       // 1..8 for a motor-numbered fault, 0 otherwise
   int manual_bit;  // position in the kManual32 word (error_bit_index(byte, bit)) or kNoBit
   int agx16_bit;   // position in the kAgxV2_16 word or kNoBit
+  int mini32_bit;  // position in the kMini32 word or kNoBit
   bool critical;
   std::string_view name;
   std::string_view description;
 
   constexpr int bit(ErrorWordLayout layout) const {
-    return layout == ErrorWordLayout::kAgxV2_16 ? agx16_bit : manual_bit;
+    switch (layout) {
+      case ErrorWordLayout::kAgxV2_16:
+        return agx16_bit;
+      case ErrorWordLayout::kMini32:
+        return mini32_bit;
+      default:
+        return manual_bit;
+    }
   }
 };
+// The MINI 3.0's bits (PROTOCOL_MINI_V3.md): 0 under-voltage, 1 over-voltage, 2 remote lost, 3-6
+// motor driver 1-4 communication, 7 e-stop, 8 driver status, 10-13 motor driver 5-8 communication,
+// 14 over-temperature, 15 over-current, 16-19 steering zero calibration of wheels 1-4 (= steering
+// motors 5-8), 20 steering calibration timeout.
 // clang-format off
 inline constexpr FaultInfo kFaultTable[] = {
-  // fault                             motor manual bit              agx16  critical
-  {Fault::kBatteryUnderVoltage,         0, error_bit_index(7, 0),     0, true,  "battery_under_voltage", "battery under-voltage (agx_v2: battery fault)"},
-  {Fault::kBatteryWarning,              0, kNoBit,                    1, false, "battery_warning", "battery warning"},
-  {Fault::kUltrasonicTriggered,         0, error_bit_index(7, 1), kNoBit, false, "ultrasonic_obstacle_triggered", "ultrasonic obstacle avoidance triggered"},
-  {Fault::kRemoteSignalLost,            0, error_bit_index(7, 2),     2, false, "remote_control_lost", "remote control lost-connection protection"},
-  {Fault::kMotorCommunication,          1, error_bit_index(7, 3),     3, true,  "motor_driver_1_communication_fault", "communication fault of motor driver 1 (front-right wheel)"},
-  {Fault::kMotorCommunication,          2, error_bit_index(7, 4),     4, true,  "motor_driver_2_communication_fault", "communication fault of motor driver 2 (rear-right wheel)"},
-  {Fault::kMotorCommunication,          3, error_bit_index(7, 5),     5, true,  "motor_driver_3_communication_fault", "communication fault of motor driver 3 (rear-left wheel)"},
-  {Fault::kMotorCommunication,          4, error_bit_index(7, 6),     6, true,  "motor_driver_4_communication_fault", "communication fault of motor driver 4 (front-left wheel)"},
-  {Fault::kDriverStatusError,           0, error_bit_index(6, 0),     8, true,  "driver_status_error", "motor driver status error (agx_v2: motor driver fault)"},
-  {Fault::kHostCommunicationLost,       0, error_bit_index(6, 1),     9, false, "host_communication_lost", "communication with the upper layer (host) lost"},
-  {Fault::kMotorCommunication,          5, error_bit_index(6, 2), kNoBit, true,  "motor_driver_5_communication_fault", "communication fault of motor driver 5 (front-right steering)"},
-  {Fault::kMotorCommunication,          6, error_bit_index(6, 3), kNoBit, true,  "motor_driver_6_communication_fault", "communication fault of motor driver 6 (rear-right steering)"},
-  {Fault::kMotorCommunication,          7, error_bit_index(6, 4), kNoBit, true,  "motor_driver_7_communication_fault", "communication fault of motor driver 7 (rear-left steering)"},
-  {Fault::kMotorCommunication,          8, error_bit_index(6, 5), kNoBit, true,  "motor_driver_8_communication_fault", "communication fault of motor driver 8 (front-left steering)"},
-  {Fault::kOverTemperature,             0, error_bit_index(6, 6), kNoBit, true,  "over_temperature", "over-temperature protection"},
-  {Fault::kOverCurrent,                 0, error_bit_index(6, 7), kNoBit, true,  "over_current", "over-current protection"},
-  {Fault::kSteeringCalibration,         5, error_bit_index(5, 0), kNoBit, true,  "steering_calibration_fault_front_right", "steering zero-point calibration fault, front-right"},
-  {Fault::kSteeringCalibration,         6, error_bit_index(5, 1), kNoBit, true,  "steering_calibration_fault_rear_right", "steering zero-point calibration fault, rear-right"},
-  {Fault::kSteeringCalibration,         7, error_bit_index(5, 2), kNoBit, true,  "steering_calibration_fault_rear_left", "steering zero-point calibration fault, rear-left"},
-  {Fault::kSteeringCalibration,         8, error_bit_index(5, 3), kNoBit, true,  "steering_calibration_fault_front_left", "steering zero-point calibration fault, front-left"},
-  {Fault::kSteeringCalibrationTimeout,  0, error_bit_index(5, 4), kNoBit, true,  "steering_calibration_timeout", "steering calibration timeout"},
-  {Fault::kSafetyEdge,                  0, error_bit_index(5, 5), kNoBit, true,  "safety_edge_collision", "safety edge (bumper) collision"},
-  {Fault::kSteeringServoWarning,        5, error_bit_index(4, 0), kNoBit, false, "steering_servo_warning_front_right", "steering servo warning, front-right"},
-  {Fault::kSteeringServoWarning,        6, error_bit_index(4, 1), kNoBit, false, "steering_servo_warning_rear_right", "steering servo warning, rear-right"},
-  {Fault::kSteeringServoWarning,        7, error_bit_index(4, 2), kNoBit, false, "steering_servo_warning_rear_left", "steering servo warning, rear-left"},
-  {Fault::kSteeringServoWarning,        8, error_bit_index(4, 3), kNoBit, false, "steering_servo_warning_front_left", "steering servo warning, front-left"},
-  {Fault::kSteeringEncoder,             0, kNoBit,                    7, true,  "steering_encoder_fault", "steering encoder fault"},
+  // fault                             motor manual bit              agx16  mini32 critical
+  {Fault::kBatteryUnderVoltage,         0, error_bit_index(7, 0),     0,      0, true,  "battery_under_voltage", "battery under-voltage (agx_v2: battery fault)"},
+  {Fault::kBatteryWarning,              0, kNoBit,                    1, kNoBit, false, "battery_warning", "battery warning"},
+  {Fault::kUltrasonicTriggered,         0, error_bit_index(7, 1), kNoBit, kNoBit, false, "ultrasonic_obstacle_triggered", "ultrasonic obstacle avoidance triggered"},
+  {Fault::kRemoteSignalLost,            0, error_bit_index(7, 2),     2,      2, false, "remote_control_lost", "remote control lost-connection protection"},
+  {Fault::kMotorCommunication,          1, error_bit_index(7, 3),     3,      3, true,  "motor_driver_1_communication_fault", "communication fault of motor driver 1 (front-right wheel)"},
+  {Fault::kMotorCommunication,          2, error_bit_index(7, 4),     4,      4, true,  "motor_driver_2_communication_fault", "communication fault of motor driver 2 (rear-right wheel)"},
+  {Fault::kMotorCommunication,          3, error_bit_index(7, 5),     5,      5, true,  "motor_driver_3_communication_fault", "communication fault of motor driver 3 (rear-left wheel)"},
+  {Fault::kMotorCommunication,          4, error_bit_index(7, 6),     6,      6, true,  "motor_driver_4_communication_fault", "communication fault of motor driver 4 (front-left wheel)"},
+  {Fault::kDriverStatusError,           0, error_bit_index(6, 0),     8,      8, true,  "driver_status_error", "motor driver status error (agx_v2: motor driver fault)"},
+  {Fault::kHostCommunicationLost,       0, error_bit_index(6, 1),     9, kNoBit, false, "host_communication_lost", "communication with the upper layer (host) lost"},
+  {Fault::kMotorCommunication,          5, error_bit_index(6, 2), kNoBit,    10, true,  "motor_driver_5_communication_fault", "communication fault of motor driver 5 (front-right steering)"},
+  {Fault::kMotorCommunication,          6, error_bit_index(6, 3), kNoBit,    11, true,  "motor_driver_6_communication_fault", "communication fault of motor driver 6 (rear-right steering)"},
+  {Fault::kMotorCommunication,          7, error_bit_index(6, 4), kNoBit,    12, true,  "motor_driver_7_communication_fault", "communication fault of motor driver 7 (rear-left steering)"},
+  {Fault::kMotorCommunication,          8, error_bit_index(6, 5), kNoBit,    13, true,  "motor_driver_8_communication_fault", "communication fault of motor driver 8 (front-left steering)"},
+  {Fault::kOverTemperature,             0, error_bit_index(6, 6), kNoBit,    14, true,  "over_temperature", "over-temperature protection"},
+  {Fault::kOverCurrent,                 0, error_bit_index(6, 7), kNoBit,    15, true,  "over_current", "over-current protection"},
+  {Fault::kSteeringCalibration,         5, error_bit_index(5, 0), kNoBit,    16, true,  "steering_calibration_fault_front_right", "steering zero-point calibration fault, front-right"},
+  {Fault::kSteeringCalibration,         6, error_bit_index(5, 1), kNoBit,    17, true,  "steering_calibration_fault_rear_right", "steering zero-point calibration fault, rear-right"},
+  {Fault::kSteeringCalibration,         7, error_bit_index(5, 2), kNoBit,    18, true,  "steering_calibration_fault_rear_left", "steering zero-point calibration fault, rear-left"},
+  {Fault::kSteeringCalibration,         8, error_bit_index(5, 3), kNoBit,    19, true,  "steering_calibration_fault_front_left", "steering zero-point calibration fault, front-left"},
+  {Fault::kSteeringCalibrationTimeout,  0, error_bit_index(5, 4), kNoBit,    20, true,  "steering_calibration_timeout", "steering calibration timeout"},
+  {Fault::kSafetyEdge,                  0, error_bit_index(5, 5), kNoBit, kNoBit, true,  "safety_edge_collision", "safety edge (bumper) collision"},
+  {Fault::kSteeringServoWarning,        5, error_bit_index(4, 0), kNoBit, kNoBit, false, "steering_servo_warning_front_right", "steering servo warning, front-right"},
+  {Fault::kSteeringServoWarning,        6, error_bit_index(4, 1), kNoBit, kNoBit, false, "steering_servo_warning_rear_right", "steering servo warning, rear-right"},
+  {Fault::kSteeringServoWarning,        7, error_bit_index(4, 2), kNoBit, kNoBit, false, "steering_servo_warning_rear_left", "steering servo warning, rear-left"},
+  {Fault::kSteeringServoWarning,        8, error_bit_index(4, 3), kNoBit, kNoBit, false, "steering_servo_warning_front_left", "steering servo warning, front-left"},
+  {Fault::kSteeringEncoder,             0, kNoBit,                    7, kNoBit, true,  "steering_encoder_fault", "steering encoder fault"},
+  // The MINI 3.0's own: cleared by 0x441 code 0x00 (no code of their own), so not critical; the
+  // e-stop's state is 0x211 byte 0 as on every revision, this bit repeats it.
+  {Fault::kBatteryOverVoltage,          0, kNoBit,                kNoBit,     1, false, "battery_over_voltage", "battery over-voltage"},
+  {Fault::kEmergencyStop,               0, kNoBit,                kNoBit,     7, false, "emergency_stop", "emergency stop (the MINI 3.0's fault word)"},
 };
 // clang-format on
 
