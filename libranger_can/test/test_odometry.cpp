@@ -293,6 +293,45 @@ TEST(OdometryTime, AGapGrowsTheCovarianceByWhatTheChassisCouldHaveMovedAndIsSaid
   EXPECT_EQ(odom.state().gaps, 1u);
 }
 
+// Where the chassis counts its wheels' distance in metres (the RANGER MINI 3.0's 0x311), what it
+// counted across a gap advances the pose along the motion before the gap, straight or on an arc;
+// a reading of no stated unit (the vendor's 0x311) adds nothing.
+TEST(OdometryTime, TheChassissOwnOdometerBridgesAGapAlongTheMotionBeforeIt) {
+  for (const double wz : {0.0, 0.2}) {
+    Odometry odom;
+    Chassis chassis;
+    const BodyTwist twist{0.5, 0, wz};
+    OdometerFeedback odometer;
+    odometer.left_distance = odometer.right_distance = 1.0;
+    const Timestamp t = chassis.drive(odom, twist, Timestamp{5s}, 1s);
+    EXPECT_FALSE(odom.on_message(odometer, t));  // the first reading only anchors
+    const Pose2D before = odom.state().pose;
+    chassis.feed(odom, twist, t + 2s);  // 2 s of silence, in which the wheels rolled 0.3 m
+    odometer.left_distance = odometer.right_distance = 1.3;
+    EXPECT_TRUE(odom.on_message(odometer, t + 2s)) << "wz " << wz;
+    EXPECT_NEAR(odom.state().last_gap_odometer_distance, 0.3, 1e-9);
+    const Pose2D expected = integrate_pose(before, twist, 0.3 / 0.5);
+    EXPECT_NEAR(odom.state().pose.x, expected.x, 2e-3) << "wz " << wz;
+    EXPECT_NEAR(odom.state().pose.y, expected.y, 2e-3) << "wz " << wz;
+    EXPECT_NEAR(odom.state().pose.yaw, expected.yaw, 2e-3) << "wz " << wz;
+    EXPECT_EQ(odom.state().gaps, 1u);
+    const auto variance = odom.state().pose_variance[0];  // the gap's stays: the path is unknown
+    EXPECT_GT(variance, 1.0);
+  }
+  Odometry odom;
+  Chassis chassis;
+  OdometerFeedback no_unit;
+  no_unit.left_wheel = no_unit.right_wheel = 1000;
+  const Timestamp t = chassis.drive(odom, {0.5, 0, 0}, Timestamp{5s}, 1s);
+  odom.on_message(no_unit, t);
+  chassis.feed(odom, {0.5, 0, 0}, t + 2s);
+  const double x = odom.state().pose.x;
+  no_unit.left_wheel = no_unit.right_wheel = 1300;
+  EXPECT_FALSE(odom.on_message(no_unit, t + 2s));
+  EXPECT_DOUBLE_EQ(odom.state().pose.x, x);
+  EXPECT_EQ(odom.state().last_gap_odometer_distance, 0.0);
+}
+
 TEST(OdometryRobustness, AbsurdSteeringOnTheWireNeverPoisonsThePose) {
   // 0x221 steering of 120 deg in Ackermann mode is outside the protocol but encodable.
   Odometry odom(OdometryConfig{{}, OdometrySource::kMotion});

@@ -244,31 +244,6 @@ ranger_msgs::BmsFlags to_bms_flags(std::uint8_t status1, std::uint8_t status2) {
 
 // ---- chassis state ----------------------------------------------------------------------------
 
-namespace {
-
-// The drive mode, the wheels' own odometers and the pack's BMS alarms (the RANGER MINI 3.0's
-// frames, and the BMS alarm frame of every revision).
-void fill_mini_v3_fields(const ranger::DriverSnapshot& snapshot, ranger_msgs::SystemState& out) {
-  const ranger::ChassisFeedback& feedback = snapshot.feedback;
-  out.drive_mode = ranger_msgs::SystemState::DRIVE_MODE_NONE;
-  if (snapshot.drive_mode) {
-    out.drive_mode = static_cast<std::uint8_t>(*snapshot.drive_mode);
-    out.drive_mode_name = std::string(ranger::to_string(*snapshot.drive_mode));
-  }
-  const auto distances = [&](const auto& odometer, double& left, double& right) {
-    left = odometer ? odometer->value.left_distance.value_or(kNaN) : kNaN;
-    right = odometer ? odometer->value.right_distance.value_or(kNaN) : kNaN;
-  };
-  distances(feedback.odometer, out.front_left_distance, out.front_right_distance);
-  distances(feedback.rear_odometer, out.rear_left_distance, out.rear_right_distance);
-  if (const auto& alarm = feedback.bms_alarm[0]) {
-    out.bms_alarms = ranger::bms_status_names(alarm->value.alarm1, alarm->value.alarm2);
-    out.bms_warnings = ranger::bms_status_names(alarm->value.warning1, alarm->value.warning2);
-  }
-}
-
-}  // namespace
-
 ranger_msgs::SystemState to_system_state(const ranger::DriverSnapshot& snapshot,
                                          const ros::Time& stamp) {
   const ranger::ControllerState& state = snapshot.controller;
@@ -316,7 +291,19 @@ ranger_msgs::SystemState to_system_state(const ranger::DriverSnapshot& snapshot,
   out.parked = state.parked();
   out.firmware_version = snapshot.firmware.text;
   out.firmware_version_state = std::string(ranger::to_string(snapshot.firmware.state));
-  fill_mini_v3_fields(snapshot, out);
+  out.drive_mode = ranger_msgs::SystemState::DRIVE_MODE_NONE;
+  if (snapshot.drive_mode) {
+    out.drive_mode = static_cast<std::uint8_t>(*snapshot.drive_mode);
+    out.drive_mode_name = std::string(ranger::to_string(*snapshot.drive_mode));
+  }
+  const auto [front_left, front_right, rear_left, rear_right] = ranger::wheel_odometers(feedback);
+  out.front_left_distance = front_left;
+  out.front_right_distance = front_right;
+  out.rear_left_distance = rear_left;
+  out.rear_right_distance = rear_right;
+  auto bms = ranger::pack_bms_alarms(feedback);
+  out.bms_alarms = std::move(bms.alarms);
+  out.bms_warnings = std::move(bms.warnings);
   return out;
 }
 

@@ -41,17 +41,10 @@ int check_parameters(std::istream& in, std::ostream& err) {
     err << "ranger_base_node --check-parameters: " << source.error().message << "\n";
     return 2;
   }
-  bool ok = true;
-  for (const auto& name : ranger::unknown_parameter_names(*source, kAlsoRead)) {
-    err << "parameter " << source->display_name(name)
-        << " is not one ranger_base_node reads (ranger_base/README.md lists them)\n";
-    ok = false;
-  }
-  if (const auto params = load_parameters(*source); !params) {
-    err << params.error().message << "\n";
-    ok = false;
-  }
-  return ok ? 0 : 2;
+  const auto problems = ranger::parameter_problems(*source, kAlsoRead);
+  for (const auto& problem : problems)
+    err << problem << "\n";
+  return problems.empty() ? 0 : 2;
 }
 
 }  // namespace ranger_base

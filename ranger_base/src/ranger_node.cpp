@@ -18,9 +18,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cinttypes>
-#include <map>
 #include <string>
 
+#include <ranger_can/frontend/answers.hpp>
 #include <ranger_can/sim/chassis_commands.hpp>
 #include <ranger_can/text.hpp>
 #include <ranger_can/transport/bus_source.hpp>
@@ -32,7 +32,6 @@ namespace {
 
 using std::chrono::nanoseconds;
 using Kind = ranger::RequestOutcome::Kind;
-using State = ranger::RequestOutcome::State;
 
 const ranger::Clock& driver_clock() {
   static const ranger::SteadyClock clock;
@@ -43,15 +42,13 @@ const ranger::Clock& bus_clock() {
   return clock;
 }
 
-using ranger::text::join;
 
-// "name<separator>value, ..." of (name, value) pairs, for the log.
-std::string join_pairs(const std::vector<std::pair<std::string, std::string>>& pairs,
-                       const char* separator) {
-  std::vector<std::string> items;
-  for (const auto& [name, value] : pairs)
-    items.push_back(name + separator + value);
-  return join(items);
+// A service answer from the library's words onto a ROS response.
+template <class Response>
+bool respond(const ranger::ServiceAnswer& answer, Response& res) {
+  res.success = answer.success;
+  res.message = answer.message;
+  return true;
 }
 
 // Publishes a message as a shared pointer: a subscriber in the same process gets this very
@@ -68,12 +65,15 @@ void publish_if_heard(const ros::Publisher& pub, Make make) {
   if (pub.getNumSubscribers() > 0) publish_shared(pub, make());
 }
 
-// The driver's event in the log at its severity: the one mapping from the library's events.
-void log_event(const ranger::DriverEvent& event) {
+// A line in the log at its severity: the one mapping from the library's severities (the driver's
+// events, the library's start-up and injection lines).
+void log_at(ranger::Severity severity, const std::string& text) {
   using Level = ros::console::levels::Level;
   static constexpr Level kLevel[] = {Level::Debug, Level::Info, Level::Warn, Level::Error};
-  ROS_LOG(kLevel[static_cast<int>(event.severity)], ROSCONSOLE_DEFAULT_NAME, "%s",
-          ranger::describe(event).c_str());
+  ROS_LOG(kLevel[static_cast<int>(severity)], ROSCONSOLE_DEFAULT_NAME, "%s", text.c_str());
+}
+void log_event(const ranger::DriverEvent& event) {
+  log_at(event.severity, ranger::describe(event));
 }
 
 // A publication is due from this long before its time (the estimates come with the driver's
@@ -209,36 +209,8 @@ void RangerNode::start() {
 }
 
 void RangerNode::log_protocol() const {
-  const auto& pp = params_.protocol;
-  const auto& c = params_.driver.controller;
-  ROS_INFO("model %s (%s): wheelbase %.3f m, track %.3f m, wheel radius %.3f m, max speed %.2f m/s",
-           pp.model.c_str(), pp.model_display_name.c_str(), c.geometry.wheelbase, c.geometry.track,
-           c.geometry.wheel_radius, c.limits.max_linear_speed);
-  if (params_.driver.protocol == ranger::ProtocolChoice::kAuto) {
-    ROS_INFO(
-        "protocol auto: the settings are identified from the chassis before anything moves "
-        "(listening first, then a few degrees of steering at zero speed; identify_timeout %.1f "
-        "s); nothing is driven until then, and the plausibility monitors check them while "
-        "driving",
-        ranger::seconds(params_.driver.identification.timeout));
-    if (!pp.model_settings.empty()) {
-      ROS_INFO(
-          "the %s's own readings (%s) are not assumed with protocol auto: the identification "
-          "decides what it can at rest, the plausibility monitors the rest on first motion; set "
-          "protocol: %s to force the model's profile",
-          pp.model_display_name.c_str(), join_pairs(pp.model_settings, "=").c_str(),
-          c.profile.revision.c_str());
-    }
-  } else if (pp.auto_overridden) {
-    ROS_WARN(
-        "protocol auto, but interpretation parameters are set (%s): the driver cannot keep "
-        "single settings forced on top of an identification, so identification is off and the "
-        "settings are forced: %s (the plausibility monitors still check them while driving)",
-        join_pairs(pp.settings, ": ").c_str(), ranger::describe(c.profile).c_str());
-  } else {
-    ROS_INFO("protocol settings %s (%s); the plausibility monitors check them while driving",
-             ranger::describe(c.profile).c_str(), pp.source.c_str());
-  }
+  for (const auto& line : ranger::describe_protocol_setup(params_))
+    log_at(line.severity, line.text);
 }
 
 void RangerNode::shutdown() {
@@ -293,64 +265,32 @@ void RangerNode::wake_publication() {
 
 void RangerNode::on_sim_inject(const std_msgs::String::ConstPtr& msg) {
   if (!sim_) return;
-  const std::string& line = msg->data;
-  const auto said = sim_->with_chassis(
-      [&](ranger::sim::VirtualChassis& c) { return ranger::sim::apply_chassis_command(line, c); });
-  if (!said) {
-    ROS_WARN("sim/inject \"%s\" not applied: %s (valid commands: %s; see ranger_base/README.md)",
-             line.c_str(), said.error().message.c_str(),
-             join(ranger::sim::chassis_command_names()).c_str());
-    return;
-  }
-  ROS_INFO("sim/inject \"%s\" applied to the virtual chassis%s%s", line.c_str(),
-           said->empty() ? "" : ": ", said->c_str());
+  const auto said = sim_->with_chassis([&](ranger::sim::VirtualChassis& c) {
+    return ranger::sim::apply_chassis_command(msg->data, c);
+  });
+  const auto line = ranger::describe_injection(msg->data, said);
+  log_at(line.severity, line.text);
 }
 
 bool RangerNode::on_resume(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
-  const auto before = driver_->snapshot();
-  if (!before->bus_open) {
-    res.success = false;
-    res.message = "resume refused: not connected to " + params_.port_name +
-                  (before->bus_error.empty() ? "" : ": " + before->bus_error);
-    ROS_WARN("%s", res.message.c_str());
-    return true;
-  }
-  const auto outcome = wait_for(driver_->resume(), Kind::kResume);
   // (The outcome is logged as the driver's event.)
-  res.success = outcome.state == State::kAnswered;
-  res.message = res.success ? "re-armed: cmd_vel drives the chassis again"
-                : outcome.message.empty()
-                    ? "resume not applied (" + std::string(ranger::to_string(outcome.state)) + ")"
-                    : outcome.message;
-  return true;
+  auto answer = ranger::resume_refused_offline(*driver_->snapshot(), params_.port_name);
+  if (answer) ROS_WARN("%s", answer->message.c_str());
+  if (!answer) answer = ranger::resume_answer(wait_for(driver_->resume(), Kind::kResume));
+  return respond(*answer, res);
 }
 
 bool RangerNode::on_clear_errors(ranger_msgs::ClearErrors::Request& req,
                                  ranger_msgs::ClearErrors::Response& res) {
-  res.success = false;
   const auto posted = driver_->clear_errors(req.code);
-  if (!posted) {
-    res.message = posted.error().message;
-    res.error_word = driver_->snapshot()->controller.error_bits;
-    return true;
-  }
+  res.error_word = driver_->snapshot()->controller.error_bits;
+  if (!posted) return respond({false, posted.error().message}, res);
   const auto outcome = wait_for(*posted, Kind::kClearErrors);
-  const std::string asked = "clear_errors code " + std::to_string(req.code) + " (" +
-                            ranger::error_clear_description(req.code) + ")";
-  if (outcome.state == State::kAnswered && outcome.error_word) {
-    res.success = true;
-    res.error_word = *outcome.error_word;
-    const auto names = ranger::fault_names(res.error_word, driver_->snapshot()->profile.error_word);
-    res.message = asked + ": the chassis answered with error word " +
-                  ranger::text::hex(res.error_word, 8) +
-                  (names.empty() ? " (no errors)" : " (" + join(names) + ")");
-  } else {
-    res.error_word = driver_->snapshot()->controller.error_bits;
-    res.message = asked + ": " +
-                  (outcome.state == State::kFailed ? outcome.message
-                                                   : std::string("the chassis did not answer"));
-  }
-  return true;
+  const auto answer =
+      ranger::clear_errors_answer(req.code, outcome, driver_->snapshot()->profile.error_word);
+  res.error_word =
+      answer.success ? *outcome.error_word : driver_->snapshot()->controller.error_bits;
+  return respond(answer, res);
 }
 
 bool RangerNode::on_set_ultrasonic(ranger_msgs::SetUltrasonic::Request& req,
@@ -365,52 +305,27 @@ bool RangerNode::on_set_ultrasonic(ranger_msgs::SetUltrasonic::Request& req,
     return true;
   }
   const auto outcome = wait_for(driver_->set_ultrasonic(req.enable), Kind::kUltrasonic);
-  res.success = outcome.state == State::kAnswered;
   res.enabled = driver_->snapshot()->controller.ultrasonic_enabled.value_or(false);
-  res.message = outcome.message.empty()
-                    ? "the chassis did not confirm the ultrasonic setting in time"
-                    : outcome.message;
-  return true;
+  return respond(
+      ranger::answer_of(outcome, "the chassis did not confirm the ultrasonic setting in time"),
+      res);
 }
 
 bool RangerNode::on_set_motion_mode(ranger_msgs::SetMotionMode::Request& req,
                                     ranger_msgs::SetMotionMode::Response& res) {
-  using Req = ranger_msgs::SetMotionMode::Request;
-  using M = ranger::MotionMode;
-  static const std::map<std::uint8_t, std::optional<M>> kModes = {{Req::ACKERMANN, M::kAckermann},
-                                                                  {Req::OBLIQUE, M::kOblique},
-                                                                  {Req::SPIN, M::kSpin},
-                                                                  {Req::SIDE_SLIP, M::kSideSlip},
-                                                                  {Req::AUTOMATIC, std::nullopt}};
-  const auto known = kModes.find(req.mode);
-  if (known == kModes.end()) {
-    // The valid values are the ones valid on this chassis (the settings in use).
-    const auto profile = driver_->snapshot()->profile;
-    std::vector<std::string> valid;
-    for (const auto& [number, m] : kModes) {
-      if (m && ranger::can_drive_in(*m, profile)) {
-        valid.push_back(std::to_string(number) + " (" + std::string(ranger::to_string(*m)) + ")");
-      }
-    }
-    res.success = false;
-    res.message = "mode " + std::to_string(req.mode) + " unknown: under protocol " +
-                  profile.revision + " use " + join(valid) + " or " +
-                  std::to_string(Req::AUTOMATIC) + " (automatic)";
-    ROS_WARN("set_motion_mode: %s", res.message.c_str());
-    return true;
+  const auto& numbers = ranger::motion_mode_numbers();
+  const auto known = std::find_if(numbers.begin(), numbers.end(),
+                                  [&](const auto& n) { return n.first == req.mode; });
+  ranger::ServiceAnswer answer{false, ""};
+  if (known == numbers.end()) {
+    answer.message = ranger::unknown_motion_mode_number(req.mode, driver_->snapshot()->profile);
+  } else if (const ranger::Status st = driver_->set_motion_mode(known->second); !st) {
+    answer.message = st.error().message;
+  } else {
+    answer = {true, ranger::motion_mode_pinned(known->second)};
   }
-  const std::optional<M> mode = known->second;
-  if (const ranger::Status st = driver_->set_motion_mode(mode); !st) {
-    res.success = false;
-    res.message = st.error().message;
-    ROS_WARN("set_motion_mode: %s", res.message.c_str());
-    return true;
-  }
-  res.success = true;
-  res.message = mode ? "motion mode pinned to " + std::string(ranger::to_string(*mode)) +
-                           " (the switch happens at standstill)"
-                     : "automatic motion-mode selection";
-  return true;
+  if (!answer.success) ROS_WARN("set_motion_mode: %s", answer.message.c_str());
+  return respond(answer, res);
 }
 
 bool RangerNode::on_set_lights(ranger_msgs::SetLights::Request& req,
@@ -427,23 +342,18 @@ bool RangerNode::on_set_lights(ranger_msgs::SetLights::Request& req,
     res.message = posted.error().message;
     return true;
   }
-  const auto outcome = wait_for(*posted, Kind::kLights);
-  res.success = outcome.state == State::kAnswered;
-  res.message = outcome.message.empty() ? "the chassis did not report its lights in time (" +
-                                              std::string(ranger::to_string(outcome.state)) + ")"
-                                        : outcome.message;
+  respond(ranger::answer_of(wait_for(*posted, Kind::kLights),
+                            "the chassis did not report its lights in time"),
+          res);
   fill_lights_response(driver_->snapshot()->lights, res);
   return true;
 }
 
 bool RangerNode::on_park(std_srvs::SetBool::Request& req, std_srvs::SetBool::Response& res) {
   const auto outcome = wait_for(driver_->set_park(req.data), Kind::kPark);
-  res.success = outcome.state == State::kAnswered;
-  res.message = outcome.message.empty()
-                    ? std::string(req.data ? "park" : "release") + " not confirmed in time (" +
-                          std::string(ranger::to_string(outcome.state)) + ")"
-                    : outcome.message;
-  return true;
+  return respond(ranger::answer_of(outcome, std::string(req.data ? "park" : "release") +
+                                                " not confirmed in time"),
+                 res);
 }
 
 bool RangerNode::on_set_drive_mode(ranger_msgs::SetDriveMode::Request& req,
@@ -454,11 +364,9 @@ bool RangerNode::on_set_drive_mode(ranger_msgs::SetDriveMode::Request& req,
     res.message = "drive mode " + std::to_string(req.mode) +
                   " is not one of 0 (CURRENT), 1 (VOLTAGE): nothing sent";
   } else {
-    const auto outcome = wait_for(driver_->set_drive_mode(*mode), Kind::kDriveMode);
-    res.success = outcome.state == State::kAnswered;
-    res.message = outcome.message.empty() ? "drive mode not confirmed in time (" +
-                                                std::string(ranger::to_string(outcome.state)) + ")"
-                                          : outcome.message;
+    respond(ranger::answer_of(wait_for(driver_->set_drive_mode(*mode), Kind::kDriveMode),
+                              "drive mode not confirmed in time"),
+            res);
   }
   const auto reported = driver_->snapshot()->drive_mode;
   res.drive_mode = ranger_msgs::SystemState::DRIVE_MODE_NONE;

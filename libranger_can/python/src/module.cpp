@@ -11,7 +11,6 @@
 
 #include <array>
 #include <chrono>
-#include <limits>
 #include <sstream>
 #include <string>
 
@@ -19,6 +18,7 @@
 #include "ranger_can/control/geometry.hpp"
 #include "ranger_can/control/model.hpp"
 #include "ranger_can/control/rearm.hpp"
+#include "ranger_can/control/vocabulary.hpp"
 #include "ranger_can/sim/chassis_commands.hpp"
 #include "ranger_can/sim/sim_bus_source.hpp"
 #include "ranger_can/text.hpp"
@@ -479,33 +479,13 @@ PYBIND11_MODULE(_ranger_can, m) {
                                if (!s.s().drive_mode) return std::nullopt;
                                return static_cast<int>(*s.s().drive_mode);
                              })
-      .def_property_readonly("wheel_odometers",
-                             [](const S& s) {
-                               // front left, front right, rear left, rear right (m; NaN: none)
-                               const auto& fb = s.s().feedback;
-                               std::array<double, 4> out{};
-                               const auto fill = [&](const auto& o, double& l, double& r) {
-                                 const double nan = std::numeric_limits<double>::quiet_NaN();
-                                 l = o ? o->value.left_distance.value_or(nan) : nan;
-                                 r = o ? o->value.right_distance.value_or(nan) : nan;
-                               };
-                               fill(fb.odometer, out[0], out[1]);
-                               fill(fb.rear_odometer, out[2], out[3]);
-                               return out;
-                             })
+      .def_property_readonly(
+          "wheel_odometers",  // front left, front right, rear left, rear right (m; NaN: none)
+          [](const S& s) { return wheel_odometers(s.s().feedback); })
       .def_property_readonly("bms_alarms",
-                             [](const S& s) {
-                               const auto& a = s.s().feedback.bms_alarm[0];
-                               if (!a) return std::vector<std::string>{};
-                               return protocol::bms_status_names(a->value.alarm1, a->value.alarm2);
-                             })
+                             [](const S& s) { return pack_bms_alarms(s.s().feedback).alarms; })
       .def_property_readonly("bms_warnings",
-                             [](const S& s) {
-                               const auto& a = s.s().feedback.bms_alarm[0];
-                               if (!a) return std::vector<std::string>{};
-                               return protocol::bms_status_names(a->value.warning1,
-                                                                 a->value.warning2);
-                             })
+                             [](const S& s) { return pack_bms_alarms(s.s().feedback).warnings; })
       .def_property_readonly("firmware_version", [](const S& s) { return s.s().firmware.text; })
       .def_property_readonly(
           "firmware_state", [](const S& s) { return std::string(to_string(s.s().firmware.state)); })

@@ -216,6 +216,9 @@ DiagnosticGroup diagnose_link(const DriverSnapshot& s) {
   // could have moved in it.
   out.add("Odometry gaps", s.odometry.gaps);
   out.add("Last odometry gap (s)", seconds(s.odometry.last_gap));
+  if (s.odometry.last_gap_odometer_distance > 0.0) {  // the chassis's own odometer bridged it
+    out.add("Last gap's odometer distance (m)", s.odometry.last_gap_odometer_distance);
+  }
   out.add("Undecodable frames", c.counters.decode_errors);
   out.add("Send failures", c.counters.send_failures);
   if (!c.last_error.empty()) out.add("Last error", c.last_error);

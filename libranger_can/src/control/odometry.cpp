@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <variant>
 
 #include "ranger_can/wire/interpretation.hpp"
@@ -13,6 +14,10 @@ namespace {
 
 namespace interp = ranger::interpretation;
 using protocol::MotionMode;
+
+// Slower than this (m/s, the body's or a spinning wheel's), the motion before a gap says no
+// direction for the distance the chassis's odometer counted in it.
+constexpr double kStandstillSpeed = 1e-3;
 
 }  // namespace
 
@@ -133,7 +138,8 @@ void Odometry::reset(const Pose2D& pose) {
                            config_.twist_variance_angular};
   state_.active_source = config_.source;
   anchored_ = false;
-  previous_twist_ = BodyTwist{};
+  previous_twist_ = gap_twist_ = BodyTwist{};
+  odometer_.reset();
 }
 
 bool Odometry::on_frame(const CanFrame& frame) {
@@ -164,6 +170,8 @@ bool Odometry::on_message(const Message& message, Timestamp stamp) {
           return on_motion_feedback(m, stamp);
         } else if constexpr (std::is_same_v<T, MotionModeFeedback>) {
           return on_motion_mode(m, stamp);
+        } else if constexpr (std::is_same_v<T, OdometerFeedback>) {
+          return on_odometer(m, stamp);
         } else {
           return false;
         }
@@ -181,6 +189,30 @@ bool Odometry::on_steering_angles(const SteeringAnglesFeedback& m, Timestamp sta
 bool Odometry::on_motion_mode(const MotionModeFeedback& m, Timestamp) {
   if (m.mode_known) mode_ = m.mode;
   return false;
+}
+
+bool Odometry::on_odometer(const OdometerFeedback& m, Timestamp stamp) {
+  if (!m.left_distance || !m.right_distance || stamp.count() == 0) return false;  // no unit
+  if (odometer_ && m.rear && !odometer_->rear) return false;  // the front axle's is in use
+  const OdometerReading now{*m.left_distance, *m.right_distance, stamp, m.rear};
+  const auto before = std::exchange(odometer_, now);
+  if (!before || before->rear != now.rear || stamp - before->stamp <= config_.max_step) {
+    return false;
+  }
+  // A gap in the odometer's frames: what its wheels rolled in it, along the motion before it
+  // (the motion gap is found on the motion frames, which come first, or is still to come).
+  const double d = (std::fabs(now.left - before->left) + std::fabs(now.right - before->right)) / 2;
+  const BodyTwist motion = state_.last_gap_end > before->stamp ? gap_twist_ : previous_twist_;
+  const double speed = std::hypot(motion.vx, motion.vy);
+  const double spin_radius = std::hypot(config_.geometry.wheelbase, config_.geometry.track) / 2;
+  // The time at the motion before the gap that rolls the wheels by d.
+  const double rolled_per_second =
+      speed > kStandstillSpeed ? speed : std::fabs(motion.wz) * spin_radius;
+  if (!std::isfinite(d) || d <= 0.0 || rolled_per_second <= kStandstillSpeed) return false;
+  state_.pose = integrate_pose(state_.pose, motion, d / rolled_per_second);
+  state_.distance += d;
+  state_.last_gap_odometer_distance = d;
+  return true;
 }
 
 bool Odometry::wheels_fresh(Timestamp stamp) const {
@@ -228,6 +260,7 @@ void Odometry::account_gap(std::chrono::nanoseconds gap, Timestamp end) {
   state_.last_gap = gap;
   state_.last_gap_end = end;
   ++state_.gaps;
+  gap_twist_ = previous_twist_;
 }
 
 bool Odometry::step(const BodyTwist& twist, Timestamp stamp, OdometrySource source) {

@@ -49,6 +49,27 @@ bool bms_present(const ChassisFeedback& feedback, int slot, Timestamp now) {
                   std::chrono::milliseconds(kStalePeriods * period_ms));
 }
 
+std::array<double, 4> wheel_odometers(const ChassisFeedback& feedback) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::array<double, 4> out{};
+  const auto fill = [&](const auto& odometer, double& left, double& right) {
+    left = odometer ? odometer->value.left_distance.value_or(nan) : nan;
+    right = odometer ? odometer->value.right_distance.value_or(nan) : nan;
+  };
+  fill(feedback.odometer, out[0], out[1]);
+  fill(feedback.rear_odometer, out[2], out[3]);
+  return out;
+}
+
+BmsAlarmNames pack_bms_alarms(const ChassisFeedback& feedback) {
+  BmsAlarmNames out;
+  if (const auto& alarm = feedback.bms_alarm[0]) {
+    out.alarms = bms_status_names(alarm->value.alarm1, alarm->value.alarm2);
+    out.warnings = bms_status_names(alarm->value.warning1, alarm->value.warning2);
+  }
+  return out;
+}
+
 double ultrasonic_range(std::int16_t raw) {
   return interpretation::ultrasonic_distance_m(raw).value_or(
       std::numeric_limits<double>::quiet_NaN());

@@ -250,8 +250,7 @@ void add_connection(std::vector<Binding>& out) {
 void add_control(std::vector<Binding>& out) {
   for (const char* name :
        {"cmd_vel_timeout", "auto_command_mode", "auto_reclaim_after_remote", "rearm_on_zero_twist",
-        "link_timeout",
-        "min_command_interval", "mode_switch_timeout", "mode_switch_max_attempts",
+        "link_timeout", "min_command_interval", "mode_switch_timeout", "mode_switch_max_attempts",
         "standstill_speed", "steer_first_threshold", "low_battery_soc"}) {
     out.push_back(driver_row(name));
   }
@@ -453,7 +452,9 @@ void add_odometry(std::vector<Binding>& out) {
                     "(a silence longer than 0.5 s the odometry cannot integrate) what the chassis "
                     "could have moved in it: (`max_linear_speed` × gap)² on x and y, (its fastest "
                     "turn × gap)² on yaw (at most π²); `system_state.odometry_gap` says how long "
-                    "it was")
+                    "it was. Where the chassis counts its wheels' distance in metres (the RANGER "
+                    "MINI 3.0's 0x311), the pose advances by what it counted in the gap, along "
+                    "the motion before it")
                     .size(6)
                     .apply(diagonal(&NodeParameters::pose_covariance_diagonal)));
   out.push_back(Row("twist_covariance_diagonal", T::kNumberList, "", kVariance,
@@ -701,6 +702,19 @@ std::vector<std::string> unknown_parameter_names(const ParameterSource& source,
   for (const auto& n : source.names()) {
     if (n.rfind("description/", 0) == 0) continue;  // the URDF's part of geometry.yaml
     if (known_set.count(n) == 0) out.push_back(n);
+  }
+  return out;
+}
+
+std::vector<std::string> parameter_problems(const ParameterSource& source,
+                                            const std::vector<std::string>& also_read) {
+  std::vector<std::string> out;
+  for (const auto& name : unknown_parameter_names(source, also_read)) {
+    out.push_back("parameter " + source.display_name(name) +
+                  " is not one ranger_base_node reads (ranger_base/README.md lists them)");
+  }
+  if (const auto params = load_parameters(source); !params) {
+    out.push_back(params.error().message);
   }
   return out;
 }

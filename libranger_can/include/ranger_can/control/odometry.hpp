@@ -21,6 +21,7 @@
 #include <array>
 #include <chrono>
 #include <cstdint>
+#include <optional>
 #include <string_view>
 
 #include "ranger_can/control/geometry.hpp"
@@ -101,6 +102,10 @@ struct OdometryState {
   std::chrono::nanoseconds last_gap{0};
   Timestamp last_gap_end{0};
   std::uint64_t gaps = 0;
+  // What the chassis's own odometer (0x311, else 0x312, where it reports metres: the RANGER MINI
+  // 3.0) counted across the latest gap in its frames, m (the mean of its two wheels' distances,
+  // unsigned), and was added to the pose along the motion before the gap; 0 = none.
+  double last_gap_odometer_distance = 0.0;
 };
 
 // The fastest the chassis can turn under `limits` (rad/s): a spin at max_spin_wheel_speed or an
@@ -142,6 +147,10 @@ class Odometry {
   bool on_wheel_speeds(const WheelSpeedsFeedback& m, Timestamp stamp);
   bool on_motion_feedback(const MotionFeedback& m, Timestamp stamp);
   bool on_motion_mode(const MotionModeFeedback& m, Timestamp stamp);
+  // The chassis's own odometer: where it reports metres, the distance it counted across a gap in
+  // its frames advances the pose along the arc the chassis was driving before the gap (its
+  // direction and curvature); the gap's variance (account_gap) stays, the path's shape unknown.
+  bool on_odometer(const OdometerFeedback& m, Timestamp stamp);
 
   // Back to `pose` with the initial covariance; twist, counters and time anchor cleared.
   void reset(const Pose2D& pose = {});
@@ -160,6 +169,14 @@ class Odometry {
   OdometryState state_;
   bool anchored_ = false;
   BodyTwist previous_twist_;
+  BodyTwist gap_twist_;  // previous_twist_ when the latest gap was found: the motion before it
+
+  struct OdometerReading {
+    double left = 0.0, right = 0.0;  // m
+    Timestamp stamp{0};
+    bool rear = false;
+  };
+  std::optional<OdometerReading> odometer_;  // the latest, of the axle in use (front first)
 
   bool have_angles_ = false;
   SteeringAnglesFeedback angles_;

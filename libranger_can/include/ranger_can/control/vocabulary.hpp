@@ -19,8 +19,8 @@ namespace ranger {
 
 // ---- the vocabulary ---------------------------------------------------------------------------
 using protocol::ControlMode;
-using protocol::DriveMode;
 using protocol::drive_mode_from_wire;  // 0 current, 1 voltage (ranger_msgs' SetDriveMode)
+using protocol::DriveMode;
 using protocol::Fault;
 using protocol::LightMode;
 using protocol::MotionMode;
@@ -60,6 +60,15 @@ using protocol::bms_status_names;
 // report older than three of its periods counts as absent (an unfitted slot). `now`: the driver's
 // clock (DriverSnapshot::now).
 bool bms_present(const ChassisFeedback& feedback, int slot, Timestamp now);
+// The wheels' own odometers, m: front left, front right, rear left, rear right (0x311, 0x312);
+// NaN where the chassis reports none, or none in a known unit.
+std::array<double, 4> wheel_odometers(const ChassisFeedback& feedback);
+// The whole pack's BMS alarms and warnings (0x362) by name; both empty before one is heard.
+struct BmsAlarmNames {
+  std::vector<std::string> alarms;
+  std::vector<std::string> warnings;
+};
+BmsAlarmNames pack_bms_alarms(const ChassisFeedback& feedback);
 // The distance a raw ultrasonic value stands for, in m; NaN for no reading and every error code.
 double ultrasonic_range(std::int16_t raw);
 // "ok", "no_reading", "offline", ... (ranger_msgs' UltrasonicReading status).

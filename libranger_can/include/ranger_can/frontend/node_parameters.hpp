@@ -104,4 +104,10 @@ Result<NodeParameters> load_parameters(const ParameterSource& source);
 std::vector<std::string> unknown_parameter_names(const ParameterSource& source,
                                                  const std::vector<std::string>& also_read = {});
 
+// Every problem a node would refuse to start with, one per line: each unknown name (as
+// unknown_parameter_names, "parameter ~NAME is not one ranger_base_node reads ...") and every
+// problem load_parameters reports. Empty: the parameters are good (`--check-parameters`).
+std::vector<std::string> parameter_problems(const ParameterSource& source,
+                                            const std::vector<std::string>& also_read = {});
+
 }  // namespace ranger
