@@ -135,6 +135,10 @@ def to_system_state(s, stamp, detail: str) -> SystemState:
     msg.parked = s.parked
     msg.firmware_version = s.firmware_version
     msg.firmware_version_state = s.firmware_state
+    o = s.odometry  # the latest gap in the feedback (its variance is in odom's covariance)
+    msg.odometry_gap = float(o.last_gap)
+    msg.odometry_gap_end = to_time(o.last_gap_end_ns) if o.last_gap_end_ns > 0 else Time()
+    msg.odometry_gaps = o.gaps
     return msg
 
 
