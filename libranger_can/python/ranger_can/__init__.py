@@ -196,12 +196,16 @@ class Driver:
 
     # ---- commands (the driver's mailbox: never waits for the bus) ----
     def command(self, vx: float = 0.0, vy: float = 0.0, wz: float = 0.0,
-                mode: Optional[str] = None) -> None:
+                mode: Optional[str] = None, vz: float = 0.0, wx: float = 0.0,
+                wy: float = 0.0) -> None:
         """The motion wanted from now on (REP-103: m/s, rad/s), optionally in a forced mode.
         Repeat it at least every cmd_vel_timeout (0.5 s), or the driver stops the chassis.
-        RangerError for NaN/inf (the chassis is then commanded to stop) or a bus never opened."""
+        vz, wx, wy (a twist's linear.z, angular.x, angular.y) are not driven, only checked.
+        RangerError for NaN/inf in any of the six (the chassis is then commanded to stop, and the
+        snapshot's refusal is "invalid_command" naming it until a valid command) or a bus never
+        opened."""
         self._check_open()
-        self._s.command(float(vx), float(vy), float(wz), mode)
+        self._s.command(float(vx), float(vy), float(wz), mode, float(vz), float(wx), float(wy))
 
     def set_motion_mode(self, mode: Optional[str]) -> None:
         """Pins every later command to "ackermann", "oblique", "spin" or "side_slip" (where the

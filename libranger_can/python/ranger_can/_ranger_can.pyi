@@ -11,6 +11,9 @@ class Odometry:
     twist_variance: Tuple[float, float, float]  # vx, vy, wz
     source: str  # "wheels" | "motion"
     steps: int
+    last_gap: float  # s: the latest gap in the feedback, not integrated (its variance added)
+    last_gap_end_ns: int  # the frame time the feedback returned after it, 0 = no gap yet
+    gaps: int
 
 class Joints:
     steering_names: List[str]; wheel_names: List[str]
@@ -104,6 +107,7 @@ class Snapshot:
     odometry: Odometry; joints: Joints; motors: List[Motor]; batteries: List[Battery]
     ultrasonic: List[UltrasonicReading]
     protocol: str; profile: str; profile_revision: str
+    drivable_modes: List[str]  # the motion modes the settings in use can drive
     identification: Optional[Identification]
     plausibility_warnings: List[str]; plausibility_stop: Optional[str]
     vendor_frames: str; remote: Optional[RemoteState]; lights: Optional[Lights]

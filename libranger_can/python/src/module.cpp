@@ -219,6 +219,9 @@ PYBIND11_MODULE(_ranger_can, m) {
       .def_readonly("twist_variance", &OdometryView::twist_variance)
       .def_readonly("source", &OdometryView::source)
       .def_readonly("steps", &OdometryView::steps)
+      .def_readonly("last_gap", &OdometryView::last_gap)
+      .def_readonly("last_gap_end_ns", &OdometryView::last_gap_end_ns)
+      .def_readonly("gaps", &OdometryView::gaps)
       .def("__repr__", [](const OdometryView& o) {
         std::ostringstream out;
         out << "Odometry(x=" << o.x << ", y=" << o.y << ", yaw=" << o.yaw << ", vx=" << o.vx
@@ -455,6 +458,13 @@ PYBIND11_MODULE(_ranger_can, m) {
                              [](const S& s) { return std::string(to_string(s.s().protocol)); })
       .def_property_readonly("profile", [](const S& s) { return describe(s.s().profile); })
       .def_property_readonly("profile_revision", [](const S& s) { return s.s().profile.revision; })
+      .def_property_readonly("drivable_modes",
+                             [](const S& s) {
+                               std::vector<std::string> out;
+                               for (auto m : drivable_modes(s.s().profile))
+                                 out.emplace_back(protocol::to_string(m));
+                               return out;
+                             })
       .def_property_readonly("identification",
                              [](const S& s) { return identification_view(s.s()); })
       .def_property_readonly("plausibility_warnings",
@@ -556,12 +566,15 @@ PYBIND11_MODULE(_ranger_can, m) {
           py::arg("sequence"), py::arg("timeout"))
       .def(
           "command",
-          [](PySession& p, double vx, double vy, double wz, std::optional<std::string> mode) {
-            MotionRequest r{BodyTwist{vx, vy, wz}, std::nullopt};
+          [](PySession& p, double vx, double vy, double wz, std::optional<std::string> mode,
+             double vz, double wx, double wy) {
+            // All six components: the driver refuses NaN/inf in any of them (naming it).
+            MotionRequest r{BodyTwist{vx, vy, wz}, std::nullopt, OutOfPlaneTwist{vz, wx, wy}};
             if (mode) r.mode = parse_mode(*mode);
             check(p.s().driver().command(r));
           },
-          py::arg("vx"), py::arg("vy"), py::arg("wz"), py::arg("mode") = py::none())
+          py::arg("vx"), py::arg("vy"), py::arg("wz"), py::arg("mode") = py::none(),
+          py::arg("vz") = 0.0, py::arg("wx") = 0.0, py::arg("wy") = 0.0)
       .def(
           "set_motion_mode",
           [](PySession& p, std::optional<std::string> mode) {

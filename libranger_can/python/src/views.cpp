@@ -64,6 +64,9 @@ OdometryView odometry_view(const DriverSnapshot& s) {
   v.twist_variance = o.twist_variance;
   v.source = std::string(to_string(o.active_source));
   v.steps = o.steps;
+  v.last_gap = seconds(o.last_gap);
+  v.last_gap_end_ns = ns(o.last_gap_end);
+  v.gaps = o.gaps;
   return v;
 }
 

@@ -23,6 +23,9 @@ struct OdometryView {
   std::array<double, 3> pose_variance{}, twist_variance{};
   std::string source;
   std::uint64_t steps = 0;
+  double last_gap = 0;               // s, the latest gap in the feedback (not integrated)
+  std::int64_t last_gap_end_ns = 0;  // the frame time the feedback returned, 0 = no gap yet
+  std::uint64_t gaps = 0;
 };
 
 struct JointsView {

@@ -145,6 +145,31 @@ def test_estop_latches_until_resume(sim):
     sim.wait_until(lambda s: s.refusal == "none" and sim.ground_truth().vx > 0.1, timeout=10)
 
 
+def test_nan_in_a_field_the_chassis_does_not_use_is_refused_and_a_silence_is_said(sim):
+    # {linear: {x: 0.3, z: .nan}}: refused, named while it lasts, nothing moves.
+    with pytest.raises(RangerError) as e:
+        sim.command(vx=0.3, vz=float("nan"))
+    assert e.value.code == "not_finite"
+    s = sim.wait_until(lambda s: s.refusal == "invalid_command", timeout=10)
+    assert "linear.z is NaN" in s.refusal_detail, s.refusal_detail
+    assert sim.ground_truth().vx == 0.0
+    assert s.drivable_modes == ["ackermann", "oblique", "spin"]  # the manual's chassis
+    # Silent for 2 s while driving: the odometry says the gap and its variance grew by it.
+    sim.command(vx=0.5)
+    s = sim.wait_until(lambda s: sim.ground_truth().vx > 0.4, timeout=10)
+    before = s.odometry
+    assert before.gaps == 0 and before.last_gap == 0.0 and before.last_gap_end_ns == 0
+    sim.inject("silent 2")
+
+    def heard_after_a_gap(s):
+        sim.command(vx=0.5)
+        return s.link == "connected" and s.odometry.gaps > 0
+    o = sim.wait_until(heard_after_a_gap, timeout=10).odometry
+    assert o.gaps == 1 and o.last_gap >= 1.95 and o.last_gap_end_ns > 0
+    reach = 1.5 * o.last_gap  # the default max_linear_speed, 1.5 m/s
+    assert o.pose_variance[0] >= before.pose_variance[0] + reach * reach - 1e-6
+
+
 def test_remote_control_takes_over_and_stays_won_until_resume(sim):
     sim.inject("remote on")
     s = sim.wait_until(lambda s: s.refusal == "remote", timeout=10)

@@ -142,6 +142,10 @@ def to_system_state(s, stamp, detail: str) -> SystemState:
      msg.rear_right_distance) = s.wheel_odometers
     msg.bms_alarms = list(s.bms_alarms)
     msg.bms_warnings = list(s.bms_warnings)
+    o = s.odometry  # the latest gap in the feedback (its variance is in odom's covariance)
+    msg.odometry_gap = float(o.last_gap)
+    msg.odometry_gap_end = to_time(o.last_gap_end_ns) if o.last_gap_end_ns > 0 else Time()
+    msg.odometry_gaps = o.gaps
     return msg
 
 

@@ -189,11 +189,12 @@ class RangerNode(Node):
 
     # ---- callbacks ----
     def _on_cmd_vel(self, msg: Twist):
-        if msg.linear.z or msg.angular.x or msg.angular.y:
-            self.get_logger().warn("cmd_vel: linear.z, angular.x and angular.y are ignored "
-                                   "(planar base)", throttle_duration_sec=5.0)
-        try:
-            self.driver.command(msg.linear.x, msg.linear.y, msg.angular.z)
+        try:  # all six fields: the driver refuses NaN/inf in any of them, naming it
+            self.driver.command(msg.linear.x, msg.linear.y, msg.angular.z, vz=msg.linear.z,
+                                wx=msg.angular.x, wy=msg.angular.y)
+            if msg.linear.z or msg.angular.x or msg.angular.y:
+                self.get_logger().warn("cmd_vel: linear.z, angular.x and angular.y are ignored "
+                                       "(planar base)", throttle_duration_sec=5.0)
         except RangerError as e:
             if e.code == "not_finite":
                 self.get_logger().error(f"cmd_vel refused, chassis stopped: {e}",
@@ -273,9 +274,13 @@ class RangerNode(Node):
 
     def _on_set_motion_mode(self, request, response):
         if request.mode not in MOTION_MODES:
+            s = self.driver.snapshot()  # the valid values: the ones valid on this chassis
+            valid = [f"{n} ({m})" for n, m in MOTION_MODES.items() if m in s.drivable_modes]
             response.success = False
-            response.message = (f"mode {request.mode} unknown: use 0 (Ackermann), 1 (oblique), "
-                                 "2 (spin), 4 (side slip) or 255 (automatic)")
+            response.message = (f"mode {request.mode} unknown: under protocol "
+                                f"{s.profile_revision} use {', '.join(valid)} or "
+                                f"{SetMotionMode.Request.AUTOMATIC} (automatic)")
+            self._log_answer("set_motion_mode", False, response.message)
             return response
         mode = MOTION_MODES[request.mode]
         try:
