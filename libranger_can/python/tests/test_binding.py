@@ -86,12 +86,14 @@ def test_readme_example_runs_as_written():
     assert refusal in ("none", "cmd_timeout")
 
 
-@pytest.mark.parametrize("port", ["sim", "sim:agx_v2", "sim:mini_v3"])
-def test_drives_every_mode_with_odometry_following_the_ground_truth(port):
-    with ranger_can.Driver(port) as d:
+@pytest.mark.parametrize("port,model,revision", [("sim", "ranger", "manual"),
+                                                 ("sim:agx_v2", "ranger", "agx_v2"),
+                                                 ("sim:mini_v3", "ranger_mini_v3", "mini_v3")])
+def test_drives_every_mode_with_odometry_following_the_ground_truth(port, model, revision):
+    with ranger_can.Driver(port, model=model) as d:
         s = d.wait_ready(timeout=30)
         assert s.identification.phase == "decided"
-        assert s.profile_revision == ("agx_v2" if port == "sim:agx_v2" else "manual")
+        assert s.profile_revision == revision
         drive(d, vx=0.6, wz=0.2, distance=1.0)  # dual Ackermann, an arc to the left
         assert d.snapshot().motion_mode == "ackermann"
         assert_odometry_follows(d)
@@ -215,9 +217,9 @@ def test_park_and_lights_on_agx_v2():
 
 
 def test_drive_mode_and_wheel_odometers_on_the_mini_v3():
-    with ranger_can.Driver("sim:mini_v3") as d:
+    with ranger_can.Driver("sim:mini_v3", model="ranger_mini_v3") as d:
         d.wait_ready(timeout=30)
-        assert d.snapshot().protocol == "mini_v3"
+        assert d.snapshot().profile_revision == "mini_v3"
         outcome = d.set_drive_mode("voltage")
         assert outcome.state == "answered"
         s = d.snapshot()
