@@ -27,7 +27,8 @@ from typing import Dict, List, Optional
 
 from ._errors import RangerError, RequestFailed, RequestTimeout
 from ._ranger_can import (  # noqa: F401  (re-exported)
-    Battery, CliResult, Event, FrameCount, GroundTruth, Identification, Joints, Lights, Motor, Odometry,
+    Battery, CliResult, Event, FrameCount, GroundTruth, Identification, Joints, Lights, Motor,
+    MotionUpdate, Odometry,
     ParameterRow, RemoteState, RequestOutcome, SentMotion, Snapshot, UltrasonicReading,
     __version__, _cli, _Session, bms_status_bit_names, chassis_command_names,
     driver_status_bit_names, error_clear_description, error_names, event_kinds, fault_names,
@@ -37,7 +38,7 @@ from ._ranger_can import (  # noqa: F401  (re-exported)
 
 __all__ = [
     "Driver", "RangerError", "RequestFailed", "RequestTimeout", "Snapshot", "RequestOutcome",
-    "Event", "event_kinds",
+    "Event", "event_kinds", "MotionUpdate",
     "decode", "replay_odometry", "parameters", "model_names", "variant_names", "protocol_names",
     "motion_modes", "light_modes", "refusal_names", "fault_names", "steering_joint_names",
     "wheel_joint_names", "__version__",
@@ -183,6 +184,24 @@ class Driver:
                     + (f", identification {ident.phase}: {ident.message}" if ident else ""))
                 raise RequestTimeout(f"{self.port}: not ready within {timeout} s ({why})")
             s = self._s.wait_snapshot(s.sequence, min(left, _SLICE))
+
+    def wait_motion(self, rate: float = 50.0, timeout: float = 1.0) -> MotionUpdate:
+        """For a publisher of the motion estimate (odom, TF, joint states), paced as the ROS 1
+        node paces it: waits (GIL released) until a publication is due at `rate` (Hz) and the
+        driver has an estimate not handed out before, then returns it (update.odometry,
+        update.joints: ready tuples, None when not new). Returns early with update.sent when a
+        motion frame was sent (record_sent), and empty after `timeout` s or close(). The driver's
+        thread wakes the caller only for a new estimate or a frame sent. One caller per driver."""
+        if not rate > 0:
+            raise RangerError(f"wait_motion: rate {rate} Hz: expected > 0", "invalid_argument")
+        period = 1.0 / rate
+        deadline = time.monotonic() + timeout
+        while True:
+            left = deadline - time.monotonic()
+            update = self._s.wait_motion(period, max(0.0, min(left, _SLICE)))
+            if (update.snapshot is not None or update.sent or left <= _SLICE
+                    or self._s.stopped):
+                return update
 
     def events(self) -> List[Event]:
         """The driver's events (transitions with a severity: link, control mode, re-arm,

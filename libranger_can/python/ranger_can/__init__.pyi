@@ -6,7 +6,8 @@ from ._errors import RangerError as RangerError, RequestFailed as RequestFailed
 from ._errors import RequestTimeout as RequestTimeout
 from ._ranger_can import (Battery as Battery, Event as Event, event_kinds as event_kinds, FrameCount as FrameCount, GroundTruth as GroundTruth,
                           Identification as Identification, Joints as Joints, Lights as Lights,
-                          Motor as Motor, Odometry as Odometry, ParameterRow as ParameterRow,
+                          Motor as Motor, MotionUpdate as MotionUpdate,
+                          Odometry as Odometry, ParameterRow as ParameterRow,
                           RemoteState as RemoteState, RequestOutcome as RequestOutcome,
                           SentMotion as SentMotion, Snapshot as Snapshot,
                           UltrasonicReading as UltrasonicReading, __version__ as __version__,
@@ -44,6 +45,7 @@ class Driver:
     def wait_until(self, predicate: Callable[[Snapshot], bool],
                    timeout: float = ...) -> Snapshot: ...
     def wait_ready(self, timeout: float = ...) -> Snapshot: ...
+    def wait_motion(self, rate: float = ..., timeout: float = ...) -> MotionUpdate: ...
     def events(self) -> List[Event]: ...
     def command(self, vx: float = ..., vy: float = ..., wz: float = ...,
                 mode: Optional[str] = ...) -> None: ...

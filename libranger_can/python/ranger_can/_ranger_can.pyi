@@ -77,6 +77,15 @@ class GroundTruth:
 class SentMotion:
     vx: float; vy: float; wz: float; wall: float; shutdown: bool
 
+class MotionUpdate:
+    snapshot: Optional[Snapshot]  # None: nothing new (timeout, close, only frames sent)
+    # (sec, nanosec, x, y, qz, qw, vx, vy, wz, var_x, var_y, var_yaw); None when not new
+    odometry: Optional[Tuple[int, int, float, float, float, float, float, float, float, float,
+                             float, float]]
+    # (sec, nanosec, positions, velocities): steering joints 1-4, then wheels 1-4; None: not new
+    joints: Optional[Tuple[int, int, List[float], List[float]]]
+    sent: List[SentMotion]
+
 class ParameterRow:
     name: str; type: str; unit: str; lo: float; hi: float; lo_open: bool; hi_open: bool
     has_range: bool; default: str; choices: List[str]; meaning: str; group: str

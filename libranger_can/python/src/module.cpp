@@ -367,6 +367,27 @@ PYBIND11_MODULE(_ranger_can, m) {
       .def_property_readonly("wz", [](const SentMotion& s) { return s.achieved.wz; })
       .def_readonly("wall", &SentMotion::wall)
       .def_readonly("shutdown", &SentMotion::shutdown);
+  py::class_<MotionUpdate>(m, "MotionUpdate")
+      .def_property_readonly("snapshot",
+                             [](const MotionUpdate& u) -> std::optional<Snapshot> {
+                               if (!u.snapshot) return std::nullopt;
+                               return Snapshot(u.snapshot);
+                             })
+      .def_property_readonly("odometry",
+                             [](const MotionUpdate& u) -> std::optional<OdometryValues> {
+                               if (!u.odometry) return std::nullopt;
+                               return odometry_values(*u.snapshot);
+                             })
+      .def_property_readonly("joints",
+                             [](const MotionUpdate& u) -> std::optional<JointValues> {
+                               if (!u.joints) return std::nullopt;
+                               return joint_values(*u.snapshot);
+                             })
+      .def_readonly("sent", &MotionUpdate::sent)
+      .def("__repr__", [](const MotionUpdate& u) {
+        return std::string("MotionUpdate(") + (u.odometry ? "odometry " : "") +
+               (u.joints ? "joints " : "") + std::to_string(u.sent.size()) + " sent)";
+      });
   py::class_<ParameterRow>(m, "ParameterRow")
       .def_readonly("name", &ParameterRow::name)
       .def_readonly("type", &ParameterRow::type)
@@ -641,6 +662,14 @@ PYBIND11_MODULE(_ranger_can, m) {
             return py::make_tuple(out, missed);
           },
           py::arg("after"))
+      .def(
+          "wait_motion",
+          [](PySession& p, double period, double timeout) {
+            if (!(period > 0.0)) invalid("wait_motion: the period must be > 0 s");
+            py::gil_scoped_release release;
+            return p.s().wait_motion(to_ns(period), to_ns(timeout));
+          },
+          py::arg("period"), py::arg("timeout"))
       .def("take_sent", [](PySession& p) { return p.s().take_sent(); })
       .def(
           "wait_sent",

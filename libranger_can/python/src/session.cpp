@@ -5,6 +5,8 @@
 #include "ranger_can/sim/chassis_commands.hpp"
 #include "ranger_can/text.hpp"
 
+#include "views.hpp"
+
 namespace ranger::python {
 namespace {
 
@@ -57,14 +59,23 @@ void Session::stop() {
   stopped_ = true;
   driver_->stop();
   changed_.notify_all();
+  motion_.notify_all();
 }
 
 void Session::on_step(const std::shared_ptr<const DriverSnapshot>& s) {
+  const Timestamp estimate = std::max(s->odometry.stamp, joints_stamp(*s));
+  bool advanced = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     sequence_ = s->sequence;
+    if (estimate > estimate_stamp_) {
+      estimate_stamp_ = estimate;
+      ++estimates_;
+      advanced = true;
+    }
   }
   changed_.notify_all();
+  if (advanced) motion_.notify_all();
 }
 
 void Session::on_sent(const SentEvent& e) {
@@ -79,6 +90,7 @@ void Session::on_sent(const SentEvent& e) {
                                e.sent.shutdown});
   }
   changed_.notify_all();
+  motion_.notify_all();
 }
 
 std::shared_ptr<const DriverSnapshot> Session::wait_snapshot(std::uint64_t sequence,
@@ -103,6 +115,47 @@ std::vector<SentMotion> Session::wait_sent(std::chrono::nanoseconds timeout) {
     changed_.wait_for(lock, timeout, [&] { return !sent_.empty() || stopped_; });
   }
   return take_sent();
+}
+
+MotionUpdate Session::wait_motion(std::chrono::nanoseconds period,
+                                  std::chrono::nanoseconds timeout) {
+  using Clock = std::chrono::steady_clock;
+  const auto early = std::min<Clock::duration>(std::chrono::milliseconds(5), period / 4);
+  const auto deadline = Clock::now() + timeout;
+  MotionUpdate out;
+  std::unique_lock<std::mutex> lock(mutex_);
+  while (!stopped_) {
+    out.sent.assign(sent_.begin(), sent_.end());
+    sent_.clear();
+    const auto now = Clock::now();
+    bool waiting = false;  // due, and the latest snapshot has nothing new: the next estimate
+    if (now >= motion_due_ - early) {
+      auto s = driver_->snapshot();
+      const Timestamp joints = joints_stamp(*s);
+      out.odometry = s->motion_known && s->odometry.stamp > published_odometry_;
+      out.joints = s->motion_known && (s->joints.has_steering || s->joints.has_wheels) &&
+                   joints > published_joints_;
+      if (out.odometry || out.joints || !s->motion_known) {  // published, or nothing to wait for
+        motion_due_ += period;
+        if (motion_due_ < now) motion_due_ = now + period;
+      }
+      if (out.odometry || out.joints) {
+        published_odometry_ = std::max(published_odometry_, s->odometry.stamp);
+        published_joints_ = std::max(published_joints_, joints);
+        out.snapshot = std::move(s);
+        return out;
+      }
+      waiting = s->motion_known;
+    }
+    if (!out.sent.empty() || now >= deadline) return out;
+    const std::uint64_t estimates = estimates_;
+    motion_.wait_until(lock, waiting ? deadline : std::min(deadline, motion_due_ - early), [&] {
+      return stopped_ || !sent_.empty() || (waiting && estimates_ != estimates);
+    });
+  }
+  out.sent.assign(sent_.begin(), sent_.end());
+  sent_.clear();
+  return out;
 }
 
 bool Session::stop_sent() const {

@@ -1,6 +1,7 @@
 #include "views.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "ranger_can/control/geometry.hpp"
 #include "ranger_can/sim/virtual_chassis.hpp"
@@ -67,6 +68,51 @@ OdometryView odometry_view(const DriverSnapshot& s) {
   return v;
 }
 
+Timestamp joints_stamp(const DriverSnapshot& s) {
+  Timestamp stamp{0};
+  if (s.feedback.steering_angles) stamp = std::max(stamp, s.feedback.steering_angles->stamp);
+  if (s.feedback.wheel_speeds) stamp = std::max(stamp, s.feedback.wheel_speeds->stamp);
+  return stamp;
+}
+
+namespace {
+std::pair<std::int64_t, std::uint32_t> split(Timestamp t) {
+  const std::int64_t n = ns(t);
+  const std::int64_t sec = n >= 0 ? n / 1'000'000'000 : (n - 999'999'999) / 1'000'000'000;
+  return {sec, static_cast<std::uint32_t>(n - sec * 1'000'000'000)};
+}
+}  // namespace
+
+OdometryValues odometry_values(const DriverSnapshot& s) {
+  const OdometryState& o = s.odometry;
+  const auto [sec, nanosec] = split(o.stamp);
+  return {sec,
+          nanosec,
+          o.pose.x,
+          o.pose.y,
+          std::sin(o.pose.yaw / 2.0),
+          std::cos(o.pose.yaw / 2.0),
+          o.twist.vx,
+          o.twist.vy,
+          o.twist.wz,
+          o.pose_variance[0],
+          o.pose_variance[1],
+          o.pose_variance[2]};
+}
+
+JointValues joint_values(const DriverSnapshot& s) {
+  const WheelJoints& j = s.joints;
+  const auto [sec, nanosec] = split(joints_stamp(s));
+  JointValues out{sec, nanosec, {}, {}};
+  for (std::size_t w = 0; w < static_cast<std::size_t>(kWheelCount); ++w) {
+    std::get<2>(out)[w] = j.steering_position[w];
+    std::get<3>(out)[w] = j.steering_velocity[w];
+    std::get<2>(out)[w + kWheelCount] = j.wheel_position[w];
+    std::get<3>(out)[w + kWheelCount] = j.wheel_velocity[w];
+  }
+  return out;
+}
+
 JointsView joints_view(const DriverSnapshot& s) {
   const WheelJoints& j = s.joints;
   JointsView v;
@@ -78,10 +124,7 @@ JointsView joints_view(const DriverSnapshot& s) {
   v.wheel_velocity = values(j.wheel_velocity);
   v.has_steering = j.has_steering;
   v.has_wheels = j.has_wheels;
-  Timestamp stamp{0};
-  if (s.feedback.steering_angles) stamp = std::max(stamp, s.feedback.steering_angles->stamp);
-  if (s.feedback.wheel_speeds) stamp = std::max(stamp, s.feedback.wheel_speeds->stamp);
-  v.stamp_ns = ns(stamp);
+  v.stamp_ns = ns(joints_stamp(s));
   return v;
 }
 
