@@ -22,8 +22,8 @@ namespace {
 using namespace std::chrono_literals;
 
 void print_pose(const ranger::DriverSnapshot& s, const char* label) {
-  std::printf("%-10s x=%+.3f m  y=%+.3f m  yaw=%+.2f deg  refusal=%s\n", label,
-              s.odometry.pose.x, s.odometry.pose.y, s.odometry.pose.yaw * 180.0 / M_PI,
+  std::printf("%-10s x=%+.3f m  y=%+.3f m  yaw=%+.2f deg  refusal=%s\n", label, s.odometry.pose.x,
+              s.odometry.pose.y, ranger::rad_to_deg(s.odometry.pose.yaw),
               std::string(ranger::to_string(s.controller.refusal)).c_str());
 }
 

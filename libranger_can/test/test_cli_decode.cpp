@@ -15,7 +15,7 @@
 
 #include "cli_commands.hpp"
 #include "cli_input.hpp"
-#include "cli_json.hpp"
+#include "ranger_can/json.hpp"
 #include "ranger_can/wire/protocol.hpp"
 #include "support/cli_run.hpp"
 

@@ -10,6 +10,7 @@
 
 #include "cli_commands.hpp"
 #include "cli_options.hpp"
+#include "ranger_can/parse.hpp"
 #include "support/cli_run.hpp"
 
 namespace ranger::cli {
@@ -197,6 +198,10 @@ std::optional<std::string> valid_value(const OptionSpec& o) {
       return o.rule.choices.front();
     case ValueRule::Kind::kCustom:
       return std::nullopt;
+    case ValueRule::Kind::kParameter: {  // the node's default
+      const ParameterValue& d = o.rule.parameter->default_value;
+      return d.kind == ParameterValue::Kind::kText ? d.text : number_text(*d.as_number());
+    }
   }
   return std::nullopt;
 }

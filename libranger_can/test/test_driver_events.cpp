@@ -86,20 +86,11 @@ struct Ready {
 
 // ---- names, words, the ring -------------------------------------------------------------------
 
-template <typename Enum, std::size_t N>
-void expect_all_named(const Enum (&all)[N]) {
-  std::vector<std::string> names;
-  for (int i = 0; i < 256; ++i) {
-    const std::string_view name = to_string(static_cast<Enum>(i));
-    if (name == "unknown") break;
-    names.emplace_back(name);
-  }
-  EXPECT_EQ(names, text::names_of(all));
-}
-
+// Every kind and severity is in its name table: EnumNames.EveryTableHoldsEveryEnumerator
+// (test_text.cpp) checks every enum's table.
 TEST(DriverEventNames, EveryKindAndSeverityHasItsName) {
-  expect_all_named(kAllEventKinds);
-  expect_all_named(kAllSeverities);
+  EXPECT_EQ(kEventKindNames.parse("link_silent"), EventKind::kLinkSilent);
+  EXPECT_EQ(kSeverityNames.names(), (std::vector<std::string>{"debug", "info", "warn", "error"}));
   EXPECT_EQ(to_string(EventKind::kLinkSilent), "link_silent");
   EXPECT_EQ(to_string(Severity::kWarn), "warn");
 }

@@ -465,7 +465,7 @@ TEST(ProtocolFaults, TheTableHasOneRowPerMeaningAndOneBitPerRowAndLayout) {
     }
   }
   // Every fault of the enum has a row.
-  for (const Fault f : kAllFaults) {
+  for (const Fault f : kFaultNames.values()) {
     bool found = false;
     for (const FaultInfo& row : kFaultTable)
       found = found || row.fault == f;

@@ -109,45 +109,18 @@ TEST(ScenarioParse, EveryActionWithItsLineNumber) {
   EXPECT_EQ(s.expectations, 4u);
 }
 
-// The enumerators 0, 1, ... of a contiguous enum until to_string says "unknown" are exactly its
-// `all` list: an enumerator added without its name in the list fails here.
-template <typename Enum, std::size_t N>
-void expect_all_list_complete(const Enum (&all)[N], const char* what) {
-  std::vector<std::string> named;
-  for (int i = 0; i < 256; ++i) {
-    const std::string_view name = to_string(static_cast<Enum>(i));
-    if (name == "unknown") break;
-    named.emplace_back(name);
-  }
-  EXPECT_EQ(named, text::names_of(all)) << what;
-}
-
-TEST(EnumNames, EveryAllListHoldsEveryEnumerator) {
-  expect_all_list_complete(kAllMotionRefusals, "MotionRefusal");
-  expect_all_list_complete(kAllControllerFaults, "ControllerFault");
-  expect_all_list_complete(kAllLinkStates, "LinkState");
-  expect_all_list_complete(kAllIdentificationPhases, "IdentificationPhase");
-  expect_all_list_complete(protocol::kAllFaults, "Fault");
-  expect_all_list_complete(protocol::kAllMotionModes, "MotionMode");
-  expect_all_list_complete(protocol::kAllControlModes, "ControlMode");
-  expect_all_list_complete(protocol::kAllVehicleStatuses, "VehicleStatus");
-  expect_all_list_complete(protocol::kAllRemoteSwitches, "RemoteSwitch");
-  expect_all_list_complete(protocol::kAllLightModes, "LightMode");
-  expect_all_list_complete(protocol::kAllDirections, "Direction");
-}
-
-// Every name the driver can report, taken from the enums' `all` lists and the fault table (a new
+// Every name the driver can report, taken from the enums' name tables and the fault table (a new
 // enumerator or fault is covered without touching this test), is a valid `expect` value that
 // parses back to the same name.
 TEST(ScenarioParse, EveryNameOfTheEnumsAndTheFaultTableIsAccepted) {
   std::vector<std::pair<std::string, std::string>> checks;  // field, name
-  for (const auto& n : text::names_of(kAllMotionRefusals))
+  for (const auto& n : kMotionRefusalNames.names())
     checks.emplace_back("refusal", n);
-  for (const auto& n : text::names_of(protocol::kAllControlModes))
+  for (const auto& n : protocol::kControlModeNames.names())
     checks.emplace_back("control_mode", n);
-  for (const auto& n : text::names_of(protocol::kAllMotionModes))
+  for (const auto& n : protocol::kMotionModeNames.names())
     checks.emplace_back("motion_mode", n);
-  for (const auto& n : text::names_of(kAllControllerFaults))
+  for (const auto& n : kControllerFaultNames.names())
     checks.emplace_back("fault", n);
   for (const protocol::FaultInfo& f : protocol::kFaultTable)
     checks.emplace_back("fault", std::string(f.name));
@@ -456,6 +429,25 @@ TEST(ScenarioRun, TheSameScriptGivesTheSameBytes) {
   EXPECT_EQ(test::lines_of(out1.str()).size(), 6301u);
   EXPECT_EQ(out1.str(), out2.str());
   EXPECT_EQ(err1.str(), err2.str());
+}
+
+// The driver's events ride on the next sample as "events":[{...}] after its other fields; a sample
+// with none since the one before has no such field; an event after the last sample comes on a
+// line of its own, {"t":...,"events":[...]}.
+TEST(ScenarioRun, SamplesCarryTheDriverEventsSinceTheSampleBefore) {
+  const Scenario s = parse_ok("wait 2\nestop on\nwait 0.1\n");
+  ScenarioOptions o;
+  o.every = 500ms;
+  std::ostringstream out, err;
+  ASSERT_TRUE(run_scenario(s, o, out, err).ok());
+  const auto lines = test::lines_of(out.str());
+  ASSERT_EQ(lines.size(), 6u) << out.str();  // t = 0, 0.5, ... 2.0, then the e-stop's events
+  EXPECT_TRUE(contains(lines[0], "\"identification\":\"none\",\"events\":[{\"seq\":1,\"t\":0.000,"))
+      << lines[0];
+  EXPECT_EQ(lines[0].substr(lines[0].size() - 3), "}]}");
+  EXPECT_FALSE(contains(lines[4], "\"events\"")) << lines[4];  // nothing new by t = 2
+  EXPECT_EQ(lines[5].rfind("{\"t\":2.100,\"events\":[{\"seq\":", 0), 0u) << lines[5];
+  EXPECT_TRUE(contains(lines[5], "emergency")) << lines[5];
 }
 
 // ---- the sub-command ----------------------------------------------------------------------------

@@ -3,7 +3,6 @@
 #include <tf2/LinearMath/Quaternion.h>
 #include <tf2_geometry_msgs/tf2_geometry_msgs.h>
 
-#include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -15,18 +14,9 @@ namespace ranger_base {
 namespace {
 
 using ranger::Timestamp;
-namespace protocol = ranger::protocol;
 
-using Matrix6 = Eigen::Matrix<double, 6, 6>;
-using RowMajorMatrix6 = Eigen::Matrix<double, 6, 6, Eigen::RowMajor>;
-
-Matrix6 diagonal(const std::array<double, 6>& d) {
-  return Eigen::Map<const Eigen::Matrix<double, 6, 1>>(d.data()).asDiagonal();
-}
-
-// ROS covariance arrays are row-major 6x6.
-void store(const Matrix6& m, boost::array<double, 36>& out) {
-  Eigen::Map<RowMajorMatrix6>(out.data()) = m;
+void store(const ranger::Covariance& c, boost::array<double, 36>& out) {
+  std::copy(c.begin(), c.end(), out.begin());
 }
 
 geometry_msgs::Quaternion yaw_quaternion(double yaw) {
@@ -34,18 +24,6 @@ geometry_msgs::Quaternion yaw_quaternion(double yaw) {
   q.setRPY(0.0, 0.0, yaw);
   return tf2::toMsg(q);
 }
-
-// A BMS report older than this many of its periods counts as absent (an unfitted battery slot).
-constexpr int kStalePeriods = 3;
-
-template <typename T>
-bool fresh(const std::optional<ranger::Stamped<T>>& v, Timestamp now, int period_ms) {
-  return ranger::is_fresh(v, now, std::chrono::milliseconds(kStalePeriods * period_ms));
-}
-
-// The decoded ultrasonic value (codec.hpp's UltrasonicFeedback::raw) is in millimetres. The
-// library's control layer has no name for that unit yet: this is the node's one use of it.
-constexpr double kUltrasonicMetresPerUnit = 0.001;
 
 const float kNaN = std::numeric_limits<float>::quiet_NaN();
 
@@ -110,12 +88,8 @@ nav_msgs::Odometry to_odometry(const ranger::OdometryState& odometry,
   out.twist.twist.linear.y = odometry.twist.vy;
   out.twist.twist.angular.z = odometry.twist.wz;
 
-  Matrix6 pose = diagonal(params.pose_covariance_diagonal);
-  pose(0, 0) += odometry.pose_variance[0];
-  pose(1, 1) += odometry.pose_variance[1];
-  pose(5, 5) += odometry.pose_variance[2];
-  store(pose, out.pose.covariance);
-  store(diagonal(params.twist_covariance_diagonal), out.twist.covariance);
+  store(ranger::pose_covariance(odometry, params.pose_covariance_diagonal), out.pose.covariance);
+  store(ranger::diagonal_covariance(params.twist_covariance_diagonal), out.twist.covariance);
   return out;
 }
 
@@ -233,68 +207,34 @@ const std::map<std::string_view, BmsFlagField>& bms_flag_fields() {
 #undef RANGER_FIELD
 
 namespace {
+// Each named flag sets the message field of its name.
 template <typename Msg, typename Field>
-void fill_bits(std::uint32_t word, const std::vector<protocol::NamedBit>& bits,
-               const std::map<std::string_view, Field>& fields, Msg& out) {
-  for (const auto& bit : bits) {
-    const auto it = fields.find(bit.name);
-    if (it != fields.end()) out.*(it->second) = ((word >> bit.index) & 1u) != 0;
+Msg& fill(const std::vector<ranger::NamedFlag>& flags,
+          const std::map<std::string_view, Field>& fields, Msg& out) {
+  for (const ranger::NamedFlag& flag : flags) {
+    const auto it = fields.find(flag.name);
+    if (it != fields.end()) out.*(it->second) = flag.set;
   }
+  return out;
 }
 }  // namespace
 
 void fill_system_errors(std::uint32_t error_word, ranger::ErrorWordLayout layout,
                         ranger_msgs::SystemErrors& out) {
-  // By meaning: each fault-table row with a bit in this layout sets the field of its name.
-  const auto& fields = system_error_fields();
-  for (const protocol::FaultInfo& f : protocol::kFaultTable) {
-    const int bit = f.bit(layout);
-    const auto it = fields.find(f.name);
-    if (bit == protocol::kNoBit || it == fields.end()) continue;
-    out.*(it->second) = ((error_word >> bit) & 1u) != 0;
-  }
+  fill(ranger::fault_flags(error_word, layout), system_error_fields(), out);
 }
 
 ranger_msgs::DriverStatus to_driver_status(std::uint8_t status) {
   ranger_msgs::DriverStatus out;
-  fill_bits(status, protocol::driver_status_bits(), driver_status_fields(), out);
-  return out;
+  return fill(ranger::driver_status_flags(status), driver_status_fields(), out);
 }
 
 ranger_msgs::BmsFlags to_bms_flags(std::uint8_t status1, std::uint8_t status2) {
   ranger_msgs::BmsFlags out;
-  fill_bits(status1, protocol::bms_status1_bits(), bms_flag_fields(), out);
-  fill_bits(status2, protocol::bms_status2_bits(), bms_flag_fields(), out);
-  return out;
+  return fill(ranger::bms_flags(status1, status2), bms_flag_fields(), out);
 }
 
 // ---- chassis state ----------------------------------------------------------------------------
-
-std::vector<std::string> cause_names(ranger::StopCauses causes) {
-  std::vector<std::string> out;
-  const std::string all = ranger::describe(causes);  // "emergency_stop,remote"
-  std::size_t start = 0;
-  while (start < all.size()) {
-    const std::size_t comma = all.find(',', start);
-    const std::size_t end = comma == std::string::npos ? all.size() : comma;
-    out.push_back(all.substr(start, end - start));
-    start = end + 1;
-  }
-  return out;
-}
-
-bool listening(const ranger::ControllerState& c) {
-  return c.quiet && c.identifying.has_value();
-}
-
-std::string refusal_name(const ranger::ControllerState& c) {
-  if (c.refusal == ranger::MotionRefusal::kNone) return "";
-  return std::string(ranger::to_string(c.refusal));
-}
-
-std::string describe_refusal(const ranger::DriverSnapshot& snapshot) {
-  return ranger::describe_refusal(snapshot.controller, snapshot.identification.get());
-}
 
 ranger_msgs::SystemState to_system_state(const ranger::DriverSnapshot& snapshot,
                                          const ros::Time& stamp) {
@@ -306,9 +246,9 @@ ranger_msgs::SystemState to_system_state(const ranger::DriverSnapshot& snapshot,
   out.motion_known = snapshot.motion_known;
   if (const auto& s = feedback.system_status) {
     out.vehicle_status = s->value.vehicle_status_raw;
-    out.vehicle_status_name = std::string(protocol::to_string(s->value.vehicle_status));
+    out.vehicle_status_name = std::string(ranger::to_string(s->value.vehicle_status));
     out.control_mode = s->value.control_mode_raw;
-    out.control_mode_name = std::string(protocol::to_string(s->value.control_mode));
+    out.control_mode_name = std::string(ranger::to_string(s->value.control_mode));
     out.battery_voltage = static_cast<float>(s->value.battery_voltage);
   } else {
     out.vehicle_status_name = "unknown";
@@ -316,24 +256,24 @@ ranger_msgs::SystemState to_system_state(const ranger::DriverSnapshot& snapshot,
   }
   if (const auto& m = feedback.motion_mode) {
     out.motion_mode = m->value.mode_raw;
-    out.motion_mode_name = std::string(protocol::to_string(m->value.mode));
+    out.motion_mode_name = std::string(ranger::to_string(m->value.mode));
     out.motion_mode_switching = m->value.switching;
   } else {
     out.motion_mode_name = "unknown";
   }
   out.error_word = state.error_bits;
   fill_system_errors(state.error_bits, snapshot.profile.error_word, out.errors);
-  out.active_errors = protocol::error_bit_names(state.error_bits, snapshot.profile.error_word);
-  out.motion_inhibited_reason = refusal_name(state);
+  out.active_errors = ranger::fault_names(state.error_bits, snapshot.profile.error_word);
+  out.motion_inhibited_reason = ranger::refusal_name(state);
   out.protocol = std::string(ranger::to_string(snapshot.protocol));
   out.protocol_profile = ranger::describe(snapshot.profile);
   if (snapshot.identification) {
     out.identification = std::string(ranger::to_string(snapshot.identification->phase));
   }
-  out.motion_inhibited_detail = describe_refusal(snapshot);
+  out.motion_inhibited_detail = ranger::describe_refusal(snapshot);
   out.rearm_required = state.rearm_required();
-  out.latched_causes = cause_names(state.latched_causes);
-  out.active_causes = cause_names(state.active_causes);
+  out.latched_causes = ranger::cause_names(state.latched_causes);
+  out.active_causes = ranger::cause_names(state.active_causes);
   out.reclaim_blocked = state.reclaim_blocked;
   out.steer_first_factor = static_cast<float>(state.steer_first_factor);
   out.park_requested = state.park_requested;
@@ -347,10 +287,10 @@ ranger_msgs::RemoteState to_remote_state(const ranger::RemoteState& remote,
                                          const ros::Time& stamp) {
   ranger_msgs::RemoteState out;
   out.header.stamp = stamp;
-  out.swa = std::string(protocol::to_string(remote.swa));
-  out.swb = std::string(protocol::to_string(remote.swb));
-  out.swc = std::string(protocol::to_string(remote.swc));
-  out.swd = std::string(protocol::to_string(remote.swd));
+  out.swa = std::string(ranger::to_string(remote.swa));
+  out.swb = std::string(ranger::to_string(remote.swb));
+  out.swc = std::string(ranger::to_string(remote.swc));
+  out.swd = std::string(ranger::to_string(remote.swd));
   out.left_vertical = static_cast<float>(remote.left_vertical);
   out.left_horizontal = static_cast<float>(remote.left_horizontal);
   out.right_vertical = static_cast<float>(remote.right_vertical);
@@ -364,7 +304,7 @@ ranger::Result<ranger::LightsRequest> to_lights_request(const ranger_msgs::SetLi
   const struct {
     const char* name;
     std::uint8_t mode, brightness;
-    protocol::LightMode* out_mode;
+    ranger::LightMode* out_mode;
     std::uint8_t* out_brightness;
   } lights[] = {{"front", r.front_mode, r.front_brightness, &out.front, &out.front_brightness},
                 {"rear", r.rear_mode, r.rear_brightness, &out.rear, &out.rear_brightness}};
@@ -379,7 +319,7 @@ ranger::Result<ranger::LightsRequest> to_lights_request(const ranger_msgs::SetLi
           ranger::Errc::kInvalidArgument,
           std::string(l.name) + "_brightness " + std::to_string(l.brightness) + " is above 100"};
     }
-    *l.out_mode = static_cast<protocol::LightMode>(l.mode);
+    *l.out_mode = static_cast<ranger::LightMode>(l.mode);
     *l.out_brightness = l.mode == ranger_msgs::SetLights::Request::CUSTOM ? l.brightness : 0;
   }
   return out;
@@ -399,7 +339,7 @@ ranger_msgs::ActuatorStateArray to_actuator_state(const ranger::ChassisFeedback&
                                                   const ros::Time& stamp) {
   ranger_msgs::ActuatorStateArray out;
   out.header.stamp = stamp;
-  for (int motor = 1; motor <= protocol::kMotorCount; ++motor) {
+  for (int motor = 1; motor <= ranger::kMotorCount; ++motor) {
     const auto i = static_cast<std::size_t>(motor - 1);
     ranger_msgs::ActuatorState a;
     a.motor = static_cast<std::uint8_t>(motor);
@@ -427,12 +367,12 @@ ranger_msgs::BmsStateArray to_bms_state(const ranger::ChassisFeedback& feedback,
                                         const ros::Time& stamp) {
   ranger_msgs::BmsStateArray out;
   out.header.stamp = stamp;
-  for (int b = 0; b <= protocol::kBatteryCount; ++b) {
+  for (int b = 0; b <= ranger::kBatteryCount; ++b) {
     const auto i = static_cast<std::size_t>(b);
     ranger_msgs::BmsState s;
     s.battery = static_cast<std::uint8_t>(b);
     const auto& data = feedback.bms[i];
-    s.present = fresh(data, now, protocol::frame_period_ms(protocol::kBmsBaseId));
+    s.present = ranger::bms_present(feedback, b, now);
     if (data) {
       s.header.stamp = to_ros_time(data->stamp);
       s.soc = static_cast<float>(data->value.soc);
@@ -468,7 +408,7 @@ sensor_msgs::BatteryState to_battery_state(const ranger::ChassisFeedback& fb, Ti
   out.location = "pack";
 
   const auto& pack = fb.bms[0];
-  if (fresh(pack, now, protocol::frame_period_ms(protocol::kBmsBaseId))) {
+  if (ranger::bms_present(fb, 0, now)) {
     out.header.stamp = to_ros_time(pack->stamp);
     out.present = true;
     out.voltage = static_cast<float>(pack->value.voltage);
@@ -501,9 +441,9 @@ sensor_msgs::BatteryState to_battery_state(const ranger::ChassisFeedback& fb, Ti
     out.present = true;  // the chassis runs, so it has a battery; the BMS is not reporting
     out.voltage = static_cast<float>(status->value.battery_voltage);
   }
-  for (int b = 1; b <= protocol::kBatteryCount; ++b) {
+  for (int b = 1; b <= ranger::kBatteryCount; ++b) {
     const auto& slot = fb.bms[static_cast<std::size_t>(b)];
-    const bool present = fresh(slot, now, protocol::frame_period_ms(protocol::kBmsBaseId));
+    const bool present = ranger::bms_present(fb, b, now);
     out.cell_voltage.push_back(present ? static_cast<float>(slot->value.voltage) : kNaN);
     out.cell_temperature.push_back(present ? static_cast<float>(slot->value.temperature) : kNaN);
   }
@@ -515,9 +455,7 @@ std::string ultrasonic_frame_id(const std::string& frame_prefix, int sensor) {
 }
 
 float ultrasonic_range_m(std::int16_t raw) {
-  // Whatever the library does not call "ok" (no reading, an error code) is no distance.
-  if (protocol::ultrasonic_status_name(raw) != "ok") return kNaN;
-  return static_cast<float>(raw * kUltrasonicMetresPerUnit);
+  return static_cast<float>(ranger::ultrasonic_range(raw));
 }
 
 sensor_msgs::Range to_range(int sensor, std::int16_t raw, const NodeParameters& params,
@@ -551,7 +489,7 @@ ranger_msgs::UltrasonicState to_ultrasonic_state(const ranger::DriverSnapshot& s
       r.sensor = static_cast<std::uint8_t>(group->value.first_sensor + k);
       r.raw = group->value.raw[static_cast<std::size_t>(k)];
       r.range = ultrasonic_range_m(r.raw);
-      r.status = std::string(protocol::ultrasonic_status_name(r.raw));
+      r.status = std::string(ranger::ultrasonic_status(r.raw));
       out.sensors.push_back(r);
     }
   }

@@ -30,7 +30,6 @@
 namespace ranger_base {
 namespace {
 
-namespace protocol = ranger::protocol;
 using std::chrono::nanoseconds;
 using Kind = ranger::RequestOutcome::Kind;
 using State = ranger::RequestOutcome::State;
@@ -113,7 +112,7 @@ ranger::Result<std::unique_ptr<RangerNode>> RangerNode::create(const ros::NodeHa
 ranger::Result<std::unique_ptr<RangerNode>> RangerNode::from_parameters(
     const ros::NodeHandle& nh, const ros::NodeHandle& private_nh) {
   const NodeHandleParameterSource source(private_nh);
-  for (const auto& name : unknown_parameter_names(source)) {
+  for (const auto& name : ranger::unknown_parameter_names(source, kAlsoRead)) {
     ROS_WARN("unknown parameter %s ignored (see ranger_base/README.md for the names)",
              source.display_name(name).c_str());
   }
@@ -157,10 +156,9 @@ RangerNode::RangerNode(const ros::NodeHandle& nh, const ros::NodeHandle& private
 
   if (params_.publish_odom_tf) tf_pub_ = nh_.advertise<tf2_msgs::TFMessage>("/tf", 100);
 
-  updater_.setHardwareID(hardware_id(nh_.getNamespace(), params_.port_name));
   diagnostics_ = std::make_unique<ChassisDiagnostics>(
       updater_, [this] { return driver_->snapshot(); },
-      ProtocolContext{params_.protocol.source, params_.port_name});
+      ranger::DiagnosticContext{params_.port_name, params_.protocol.source, nh_.getNamespace()});
   // Both observers run on the driver thread: they queue, or wake the publication thread, and
   // return (publication never runs on the thread that owns the 0x111 keep-alive).
   // The send's wall time is read only for cmd_vel_out.
@@ -336,12 +334,11 @@ bool RangerNode::on_clear_errors(ranger_msgs::ClearErrors::Request& req,
   }
   const auto outcome = wait_for(*posted, Kind::kClearErrors);
   const std::string asked = "clear_errors code " + std::to_string(req.code) + " (" +
-                            protocol::error_clear_description(req.code) + ")";
+                            ranger::error_clear_description(req.code) + ")";
   if (outcome.state == State::kAnswered && outcome.error_word) {
     res.success = true;
     res.error_word = *outcome.error_word;
-    const auto names =
-        protocol::error_bit_names(res.error_word, driver_->snapshot()->profile.error_word);
+    const auto names = ranger::fault_names(res.error_word, driver_->snapshot()->profile.error_word);
     res.message = asked + ": the chassis answered with error word " +
                   ranger::text::hex(res.error_word, 8) +
                   (names.empty() ? " (no errors)" : " (" + join(names) + ")");
@@ -377,7 +374,7 @@ bool RangerNode::on_set_ultrasonic(ranger_msgs::SetUltrasonic::Request& req,
 bool RangerNode::on_set_motion_mode(ranger_msgs::SetMotionMode::Request& req,
                                     ranger_msgs::SetMotionMode::Response& res) {
   using Req = ranger_msgs::SetMotionMode::Request;
-  using M = protocol::MotionMode;
+  using M = ranger::MotionMode;
   static const std::map<std::uint8_t, std::optional<M>> kModes = {{Req::ACKERMANN, M::kAckermann},
                                                                   {Req::OBLIQUE, M::kOblique},
                                                                   {Req::SPIN, M::kSpin},
@@ -394,18 +391,18 @@ bool RangerNode::on_set_motion_mode(ranger_msgs::SetMotionMode::Request& req,
   const std::optional<M> mode = known->second;
   if (mode) {
     const auto s = driver_->snapshot();
-    if (!protocol::motion_mode_to_wire(*mode, s->profile.mode_numbering)) {
+    if (!ranger::can_drive_in(*mode, s->profile)) {
       res.success = false;
-      res.message = std::string(protocol::to_string(*mode)) + ": unsupported by protocol " +
+      res.message = std::string(ranger::to_string(*mode)) + ": unsupported by protocol " +
                     s->profile.revision + " (its motion-mode numbering has no " +
-                    std::string(protocol::to_string(*mode)) + " mode; side slip is the MINI V1's)";
+                    std::string(ranger::to_string(*mode)) + " mode; side slip is the MINI V1's)";
       ROS_WARN("set_motion_mode: %s", res.message.c_str());
       return true;
     }
   }
   driver_->set_motion_mode(mode);
   res.success = true;
-  res.message = mode ? "motion mode pinned to " + std::string(protocol::to_string(*mode)) +
+  res.message = mode ? "motion mode pinned to " + std::string(ranger::to_string(*mode)) +
                            " (the switch happens at standstill)"
                      : "automatic motion-mode selection";
   return true;

@@ -1028,9 +1028,9 @@ class FaultBits : public Faults {
   static std::string diagnostic_value(const std::string& key) {
     std::lock_guard<std::mutex> lock(commands_mutex_);
     for (const auto& [name, status] : diagnostics_) {
-      if (name.size() < std::strlen(ranger_base::kDiagErrors) ||
-          name.compare(name.size() - std::strlen(ranger_base::kDiagErrors), std::string::npos,
-                       ranger_base::kDiagErrors) != 0) {
+      const std::string errors(ranger::kDiagErrors);
+      if (name.size() < errors.size() ||
+          name.compare(name.size() - errors.size(), std::string::npos, errors) != 0) {
         continue;
       }
       for (const auto& kv : status.values) {

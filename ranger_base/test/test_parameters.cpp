@@ -5,11 +5,13 @@
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <string>
 
 #include "ranger_base/parameters.hpp"
 
+#include <ranger_can/control/diagnostics.hpp>
 #include <ranger_can/control/parameters.hpp>
 
 namespace ranger_base {
@@ -146,9 +148,9 @@ TEST(Parameters, PortNamesAreWhatTheBusFactoryAccepts) {
 }
 
 TEST(Parameters, HardwareIdNamesTheRobot) {
-  EXPECT_EQ(hardware_id("/robot1", "sim"), "ranger:/robot1:sim");
-  EXPECT_NE(hardware_id("/robot1", "sim"), hardware_id("/robot2", "sim"));
-  EXPECT_EQ(hardware_id("/", "can0"), "ranger:/:can0");
+  EXPECT_EQ(ranger::hardware_id("/robot1", "sim"), "ranger:/robot1:sim");
+  EXPECT_NE(ranger::hardware_id("/robot1", "sim"), ranger::hardware_id("/robot2", "sim"));
+  EXPECT_EQ(ranger::hardware_id("/", "can0"), "ranger:/:can0");
 }
 
 TEST(Parameters, ValuesAreReadIntoTheLibraryConfigs) {
@@ -212,14 +214,13 @@ TEST_P(RejectsBadValue, NamingTheParameterAndTheValidRange) {
 INSTANTIATE_TEST_SUITE_P(
     Parameters, RejectsBadValue,
     ::testing::Values(
-        BadValue{"publish_rate", -5.0, "(0, 50] Hz"},
-        BadValue{"publish_rate", 0.0, "(0, 50] Hz"},
+        BadValue{"publish_rate", -5.0, "(0, 50] Hz"}, BadValue{"publish_rate", 0.0, "(0, 50] Hz"},
         BadValue{"publish_rate", 100.0, "(0, 50] Hz"},
         BadValue{"publish_rate", "fast", "expected a number"},
         BadValue{"cmd_vel_timeout", 0.0, "[0.02, 60] s"},
         BadValue{"cmd_vel_timeout", std::numeric_limits<double>::quiet_NaN(), "[0.02, 60] s"},
         BadValue{"wheelbase", -0.89, "(0, 10] m"}, BadValue{"track", 0.0, "(0, 10] m"},
-        BadValue{"max_linear_speed", 3.0, "not in (0, 2.6"},
+        BadValue{"max_linear_speed", 3.0, "(0, 2.6] m/s"},
         BadValue{"max_ackermann_steering", 1.0, "40 deg"},
         BadValue{"max_spin_wheel_speed", 1.5, "(0, 1] m/s"},
         BadValue{"model", "ranger_maxi", "ranger_mini_v1, ranger_mini_v2"},
@@ -468,7 +469,9 @@ TEST(Parameters, EveryParameterIsDocumentedInTheReadme) {
 }
 
 // The library's parameter table is the one source of names, ranges and defaults: the node reads
-// every row (defaults included), and the README's rows are the table's, character for character.
+// every row (the driver's defaults included), each parameter row of the README is a row of the
+// table character for character and every row is in the README, and a bad value is reported with
+// the table's range.
 TEST(Parameters, TheLibrarysTableIsWhatTheNodeReadsAndTheReadmeShows) {
   MapParameterSource empty;
   const auto p = load_parameters(empty);
@@ -476,15 +479,29 @@ TEST(Parameters, TheLibrarysTableIsWhatTheNodeReadsAndTheReadmeShows) {
   const auto& known = known_parameter_names();
   std::ifstream in(std::string(RANGER_BASE_SOURCE_DIR) + "/README.md");
   ASSERT_TRUE(in) << "README.md not found";
-  std::stringstream text;
-  text << in.rdbuf();
-  for (const ranger::DriverParameter& row : ranger::driver_parameters()) {
+  std::set<std::string> readme_rows;
+  bool in_parameters = false;
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("## ", 0) == 0) in_parameters = line.rfind("## Parameters", 0) == 0;
+    if (in_parameters && line.rfind("| `", 0) == 0) readme_rows.insert(line);
+  }
+  std::set<std::string> table_rows;
+  for (const ranger::Parameter& row : ranger::node_parameters()) {
     const std::string name(row.name);
     EXPECT_NE(std::find(known.begin(), known.end(), name), known.end()) << name;
-    EXPECT_EQ(row.get(p->driver), ranger::default_value(row)) << name;
-    EXPECT_NE(text.str().find(ranger::markdown_row(row) + "\n"), std::string::npos)
+    table_rows.insert(ranger::markdown_row(row));
+    EXPECT_EQ(readme_rows.count(ranger::markdown_row(row)), 1u)
         << "ranger_base/README.md should have the row\n"
         << ranger::markdown_row(row);
+  }
+  for (const std::string& line : readme_rows) {
+    EXPECT_EQ(table_rows.count(line), 1u)
+        << "ranger_base/README.md has a parameter row that is not the table's:\n"
+        << line;
+  }
+  for (const ranger::DriverParameter& row : ranger::driver_parameters()) {
+    const std::string name(row.name);
+    EXPECT_EQ(row.get(p->driver), ranger::default_value(row)) << name;
     // Out of range: the node names the parameter and the table's range.
     MapParameterSource bad;
     bad.values[name] = row.type == ranger::ParameterType::kBool ? XmlRpcValue(3.0)

@@ -640,11 +640,14 @@ def pip_install_in_ros2_stage(session, cmd, match):
 
 def ros2_workspace_build(session, cmd, match):
     """The ROS 2 workspace build: verified, not run here: the ros2 stage runs the same colcon
-    command in a workspace whose src/ranger_ros is this checkout, then sources its setup.bash."""
+    command in a workspace whose src/ranger_ros is this checkout, then sources its setup.bash
+    (scripts/ros2_env.sh) for the tests."""
     script = read("scripts/test_ros2.sh")
     assert 'ln -sfn "$root" "$ws/src/ranger_ros"' in script
     assert "build --paths src/ranger_ros/ros2/*" in script
-    assert 'source "$ws/install/setup.bash"' in script
+    assert "ws=$root/build/ros2_ws" in script
+    assert "source scripts/ros2_env.sh" in script  # the tests run in that workspace's setup
+    assert 'source "$ranger_root/build/ros2_ws/install/setup.bash"' in read("scripts/ros2_env.sh")
 
 
 def ros2_launch_checked(session, cmd, match):

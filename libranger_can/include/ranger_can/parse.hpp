@@ -8,6 +8,7 @@
 #include <string_view>
 
 #include "ranger_can/result.hpp"
+#include "ranger_can/text.hpp"
 
 namespace ranger {
 
@@ -19,7 +20,7 @@ Result<double> parse_double_in(std::string_view what, const std::string& text, d
 Result<std::int64_t> parse_integer(std::string_view what, const std::string& text, std::int64_t min,
                                    std::int64_t max);
 
-// A number as help texts show defaults and ranges: "%g" ("0.89", "90", "1e-05").
-std::string number_text(double v);
+// A number as help texts show defaults and ranges (text.hpp).
+using text::number_text;
 
 }  // namespace ranger

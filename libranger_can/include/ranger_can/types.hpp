@@ -1,6 +1,6 @@
 // Shared value types and the few helpers every layer uses: time stamps, a planar body twist and
-// pose (REP-103 / REP-105), one wheel's state, angle wrapping and duration conversion. Nothing
-// here knows the protocol; every layer (wire, transport, control, sim) may include it.
+// pose (REP-103 / REP-105), one wheel's state, degrees, angle wrapping and duration conversion.
+// Nothing here knows the protocol; every layer (wire, transport, control, sim) may include it.
 #pragma once
 
 #include <array>
@@ -21,6 +21,16 @@ inline double seconds(std::chrono::nanoseconds d) {
 // Seconds (double) to a duration, rounded to the nearest nanosecond.
 inline std::chrono::nanoseconds from_seconds(double s) {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::duration<double>(s));
+}
+
+// One degree in radians: the one conversion between the degrees people read and type and the
+// radians everything inside uses.
+inline constexpr double kRadPerDeg = M_PI / 180.0;
+constexpr double deg_to_rad(double deg) {
+  return deg * kRadPerDeg;
+}
+constexpr double rad_to_deg(double rad) {
+  return rad / kRadPerDeg;
 }
 
 // Wraps an angle (rad) to (-pi, pi].

@@ -19,6 +19,7 @@
 #include "ranger_can/control/rearm.hpp"
 #include "ranger_can/sim/chassis_commands.hpp"
 #include "ranger_can/sim/sim_bus_source.hpp"
+#include "ranger_can/text.hpp"
 #include "ranger_can/wire/profile.hpp"
 #include "ranger_can/wire/protocol.hpp"
 
@@ -88,38 +89,16 @@ std::chrono::nanoseconds to_ns(double s) {
   return from_seconds(std::min(s, 1e6));
 }
 
-template <typename E, std::size_t N>
-std::optional<E> parse_name(const std::string& text, const E (&all)[N]) {
-  for (E e : all) {
-    if (to_string(e) == text) return e;
-  }
-  return std::nullopt;
-}
-
-template <typename E, std::size_t N>
-std::vector<std::string> all_names(const E (&all)[N]) {
-  std::vector<std::string> out;
-  for (E e : all)
-    out.emplace_back(to_string(e));
-  return out;
-}
-
 protocol::MotionMode parse_mode(const std::string& text) {
-  using namespace protocol;
-  if (auto m = parse_name(text, kAllMotionModes)) return *m;
-  std::string valid;
-  for (const auto& n : all_names(kAllMotionModes))
-    valid += (valid.empty() ? "" : ", ") + n;
-  invalid("motion mode \"" + text + "\" unknown: one of " + valid);
+  if (auto m = protocol::kMotionModeNames.parse(text)) return *m;
+  invalid("motion mode \"" + text + "\" unknown: one of " +
+          text::join(protocol::kMotionModeNames.names()));
 }
 
 protocol::LightMode parse_light(const std::string& text) {
-  using namespace protocol;
-  if (auto m = parse_name(text, kAllLightModes)) return *m;
-  std::string valid;
-  for (const auto& n : all_names(kAllLightModes))
-    valid += (valid.empty() ? "" : ", ") + n;
-  invalid("light mode \"" + text + "\" unknown: one of " + valid);
+  if (auto m = protocol::kLightModeNames.parse(text)) return *m;
+  invalid("light mode \"" + text + "\" unknown: one of " +
+          text::join(protocol::kLightModeNames.names()));
 }
 
 template <typename T>
@@ -130,8 +109,8 @@ std::optional<std::string> name_of(const std::optional<T>& v) {
 
 std::vector<std::string> cause_names(StopCauses causes) {
   std::vector<std::string> out;
-  for (std::uint32_t bit = 1; bit != 0 && bit <= causes; bit <<= 1) {
-    if (causes & bit) out.emplace_back(to_string(static_cast<StopCause>(bit)));
+  for (const auto& [cause, name] : kStopCauseNames) {
+    if (has(causes, cause)) out.emplace_back(name);
   }
   return out;
 }
@@ -178,10 +157,8 @@ class PySession {
   // How long a request of `kind` may take before a front end gives up waiting: the driver's
   // own answer budget for it.
   double budget(const std::string& kind) {
-    using K = RequestOutcome::Kind;
-    for (K k : {K::kClearErrors, K::kUltrasonic, K::kResume, K::kLights, K::kPark,
-                K::kFirmwareVersion}) {
-      if (to_string(k) == kind) return seconds(s_->driver().answer_budget(k));
+    if (const auto k = kRequestKindNames.parse(kind)) {
+      return seconds(s_->driver().answer_budget(*k));
     }
     invalid("request kind \"" + kind + "\" unknown");
   }
@@ -689,10 +666,10 @@ PYBIND11_MODULE(_ranger_can, m) {
       out.push_back(n);
     return out;
   });
-  m.def("motion_modes", [] { return all_names(protocol::kAllMotionModes); });
-  m.def("light_modes", [] { return all_names(protocol::kAllLightModes); });
-  m.def("refusal_names", [] { return all_names(kAllMotionRefusals); });
-  m.def("event_kinds", [] { return all_names(kAllEventKinds); });
+  m.def("motion_modes", [] { return protocol::kMotionModeNames.names(); });
+  m.def("light_modes", [] { return protocol::kLightModeNames.names(); });
+  m.def("refusal_names", [] { return kMotionRefusalNames.names(); });
+  m.def("event_kinds", [] { return kEventKindNames.names(); });
   m.def("fault_names", [] {
     std::vector<std::string> out;
     for (const auto& f : protocol::kFaultTable)

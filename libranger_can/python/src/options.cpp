@@ -146,6 +146,11 @@ class Reader {
       case ParameterType::kSeconds:
         row.set(config, number(name, now, r.lo, r.hi, r.lo_open, r.hi_open, std::string(row.unit)));
         break;
+      case ParameterType::kText:  // a node's rows (frontend/node_parameters.hpp), no driver row
+      case ParameterType::kChoice:
+      case ParameterType::kNumberList:
+      case ParameterType::kTextList:
+        break;
     }
   }
 

@@ -1,59 +1,38 @@
 #include "ranger_can/control/commissioning.hpp"
 
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 
+#include "ranger_can/text.hpp"
+
 namespace ranger {
-namespace {
-
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t'))
-    s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r'))
-    s.remove_suffix(1);
-  return s;
-}
-
-}  // namespace
 
 Result<ProtocolProfile> parse_commissioning_text(std::string_view text, std::string_view origin) {
   ProtocolProfile profile = manual_profile();
-  std::vector<std::string> seen;
+  std::vector<std::string_view> seen;
   bool any_setting = false;
-  std::size_t line_no = 0;
-  auto error = [&](const std::string& what) {
-    return Error{Errc::kParseError,
-                 std::string(origin) + ": line " + std::to_string(line_no) + ": " + what};
-  };
-  while (!text.empty()) {
-    ++line_no;
-    const std::size_t nl = text.find('\n');
-    std::string_view line = text.substr(0, nl);
-    text = nl == std::string_view::npos ? std::string_view() : text.substr(nl + 1);
-    if (const std::size_t hash = line.find('#'); hash != std::string_view::npos) {
-      line = line.substr(0, hash);
+  for (const text::KeyValueLine& l : text::key_value_lines(text)) {
+    auto error = [&](const std::string& what) {
+      return Error{Errc::kParseError,
+                   std::string(origin) + ": line " + std::to_string(l.line) + ": " + what};
+    };
+    if (!l.colon || l.key.empty()) {
+      return error("'" + std::string(l.text) + "' is not `setting: value`");
     }
-    line = trim(line);
-    if (line.empty()) continue;
-    const std::size_t colon = line.find(':');
-    if (colon == std::string_view::npos || colon == 0) {
-      return error("'" + std::string(line) + "' is not `setting: value`");
+    if (std::find(seen.begin(), seen.end(), l.key) != seen.end()) {
+      return error("'" + std::string(l.key) + "' is given twice");
     }
-    const std::string key(trim(line.substr(0, colon)));
-    const std::string value(trim(line.substr(colon + 1)));
-    for (const std::string& k : seen) {
-      if (k == key) return error("'" + key + "' is given twice");
-    }
-    seen.push_back(key);
-    if (key == "protocol") {
+    seen.push_back(l.key);
+    if (l.key == "protocol") {
       if (any_setting) return error("'protocol' must come before the settings");
-      Result<ProtocolProfile> preset = protocol_preset(value);
+      Result<ProtocolProfile> preset = protocol_preset(l.value);
       if (!preset) return error(preset.error().message);
       profile = *preset;
       continue;
     }
     any_setting = true;
-    if (Status st = set_setting(profile, key, value); !st) return error(st.error().message);
+    if (Status st = set_setting(profile, l.key, l.value); !st) return error(st.error().message);
   }
   if (Status st = profile.validate(); !st) {
     return Error{Errc::kParseError, std::string(origin) + ": " + st.error().message};

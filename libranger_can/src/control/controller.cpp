@@ -44,78 +44,6 @@ Status check_duration(const char* name, std::chrono::nanoseconds d) {
 
 }  // namespace
 
-std::string_view to_string(MotionRefusal r) {
-  switch (r) {
-    case MotionRefusal::kNone:
-      return "none";
-    case MotionRefusal::kLinkLost:
-      return "link_lost";
-    case MotionRefusal::kRemote:
-      return "remote";
-    case MotionRefusal::kEstop:
-      return "estop";
-    case MotionRefusal::kCriticalError:
-      return "critical_error";
-    case MotionRefusal::kLowBattery:
-      return "low_battery";
-    case MotionRefusal::kModeSwitchFailed:
-      return "mode_switch_failed";
-    case MotionRefusal::kImplausible:
-      return "implausible_feedback";
-    case MotionRefusal::kRearmRequired:
-      return "rearm_required";
-    case MotionRefusal::kStandby:
-      return "standby";
-    case MotionRefusal::kModeUnknown:
-      return "mode_unknown";
-    case MotionRefusal::kSwitching:
-      return "switching";
-    case MotionRefusal::kCmdTimeout:
-      return "cmd_timeout";
-    case MotionRefusal::kBelowMinimum:
-      return "below_minimum";
-    case MotionRefusal::kIdentifying:
-      return "identifying";
-    case MotionRefusal::kParked:
-      return "parked";
-  }
-  return "unknown";
-}
-
-std::string_view to_string(ControllerFault f) {
-  switch (f) {
-    case ControllerFault::kLinkLost:
-      return "link_lost";
-    case ControllerFault::kEmergencyStop:
-      return "emergency_stop";
-    case ControllerFault::kVehicleAbnormal:
-      return "vehicle_abnormal";
-    case ControllerFault::kVehicleStatusUnknown:
-      return "vehicle_status_unknown";
-    case ControllerFault::kLowBattery:
-      return "low_battery";
-    case ControllerFault::kModeSwitchFailed:
-      return "motion_mode_switch_failed";
-    case ControllerFault::kImplausibleFeedback:
-      return "implausible_feedback";
-    case ControllerFault::kUltrasonicUnconfirmed:
-      return "ultrasonic_setting_unconfirmed";
-  }
-  return "unknown";
-}
-
-std::string_view to_string(LinkState s) {
-  switch (s) {
-    case LinkState::kNeverConnected:
-      return "never_connected";
-    case LinkState::kConnected:
-      return "connected";
-    case LinkState::kStale:
-      return "stale";
-  }
-  return "unknown";
-}
-
 Status ControllerConfig::validate() const {
   if (Status st = geometry.validate(); !st) return st;
   if (Status st = limits.validate(); !st) return st;
@@ -318,9 +246,13 @@ Status ChassisController::set_command(const MotionRequest& request, Timestamp no
   return ok_status();
 }
 
-bool ChassisController::can_drive_in(MotionMode mode) const {
+bool can_drive_in(MotionMode mode, const ProtocolProfile& profile) {
   return drivable_mode(mode) &&
-         protocol::motion_mode_to_wire(mode, config_.profile.mode_numbering).has_value();
+         protocol::motion_mode_to_wire(mode, profile.mode_numbering).has_value();
+}
+
+bool ChassisController::can_drive_in(MotionMode mode) const {
+  return ranger::can_drive_in(mode, config_.profile);
 }
 
 void ChassisController::request_motion_mode(std::optional<MotionMode> mode, Timestamp now) {

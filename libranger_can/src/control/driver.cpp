@@ -61,10 +61,6 @@ std::shared_ptr<const DriverSnapshot> first_snapshot(const DriverConfig& c, std:
 
 }  // namespace
 
-std::string_view to_string(ProtocolChoice c) {
-  return c == ProtocolChoice::kAuto ? "auto" : "forced";
-}
-
 Status DriverConfig::validate() const {
   if (Status st = controller.validate(); !st) return st;
   if (Status st = odometry.validate(); !st) return st;

@@ -1,11 +1,11 @@
 #include "ranger_can/control/driver_events.hpp"
 
 #include <cmath>
-#include <cstdio>
 #include <iterator>
 #include <utility>
 
 #include "ranger_can/control/kinematics.hpp"
+#include "ranger_can/json.hpp"
 #include "ranger_can/text.hpp"
 #include "ranger_can/wire/profile.hpp"
 
@@ -14,49 +14,7 @@ namespace {
 
 using text::join;
 
-// printf into a string (the log's number formats).
-template <typename... Args>
-std::string format(const char* fmt, Args... args) {
-  char buf[256];
-  std::snprintf(buf, sizeof buf, fmt, args...);
-  return buf;
-}
-
-struct KindName {
-  EventKind kind;
-  std::string_view name;
-};
-// In the order of EventKind.
-constexpr KindName kKindNames[] = {
-    {EventKind::kBusOpened, "bus_opened"},
-    {EventKind::kBusOpenFailed, "bus_open_failed"},
-    {EventKind::kStillWaiting, "still_waiting"},
-    {EventKind::kLinkConnected, "link_connected"},
-    {EventKind::kLinkSilent, "link_silent"},
-    {EventKind::kLinkHeardAgain, "link_heard_again"},
-    {EventKind::kControlModeChanged, "control_mode_changed"},
-    {EventKind::kRefusalChanged, "refusal_changed"},
-    {EventKind::kRearmLatched, "rearm_latched"},
-    {EventKind::kRearmCleared, "rearm_cleared"},
-    {EventKind::kIdentificationPhase, "identification_phase"},
-    {EventKind::kIdentified, "identified"},
-    {EventKind::kIdentificationFailed, "identification_failed"},
-    {EventKind::kSettingLearned, "setting_learned"},
-    {EventKind::kPlausibilityWarning, "plausibility_warning"},
-    {EventKind::kPlausibilityStop, "plausibility_stop"},
-    {EventKind::kCommandRefused, "command_refused"},
-    {EventKind::kCommandAdjusted, "command_adjusted"},
-    {EventKind::kMotionModeRequested, "motion_mode_requested"},
-    {EventKind::kFaultRaised, "fault_raised"},
-    {EventKind::kFaultCleared, "fault_cleared"},
-    {EventKind::kFirmwareVersion, "firmware_version"},
-    {EventKind::kParkChanged, "park_changed"},
-    {EventKind::kLightsChanged, "lights_changed"},
-    {EventKind::kRequestSettled, "request_settled"},
-    {EventKind::kFramesPadded, "frames_padded"},
-    {EventKind::kShutdownStop, "shutdown_stop"},
-};
-static_assert(std::size(kKindNames) == std::size(kAllEventKinds));
+using text::format;
 
 std::string causes_text(StopCauses causes) {
   std::string out = describe(causes);  // "emergency_stop,remote"
@@ -219,138 +177,91 @@ std::string text_of(const DriverEvent&, const ShutdownEvent& s) {
 
 // ---- JSON ----
 
-class JsonObject {
- public:
-  void field(std::string_view key, std::string_view value) {
-    key_(key);
-    out_ += '"';
-    out_ += text::json_escape(value);
-    out_ += '"';
-  }
-  void number(std::string_view key, double value, const char* fmt = "%.3f") {
-    key_(key);
-    out_ += std::isfinite(value) ? format(fmt, value) : std::string("null");
-  }
-  void integer(std::string_view key, std::uint64_t value) {
-    key_(key);
-    out_ += std::to_string(value);
-  }
-  void boolean(std::string_view key, bool value) {
-    key_(key);
-    out_ += value ? "true" : "false";
-  }
-  std::string close() { return out_ + '}'; }
-
- private:
-  void key_(std::string_view key) {
-    out_ += out_.size() > 1 ? ",\"" : "\"";
-    out_ += key;
-    out_ += "\":";
-  }
-  std::string out_ = "{";
-};
-
-void fields_of(JsonObject& j, const BusEvent& b) {
-  j.field("bus", b.bus);
-  if (!b.error.empty()) j.field("error", b.error);
+void fields_of(JsonWriter& j, const BusEvent& b) {
+  j.key("bus").string(b.bus);
+  if (!b.error.empty()) j.key("error").string(b.error);
 }
-void fields_of(JsonObject& j, const LinkEvent& l) {
-  j.field("bus", l.bus);
-  j.field("from", to_string(l.from));
-  j.field("to", to_string(l.to));
+void fields_of(JsonWriter& j, const LinkEvent& l) {
+  j.key("bus").string(l.bus);
+  j.key("from").string(to_string(l.from));
+  j.key("to").string(to_string(l.to));
 }
-void fields_of(JsonObject& j, const ControlModeEvent& m) {
-  j.field("from", control_mode_text(m.from));
-  j.field("to", control_mode_text(m.to));
+void fields_of(JsonWriter& j, const ControlModeEvent& m) {
+  j.key("from").string(control_mode_text(m.from));
+  j.key("to").string(control_mode_text(m.to));
 }
-void fields_of(JsonObject& j, const RefusalEvent& r) {
-  j.field("from", to_string(r.from));
-  j.field("to", to_string(r.to));
+void fields_of(JsonWriter& j, const RefusalEvent& r) {
+  j.key("from").string(to_string(r.from));
+  j.key("to").string(to_string(r.to));
 }
-void fields_of(JsonObject& j, const RearmEvent& r) {
-  j.field("causes", describe(r.causes));
+void fields_of(JsonWriter& j, const RearmEvent& r) {
+  j.key("causes").string(describe(r.causes));
 }
-void fields_of(JsonObject& j, const IdentificationEvent& i) {
-  j.field("phase", to_string(i.phase));
-  if (!i.settings.empty()) j.field("settings", i.settings);
+void fields_of(JsonWriter& j, const IdentificationEvent& i) {
+  j.key("phase").string(to_string(i.phase));
+  if (!i.settings.empty()) j.key("settings").string(i.settings);
 }
-void fields_of(JsonObject& j, const SettingLearnedEvent& s) {
-  j.field("setting", s.setting.name);
-  j.field("value", s.setting.value);
+void fields_of(JsonWriter& j, const SettingLearnedEvent& s) {
+  j.key("setting").string(s.setting.name);
+  j.key("value").string(s.setting.value);
 }
-void fields_of(JsonObject& j, const PlausibilityEvent& p) {
-  j.field("check", p.finding.check);
-  j.field("setting", p.finding.setting);
-  j.field("try", p.finding.try_value);
+void fields_of(JsonWriter& j, const PlausibilityEvent& p) {
+  j.key("check").string(p.finding.check);
+  j.key("setting").string(p.finding.setting);
+  j.key("try").string(p.finding.try_value);
 }
-void fields_of(JsonObject& j, const CommandRefusedEvent& c) {
-  j.integer("count", c.count);
+void fields_of(JsonWriter& j, const CommandRefusedEvent& c) {
+  j.key("count").unsigned_integer(c.count);
 }
-void fields_of(JsonObject& j, const CommandAdjustedEvent& c) {
-  j.field("flags", kinematics_flags_to_string(c.flags));
+void fields_of(JsonWriter& j, const CommandAdjustedEvent& c) {
+  j.key("flags").string(kinematics_flags_to_string(c.flags));
 }
-void fields_of(JsonObject& j, const MotionModeEvent& m) {
-  j.field("mode", m.mode ? protocol::to_string(*m.mode) : std::string_view("auto"));
+void fields_of(JsonWriter& j, const MotionModeEvent& m) {
+  j.key("mode").string(m.mode ? protocol::to_string(*m.mode) : std::string_view("auto"));
 }
-void fields_of(JsonObject& j, const FaultEvent& f) {
-  j.field("fault", f.name);
-  j.boolean("critical", f.critical);
+void fields_of(JsonWriter& j, const FaultEvent& f) {
+  j.key("fault").string(f.name);
+  j.key("critical").boolean(f.critical);
 }
-void fields_of(JsonObject& j, const FirmwareEvent& f) {
-  j.field("version", f.version);
+void fields_of(JsonWriter& j, const FirmwareEvent& f) {
+  j.key("version").string(f.version);
 }
-void fields_of(JsonObject& j, const ParkEvent& p) {
-  j.boolean("parked", p.parked);
+void fields_of(JsonWriter& j, const ParkEvent& p) {
+  j.key("parked").boolean(p.parked);
 }
-void fields_of(JsonObject& j, const LightsEvent& l) {
-  j.field("lights", describe(l.lights));
+void fields_of(JsonWriter& j, const LightsEvent& l) {
+  j.key("lights").string(describe(l.lights));
 }
-void fields_of(JsonObject& j, const RequestEvent& r) {
-  j.integer("id", r.outcome.id);
-  j.field("request", to_string(r.outcome.kind));
-  j.field("state", to_string(r.outcome.state));
+void fields_of(JsonWriter& j, const RequestEvent& r) {
+  j.key("id").unsigned_integer(r.outcome.id);
+  j.key("request").string(to_string(r.outcome.kind));
+  j.key("state").string(to_string(r.outcome.state));
 }
-void fields_of(JsonObject& j, const PaddedFramesEvent& p) {
-  j.field("id", text::hex(p.id));
+void fields_of(JsonWriter& j, const PaddedFramesEvent& p) {
+  j.key("id").string(text::hex(p.id));
 }
-void fields_of(JsonObject& j, const ShutdownEvent& s) {
-  j.boolean("sent", s.sent);
+void fields_of(JsonWriter& j, const ShutdownEvent& s) {
+  j.key("sent").boolean(s.sent);
 }
 
 }  // namespace
-
-std::string_view to_string(Severity s) {
-  switch (s) {
-    case Severity::kDebug:
-      return "debug";
-    case Severity::kInfo:
-      return "info";
-    case Severity::kWarn:
-      return "warn";
-    case Severity::kError:
-      return "error";
-  }
-  return "unknown";
-}
-
-std::string_view to_string(EventKind k) {
-  const auto i = static_cast<std::size_t>(k);
-  return i < std::size(kKindNames) ? kKindNames[i].name : std::string_view("unknown");
-}
 
 std::string describe(const DriverEvent& event) {
   return std::visit([&](const auto& payload) { return text_of(event, payload); }, event.data);
 }
 
 std::string to_json(const DriverEvent& event, Timestamp origin) {
-  JsonObject j;
-  j.integer("seq", event.sequence);
-  j.number("t", seconds(event.time - origin));
-  j.field("event", to_string(event.kind));
-  j.field("severity", to_string(event.severity));
-  j.field("text", describe(event));
+  std::string out;
+  JsonWriter j(out);
+  j.begin_object();
+  j.key("seq").unsigned_integer(event.sequence);
+  j.key("t").fixed(seconds(event.time - origin), 3);
+  j.key("event").string(to_string(event.kind));
+  j.key("severity").string(to_string(event.severity));
+  j.key("text").string(describe(event));
   std::visit([&](const auto& payload) { fields_of(j, payload); }, event.data);
-  return j.close();
+  j.end_object();
+  return out;
 }
 
 // ---- the refusal in words -----------------------------------------------------------------

@@ -18,30 +18,22 @@ namespace {
 using namespace std::chrono_literals;
 using protocol::MotionMode;
 
-constexpr double kDeg = M_PI / 180.0;
+using S = ProtocolSetting;
+using text::degrees;
+using text::duration_text;
+using text::format;
+
 // 0x271 counts as unchanged while every wheel stays within this (read in 0.01 deg: 2.5 units).
-constexpr double kSettleTolerance = 0.025 * kDeg;
+constexpr double kSettleTolerance = deg_to_rad(0.025);
 // Rolling wheels for a rigid-body sample, and the smallest angle (read in 0.01 deg) that makes
 // a sample tell the 0x271 readings apart.
 constexpr double kRollingSpeed = 0.05;  // m/s
-constexpr double kInformativeAngle = 0.3 * kDeg;
+constexpr double kInformativeAngle = deg_to_rad(0.3);
 constexpr int kMinRigidSamples = 10;
 constexpr int kMinByte7Steps = 10;
 constexpr int kMaxSteerProbes = 2;
 // The reference (inner vs mean) is judged only at angles where the two differ measurably.
-constexpr double kMinReferenceAngle = 3.0 * kDeg;
-
-std::string fmt(const char* format, double a) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, a);
-  return buf;
-}
-std::string deg(double rad) {
-  return fmt("%.2f", rad / kDeg) + " deg";
-}
-std::string secs(std::chrono::nanoseconds d) {
-  return fmt("%.2f", seconds(d)) + " s";
-}
+constexpr double kMinReferenceAngle = deg_to_rad(3.0);
 
 const std::array<AngleUnit, 2> kUnits = {AngleUnit::kCentidegree, AngleUnit::kMilliradian};
 const std::array<SteeringSign, 2> kSigns = {SteeringSign::kRightPositive,
@@ -78,7 +70,7 @@ struct Ranking {
 std::string values_text(const std::array<double, 4>& a) {
   std::string out;
   for (double v : a)
-    out += (out.empty() ? "" : " ") + fmt("%.2f", v / kDeg);
+    out += (out.empty() ? "" : " ") + text::fixed(rad_to_deg(v), 2);
   return out + " deg";
 }
 
@@ -175,17 +167,18 @@ struct SteerDecision {
   double reference_confidence = 1.0;
 };
 
-// What the steering probe's answer decides, given the proposal it was sent under and the number
-// of probes made so far.
-SteerDecision decide_steer(const std::vector<SteerCombo>& combos, const ProtocolProfile& proposal,
-                           const IdentificationConfig& config, int probes) {
-  // Units and signs first (the reference set aside: it is a 6 % effect).
+bool same_readings(const SteerCombo& a, const SteerCombo& b) {
+  return a.u111 == b.u111 && a.s111 == b.s111 && a.u271 == b.u271 && a.s271 == b.s271;
+}
+
+// The units and signs (the reference set aside: it is a 6 % effect): one entry per (u111, s111,
+// u271, s271), that of its best reference.
+Ranking rank_readings(const std::vector<SteerCombo>& combos) {
   Ranking gross;
   for (std::size_t c = 0; c < combos.size(); ++c) {
-    bool dominated = false;  // keep one entry per (u111, s111, u271, s271): its best reference
+    bool dominated = false;
     for (std::size_t d = 0; d < combos.size(); ++d) {
-      if (d != c && combos[d].u111 == combos[c].u111 && combos[d].s111 == combos[c].s111 &&
-          combos[d].u271 == combos[c].u271 && combos[d].s271 == combos[c].s271 &&
+      if (d != c && same_readings(combos[d], combos[c]) &&
           (combos[d].residual < combos[c].residual ||
            (combos[d].residual == combos[c].residual && d < c))) {
         dominated = true;
@@ -193,42 +186,54 @@ SteerDecision decide_steer(const std::vector<SteerCombo>& combos, const Protocol
     }
     if (!dominated) gross.add(static_cast<int>(c), combos[c].residual);
   }
-  SteerDecision out;
-  if (gross.best >= 0) out.best = combos[static_cast<std::size_t>(gross.best)];
-  const double probe_tol = config.angle_tolerance + 0.1 * 6.0 * config.probe_angle;
-  const bool clear = gross.clear(probe_tol, config.margin, 0.1 * kDeg);
-  const bool may_reprobe = probes < kMaxSteerProbes;
-  if (!clear) {
-    if (out.best && gross.best_residual <= probe_tol && may_reprobe &&
-        std::fabs(out.best->commanded) < kMinReferenceAngle &&
-        out.best->u111 != proposal.steering_unit_111) {
-      out.outcome = SteerOutcome::kReprobeTooSmall;
-    } else {
-      out.outcome = SteerOutcome::kNoFit;
-    }
-    return out;
-  }
+  return gross;
+}
+
+// The reference, from the two entries of the winning units and signs: decided where they tell it
+// apart (a turn of at least kMinReferenceAngle).
+void decide_reference(const std::vector<SteerCombo>& combos, const IdentificationConfig& config,
+                      SteerDecision& out) {
   const SteerCombo& g = *out.best;
-  const double actual = std::fabs(g.commanded);
-  if (actual < kMinReferenceAngle && may_reprobe && g.u111 != proposal.steering_unit_111) {
-    out.outcome = SteerOutcome::kReprobeCorrected;
-    return out;
-  }
-  out.outcome = SteerOutcome::kDecided;
-  out.confidence = gross.confidence();
-  // The reference: the two entries of the winning units and signs.
   for (const SteerCombo& k : combos) {
-    if (k.u111 == g.u111 && k.s111 == g.s111 && k.u271 == g.u271 && k.s271 == g.s271) {
+    if (same_readings(k, g)) {
       out.reference_residual[k.ref == SteeringReference::kInnerFront ? 1 : 0] = k.residual;
     }
   }
   const int best_ref = out.reference_residual[1] < out.reference_residual[0] ? 1 : 0;
   const double lo = out.reference_residual[static_cast<std::size_t>(best_ref)];
   const double hi = out.reference_residual[static_cast<std::size_t>(1 - best_ref)];
-  if (actual >= kMinReferenceAngle && hi >= config.margin * std::max(lo, 0.05 * kDeg)) {
+  if (std::fabs(g.commanded) >= kMinReferenceAngle &&
+      hi >= config.margin * std::max(lo, deg_to_rad(0.05))) {
     out.reference = kReferences[static_cast<std::size_t>(best_ref)];
     out.reference_confidence = hi > 0 ? 1.0 - lo / hi : 1.0;
   }
+}
+
+// What the steering probe's answer decides, given the proposal it was sent under and the number
+// of probes made so far.
+SteerDecision decide_steer(const std::vector<SteerCombo>& combos, const ProtocolProfile& proposal,
+                           const IdentificationConfig& config, int probes) {
+  const Ranking gross = rank_readings(combos);
+  SteerDecision out;
+  if (gross.best >= 0) out.best = combos[static_cast<std::size_t>(gross.best)];
+  const double probe_tol = config.angle_tolerance + 0.1 * 6.0 * config.probe_angle;
+  const bool clear = gross.clear(probe_tol, config.margin, deg_to_rad(0.1));
+  const bool may_reprobe = probes < kMaxSteerProbes;
+  // Far smaller than asked in another 0x111 unit than the proposal's: probe again in that unit.
+  const bool too_small = out.best && std::fabs(out.best->commanded) < kMinReferenceAngle &&
+                         may_reprobe && out.best->u111 != proposal.steering_unit_111;
+  if (!clear) {
+    out.outcome = too_small && gross.best_residual <= probe_tol ? SteerOutcome::kReprobeTooSmall
+                                                                : SteerOutcome::kNoFit;
+    return out;
+  }
+  if (too_small) {
+    out.outcome = SteerOutcome::kReprobeCorrected;
+    return out;
+  }
+  out.outcome = SteerOutcome::kDecided;
+  out.confidence = gross.confidence();
+  decide_reference(combos, config, out);
   return out;
 }
 
@@ -259,9 +264,9 @@ Angle221Decision decide_221(const CanFrame& motion, const std::array<double, 4>&
         interpretation::rep103_from_manual_steering(std::get<MotionFeedback>(*fb).steering_angle);
     r221.add(h, std::fabs(a - out.expected));
   }
-  if (std::fabs(out.expected) >= 1.0 * kDeg &&
+  if (std::fabs(out.expected) >= deg_to_rad(1.0) &&
       r221.clear(config.angle_tolerance + 0.1 * std::fabs(out.expected), config.margin,
-                 0.1 * kDeg)) {
+                 deg_to_rad(0.1))) {
     out.reading = Reading271{kUnits[r221.best / 2], kSigns[r221.best % 2]};
     out.confidence = r221.confidence();
   }
@@ -269,26 +274,6 @@ Angle221Decision decide_221(const CanFrame& motion, const std::array<double, 4>&
 }
 
 }  // namespace
-
-std::string_view to_string(IdentificationPhase p) {
-  switch (p) {
-    case IdentificationPhase::kListening:
-      return "listening";
-    case IdentificationPhase::kAwaitingControl:
-      return "awaiting_control";
-    case IdentificationPhase::kSpinCheck:
-      return "spin_check";
-    case IdentificationPhase::kSteerProbe:
-      return "steer_probe";
-    case IdentificationPhase::kReturning:
-      return "returning";
-    case IdentificationPhase::kDecided:
-      return "decided";
-    case IdentificationPhase::kFailed:
-      return "failed";
-  }
-  return "unknown";
-}
 
 Status IdentificationConfig::validate() const {
   if (listen_time.count() <= 0 || timeout.count() <= 0 || step_timeout.count() <= 0 ||
@@ -302,7 +287,7 @@ Status IdentificationConfig::validate() const {
   if (min_status_frames < 1) {
     return Error{Errc::kOutOfRange, "identification: min_status_frames must be >= 1"};
   }
-  if (!(probe_angle > 1.0 * kDeg && probe_angle <= 7.0 * kDeg)) {
+  if (!(probe_angle > deg_to_rad(1.0) && probe_angle <= deg_to_rad(7.0))) {
     return Error{Errc::kOutOfRange,
                  "identification: probe_angle must be in (1, 7] deg (read 5.7 times larger in "
                  "the other unit it must stay within the 40 deg Ackermann range)"};
@@ -314,7 +299,7 @@ Status IdentificationConfig::validate() const {
 }
 
 std::string unidentified_message(const std::string& reason, std::chrono::nanoseconds timeout) {
-  return "the chassis could not be identified within " + secs(timeout) +
+  return "the chassis could not be identified within " + duration_text(timeout) +
          " (identify_timeout): " + reason +
          ". The robot stays at rest. Set the protocol instead of `auto` (protocol: manual or "
          "protocol: agx_v2, and single settings such as steering_unit_111: millirad), or "
@@ -345,11 +330,12 @@ void ChassisIdentifier::note(std::string line) {
   status_.evidence.push_back(std::move(line));
 }
 
-void ChassisIdentifier::set(std::string_view name, std::string_view value, std::string evidence) {
-  if (Status st = set_setting(status_.profile, name, value); !st) {
+void ChassisIdentifier::set(ProtocolSetting setting, std::string_view value, std::string evidence) {
+  if (Status st = set_setting(status_.profile, setting, value); !st) {
     note("internal: " + st.error().message);
     return;
   }
+  const std::string_view name = to_string(setting);
   for (IdentifiedSetting& s : status_.decided) {
     if (s.name == name) {
       s.value = std::string(value);
@@ -379,108 +365,126 @@ void ChassisIdentifier::on_frame(const CanFrame& frame, Timestamp now) {
 }
 
 void ChassisIdentifier::observe_passive(const CanFrame& frame) {
+  observe_origin(frame);
+  switch (frame.id) {
+    case protocol::kSystemStatusId:
+      observe_status(frame);
+      break;
+    case protocol::kMotionModeFeedbackId:
+      if (Result<Message> m = decode(frame, status_.profile)) {
+        max_mode_raw_ = std::max<int>(max_mode_raw_, std::get<MotionModeFeedback>(*m).mode_raw);
+      }
+      break;
+    case protocol::kBmsBaseId:  // the whole pack
+      observe_bms(frame);
+      break;
+    case protocol::kSteeringAnglesId:
+      last_angles_frame_ = frame;
+      last_angles_time_ = frame.stamp;
+      break;
+    case protocol::kWheelSpeedsId:
+      observe_rolling(frame);
+      break;
+    default:
+      break;
+  }
+}
+
+void ChassisIdentifier::observe_origin(const CanFrame& frame) {
   const std::uint32_t id = frame.id;
+  if (!protocol::is_chassis_frame(frame)) return;  // the host's own commands do not count
   // Frames only the vendor's revision defines, sent by the chassis (the frame table).
-  const protocol::FrameInfo* info = protocol::find_frame(id);
-  const bool chassis_frame = protocol::is_chassis_frame(frame);
-  if (chassis_frame && (info->revisions & protocol::kInManual) == 0) {
+  if ((protocol::find_frame(id)->revisions & protocol::kInManual) == 0) {
     const std::string what = text::hex(id) + " (" + std::string(protocol::frame_name(id)) + ")";
     if (std::find(agx_signatures_.begin(), agx_signatures_.end(), what) == agx_signatures_.end()) {
       agx_signatures_.push_back(what);
     }
   }
-  // Padding: a chassis frame longer than its layout (the host's own commands do not count).
-  if (chassis_frame && protocol::extra_bytes(frame) > 0 &&
+  // Padding: a chassis frame longer than its layout.
+  if (protocol::extra_bytes(frame) > 0 &&
       std::find(padded_ids_.begin(), padded_ids_.end(), id) == padded_ids_.end()) {
     padded_ids_.push_back(id);
   }
+}
 
-  if (id == protocol::kSystemStatusId) {
-    // Read with the agx16 layout: byte 7 is then `counter`, whatever the chassis means by it.
-    ProtocolProfile agx = status_.profile;
-    agx.error_word = ErrorWordLayout::kAgxV2_16;
-    Result<Message> m = decode(frame, agx);
-    if (!m) return;
-    const auto& st = std::get<SystemStatus>(*m);
-    if (status_frames_++ == 0) first_status_ = status_.started;
-    status_voltage_ = st.battery_voltage;
-    if (st.control_mode_raw == static_cast<std::uint8_t>(protocol::ControlMode::kUart)) {
-      uart_seen_ = true;
-    }
-    const std::uint8_t b7 = st.counter.value_or(0);
-    if (last_byte7_) {
-      ++byte7_steps_;
-      if (b7 != *last_byte7_) ++byte7_changes_;
-      if (b7 == static_cast<std::uint8_t>(*last_byte7_ + 1)) ++byte7_increments_;
-    }
-    last_byte7_ = b7;
+void ChassisIdentifier::observe_status(const CanFrame& frame) {
+  // Read with the agx16 layout: byte 7 is then `counter`, whatever the chassis means by it.
+  ProtocolProfile agx = status_.profile;
+  agx.error_word = ErrorWordLayout::kAgxV2_16;
+  Result<Message> m = decode(frame, agx);
+  if (!m) return;
+  const auto& st = std::get<SystemStatus>(*m);
+  if (status_frames_++ == 0) first_status_ = status_.started;
+  status_voltage_ = st.battery_voltage;
+  if (st.control_mode_raw == static_cast<std::uint8_t>(protocol::ControlMode::kUart)) {
+    uart_seen_ = true;
+  }
+  const std::uint8_t b7 = st.counter.value_or(0);
+  if (last_byte7_) {
+    ++byte7_steps_;
+    if (b7 != *last_byte7_) ++byte7_changes_;
+    if (b7 == static_cast<std::uint8_t>(*last_byte7_ + 1)) ++byte7_increments_;
+  }
+  last_byte7_ = b7;
+}
+
+void ChassisIdentifier::observe_bms(const CanFrame& frame) {
+  ProtocolProfile p = status_.profile;
+  p.bms_voltage_scale = 0.01;
+  Result<Message> m = decode(frame, p);
+  if (!m || !status_voltage_) return;
+  const double v001 = std::get<BmsData>(*m).voltage;
+  const double v01 = v001 * 10.0;
+  const double ref = *status_voltage_;
+  const double tol = std::max(2.0, 0.05 * ref);
+  ++bms_frames_;
+  if (std::fabs(v001 - ref) <= tol) ++bms_agree_001_;
+  if (std::fabs(v01 - ref) <= tol) ++bms_agree_01_;
+}
+
+void ChassisIdentifier::observe_rolling(const CanFrame& frame) {
+  if (!last_angles_frame_ || frame.stamp - last_angles_time_ > 60ms ||
+      frame.stamp < last_angles_time_) {
     return;
   }
-  if (id == protocol::kMotionModeFeedbackId) {
-    Result<Message> m = decode(frame, status_.profile);
-    if (m) max_mode_raw_ = std::max<int>(max_mode_raw_, std::get<MotionModeFeedback>(*m).mode_raw);
-    return;
+  Result<Message> m = decode(frame, status_.profile);
+  if (!m) return;
+  const auto& speeds = std::get<WheelSpeedsFeedback>(*m).speeds;
+  double fastest = 0.0;
+  for (double s : speeds)
+    fastest = std::max(fastest, std::fabs(s));
+  if (fastest < kRollingSpeed) return;
+  // Informative only when the wheels are steered (straight wheels fit every reading).
+  const auto plain =
+      wheel_angles(*last_angles_frame_, AngleUnit::kCentidegree, SteeringSign::kRightPositive);
+  if (plain) {
+    double widest = 0.0;
+    for (double a : *plain)
+      widest = std::max(widest, std::fabs(a));
+    if (widest < kInformativeAngle) return;
   }
-  if (id == protocol::kBmsBaseId) {  // the whole pack
-    ProtocolProfile p = status_.profile;
-    p.bms_voltage_scale = 0.01;
-    Result<Message> m = decode(frame, p);
-    if (!m || !status_voltage_) return;
-    const double v001 = std::get<BmsData>(*m).voltage;
-    const double v01 = v001 * 10.0;
-    const double ref = *status_voltage_;
-    const double tol = std::max(2.0, 0.05 * ref);
-    ++bms_frames_;
-    if (std::fabs(v001 - ref) <= tol) ++bms_agree_001_;
-    if (std::fabs(v01 - ref) <= tol) ++bms_agree_01_;
-    return;
-  }
-  if (id == protocol::kSteeringAnglesId) {
-    last_angles_frame_ = frame;
-    last_angles_time_ = frame.stamp;
-    return;
-  }
-  if (id == protocol::kWheelSpeedsId && last_angles_frame_ &&
-      frame.stamp - last_angles_time_ <= 60ms && frame.stamp >= last_angles_time_) {
-    Result<Message> m = decode(frame, status_.profile);
-    if (!m) return;
-    const auto& speeds = std::get<WheelSpeedsFeedback>(*m).speeds;
-    double fastest = 0.0;
-    for (double s : speeds)
-      fastest = std::max(fastest, std::fabs(s));
-    if (fastest < kRollingSpeed) return;
-    // Informative only when the wheels are steered (straight wheels fit every reading).
-    const auto plain =
-        wheel_angles(*last_angles_frame_, AngleUnit::kCentidegree, SteeringSign::kRightPositive);
-    if (plain) {
-      double widest = 0.0;
-      for (double a : *plain)
-        widest = std::max(widest, std::fabs(a));
-      if (widest < kInformativeAngle) return;
+  double norm = 0.0;
+  for (double s : speeds)
+    norm += s * s;
+  ++rigid_samples_;
+  for (int h = 0; h < 4; ++h) {
+    const auto angles = wheel_angles(*last_angles_frame_, kUnits[h / 2], kSigns[h % 2]);
+    if (!angles) {
+      ++rigid_impossible_[h];
+      continue;
     }
-    double norm = 0.0;
-    for (double s : speeds)
-      norm += s * s;
-    ++rigid_samples_;
-    for (int h = 0; h < 4; ++h) {
-      const auto angles = wheel_angles(*last_angles_frame_, kUnits[h / 2], kSigns[h % 2]);
-      if (!angles) {
-        ++rigid_impossible_[h];
-        continue;
-      }
-      std::array<WheelMeasurement, kWheelCount> wheels{};
-      for (int i = 0; i < kWheelCount; ++i)
-        wheels[i] = {(*angles)[i], speeds[i]};
-      const BodyTwist t = fit_body_twist(wheels, geometry_);
-      double r = 0.0;
-      for (int i = 0; i < kWheelCount; ++i) {
-        const WheelPosition p = geometry_.wheel_position(i);
-        const double ex = t.vx - t.wz * p.y - speeds[i] * std::cos((*angles)[i]);
-        const double ey = t.vy + t.wz * p.x - speeds[i] * std::sin((*angles)[i]);
-        r += ex * ex + ey * ey;
-      }
-      rigid_residual_[h] += r / norm;
+    std::array<WheelMeasurement, kWheelCount> wheels{};
+    for (int i = 0; i < kWheelCount; ++i)
+      wheels[i] = {(*angles)[i], speeds[i]};
+    const BodyTwist t = fit_body_twist(wheels, geometry_);
+    double r = 0.0;
+    for (int i = 0; i < kWheelCount; ++i) {
+      const WheelPosition p = geometry_.wheel_position(i);
+      const double ex = t.vx - t.wz * p.y - speeds[i] * std::cos((*angles)[i]);
+      const double ey = t.vy + t.wz * p.x - speeds[i] * std::sin((*angles)[i]);
+      r += ex * ex + ey * ey;
     }
+    rigid_residual_[h] += r / norm;
   }
 }
 
@@ -531,63 +535,83 @@ void ChassisIdentifier::tick(Timestamp now) {
     timeout_from_ = now;
   }
   if (now - timeout_from_ >= config_.timeout) {
-    std::string why;
-    switch (status_.phase) {
-      case IdentificationPhase::kListening:
-        why = status_frames_ == 0 ? "no system status (0x211) heard: is the chassis on and the bus "
-                                    "at 500 kbit/s?"
-                                  : "too few system status frames (0x211) heard";
-        break;
-      case IdentificationPhase::kAwaitingControl:
-        why = !control_mode_raw_ ? "no system status (0x211) heard"
-              : *control_mode_raw_ != static_cast<std::uint8_t>(protocol::ControlMode::kCan)
-                  ? "CAN command mode was not granted (0x211 control mode " +
-                        std::to_string(*control_mode_raw_) + "): is the remote control in charge?"
-                  : "no known motion mode (0x291) reported";
-        break;
-      default:
-        why = "the steering probe did not finish (" + std::string(to_string(status_.phase)) + ")";
-        break;
-    }
-    fail(why, now);
+    fail(timeout_reason(), now);
     return;
   }
   switch (status_.phase) {
     case IdentificationPhase::kListening:
-      if (status_frames_ >= static_cast<std::uint64_t>(config_.min_status_frames) &&
-          now - status_.started >= config_.listen_time) {
-        decide_passive(now);
-        if (read_only_) {
-          decide(now);
-        } else {
-          status_.phase = IdentificationPhase::kAwaitingControl;
-          status_.message = "identifying the chassis: waiting for CAN command mode";
-        }
-      } else {
-        status_.message = "identifying the chassis: listening (" + secs(now - status_.started) +
-                          " of " + secs(config_.listen_time) + ")";
-      }
+      tick_listening(now);
       break;
     case IdentificationPhase::kAwaitingControl:
-      if (control_mode_raw_ == static_cast<std::uint8_t>(protocol::ControlMode::kCan) && mode_ &&
-          !switching_ && !probe_hold_.empty()) {
-        status_.message = "identifying the chassis: the steering probe waits: " + probe_hold_;
-      } else if (control_mode_raw_ == static_cast<std::uint8_t>(protocol::ControlMode::kCan) &&
-                 mode_ && !switching_) {
-        begin_step(config_.spin_check && !verdict_271_ ? IdentificationPhase::kSpinCheck
-                                                       : IdentificationPhase::kSteerProbe,
-                   now);
-      } else if (under_remote()) {
-        observe_remote_driving(now);
-      } else {
-        status_.message = "identifying the chassis: waiting for CAN command mode";
-      }
+      tick_awaiting_control(now);
       break;
+    default:
+      tick_step(now);
+      break;
+  }
+}
+
+std::string ChassisIdentifier::timeout_reason() const {
+  switch (status_.phase) {
+    case IdentificationPhase::kListening:
+      return status_frames_ == 0 ? "no system status (0x211) heard: is the chassis on and the bus "
+                                   "at 500 kbit/s?"
+                                 : "too few system status frames (0x211) heard";
+    case IdentificationPhase::kAwaitingControl:
+      if (!control_mode_raw_) return "no system status (0x211) heard";
+      if (*control_mode_raw_ != static_cast<std::uint8_t>(protocol::ControlMode::kCan)) {
+        return "CAN command mode was not granted (0x211 control mode " +
+               std::to_string(*control_mode_raw_) + "): is the remote control in charge?";
+      }
+      return "no known motion mode (0x291) reported";
+    default:
+      return "the steering probe did not finish (" + std::string(to_string(status_.phase)) + ")";
+  }
+}
+
+void ChassisIdentifier::tick_listening(Timestamp now) {
+  if (status_frames_ < static_cast<std::uint64_t>(config_.min_status_frames) ||
+      now - status_.started < config_.listen_time) {
+    status_.message = "identifying the chassis: listening (" +
+                      duration_text(now - status_.started) + " of " +
+                      duration_text(config_.listen_time) + ")";
+    return;
+  }
+  decide_passive(now);
+  if (read_only_) {
+    decide(now);
+  } else {
+    status_.phase = IdentificationPhase::kAwaitingControl;
+    status_.message = "identifying the chassis: waiting for CAN command mode";
+  }
+}
+
+void ChassisIdentifier::tick_awaiting_control(Timestamp now) {
+  const bool ready = control_mode_raw_ == static_cast<std::uint8_t>(protocol::ControlMode::kCan) &&
+                     mode_ && !switching_;
+  if (ready && !probe_hold_.empty()) {
+    status_.message = "identifying the chassis: the steering probe waits: " + probe_hold_;
+  } else if (ready) {
+    begin_step(config_.spin_check && !verdict_271_ ? IdentificationPhase::kSpinCheck
+                                                   : IdentificationPhase::kSteerProbe,
+               now);
+  } else if (under_remote()) {
+    observe_remote_driving(now);
+  } else {
+    status_.message = "identifying the chassis: waiting for CAN command mode";
+  }
+}
+
+// The probe's steps: the spin check, the steering probe, the return to straight.
+void ChassisIdentifier::tick_step(Timestamp now) {
+  const bool timed_out = now - step_started_ >= config_.step_timeout;
+  switch (status_.phase) {
     case IdentificationPhase::kSpinCheck:
       if (settled(now)) {
         evaluate_spin(now);
-      } else if (now - step_started_ >= config_.step_timeout) {
-        note("spin check: no settled answer within " + secs(config_.step_timeout) + " (mode " +
+      } else if (timed_out) {
+        note("spin check: no settled answer within " + duration_text(config_.step_timeout) +
+             " (mode " +
              (mode_ ? std::string(protocol::to_string(*mode_)) : std::string("unknown")) +
              "); the steering probe decides the 0x271 reading alone");
         begin_step(IdentificationPhase::kSteerProbe, now);
@@ -596,14 +620,14 @@ void ChassisIdentifier::tick(Timestamp now) {
     case IdentificationPhase::kSteerProbe:
       if (settled(now)) {
         evaluate_steer(now);
-      } else if (now - step_started_ >= config_.step_timeout) {
-        fail(
-            "the steering probe got no settled answer (0x271) within " + secs(config_.step_timeout),
-            now);
+      } else if (timed_out) {
+        fail("the steering probe got no settled answer (0x271) within " +
+                 duration_text(config_.step_timeout),
+             now);
       }
       break;
     case IdentificationPhase::kReturning:
-      if (settled(now) || now - step_started_ >= config_.step_timeout) decide(now);
+      if (settled(now) || timed_out) decide(now);
       break;
     default:
       break;
@@ -627,8 +651,8 @@ void ChassisIdentifier::begin_step(IdentificationPhase phase, Timestamp now) {
       Result<CanFrame> f = encode(c, status_.profile);
       Result<Message> back = f ? decode(*f, status_.profile) : Result<Message>(f.error());
       probe_wire_angle_ = back ? std::get<MotionCommand>(*back).steering_angle : c.steering_angle;
-      status_.message =
-          "identifying the chassis: steering probe " + deg(config_.probe_angle) + " at standstill";
+      status_.message = "identifying the chassis: steering probe " + degrees(config_.probe_angle) +
+                        " at standstill";
       break;
     }
     case IdentificationPhase::kReturning:
@@ -669,24 +693,24 @@ bool ChassisIdentifier::judge_spin_position(const std::string& context, bool qui
   }
   const auto plain = wheel_angles(*angles_, AngleUnit::kCentidegree, SteeringSign::kRightPositive);
   const double tol = config_.angle_tolerance + 0.1 * std::fabs(expected[0]);
-  if (rank.clear(tol, config_.margin, 0.2 * kDeg)) {
+  if (rank.clear(tol, config_.margin, deg_to_rad(0.2))) {
     const Hypothesis271 v{kUnits[rank.best / 2], kSigns[rank.best % 2]};
     verdict_271_ = v;
     min_margin_ = std::min(min_margin_, rank.confidence());
     const std::string read = context + ": 0x271 read " +
                              (plain ? values_text(*plain) + " in 0.01 deg" : "beyond 100 deg") +
-                             ", expected +-" + deg(std::fabs(expected[0])) +
+                             ", expected +-" + degrees(std::fabs(expected[0])) +
                              " (atan(wheelbase/track), RF +, RR -, LR +, LF - in REP-103)";
-    set("steering_unit_271", to_string(v.unit),
+    set(S::kSteeringUnit271, to_string(v.unit),
         read + ": the unit is " + std::string(to_string(v.unit)));
-    set("steering_sign_271", to_string(v.sign),
+    set(S::kSteeringSign271, to_string(v.sign),
         "spin position sign pattern: " + std::string(to_string(v.sign)));
     return true;
   }
   if (!quiet_if_unclear) {
     note("spin check inconclusive: 0x271 " + (plain ? values_text(*plain) : std::string("?")) +
-         " fits no reading of the spin position " + deg(std::fabs(expected[0])) +
-         " (best residual " + deg(rank.best_residual) + ")");
+         " fits no reading of the spin position " + degrees(std::fabs(expected[0])) +
+         " (best residual " + degrees(rank.best_residual) + ")");
   }
   return false;
 }
@@ -741,19 +765,20 @@ void ChassisIdentifier::evaluate_steer(Timestamp now) {
       begin_step(IdentificationPhase::kSteerProbe, now);
       return;
     case SteerOutcome::kReprobeCorrected:
-      note("steering probe 1: 0x271 came back " + seen + ", " + deg(std::fabs(d.best->commanded)) +
-           " where " + deg(config_.probe_angle) + " was asked: 0x111 reads " +
-           std::string(to_string(d.best->u111)) + "; probing again in that unit");
+      note("steering probe 1: 0x271 came back " + seen + ", " +
+           degrees(std::fabs(d.best->commanded)) + " where " + degrees(config_.probe_angle) +
+           " was asked: 0x111 reads " + std::string(to_string(d.best->u111)) +
+           "; probing again in that unit");
       status_.profile.steering_unit_111 = d.best->u111;
       status_.profile.steering_sign_111 = d.best->s111;
       begin_step(IdentificationPhase::kSteerProbe, now);
       return;
     case SteerOutcome::kNoFit:
       fail("the steering probe's answer fits no reading of the protocol: 0x111 steering " +
-               deg(config_.probe_angle) + " to the left (as " +
+               degrees(config_.probe_angle) + " to the left (as " +
                std::string(to_string(status_.profile.steering_unit_111)) + ", " +
                std::string(to_string(status_.profile.steering_sign_111)) + "), 0x271 came back " +
-               seen + (d.best ? ", best fit off by " + deg(d.best->residual) : ""),
+               seen + (d.best ? ", best fit off by " + degrees(d.best->residual) : ""),
            now);
       return;
     case SteerOutcome::kDecided:
@@ -763,34 +788,35 @@ void ChassisIdentifier::evaluate_steer(Timestamp now) {
   const double actual = std::fabs(g.commanded);
   min_margin_ = std::min(min_margin_, d.confidence);
   if (!verdict_271_) {
-    set("steering_unit_271", to_string(g.u271),
+    set(S::kSteeringUnit271, to_string(g.u271),
         "steering probe: 0x271 came back " + seen + ": the four wheels fit 0x271 in " +
             std::string(to_string(g.u271)));
-    set("steering_sign_271", to_string(g.s271),
+    set(S::kSteeringSign271, to_string(g.s271),
         "steering probe: the wheels' pattern fits 0x271 " + std::string(to_string(g.s271)));
     verdict_271_ = Hypothesis271{g.u271, g.s271};
   }
-  const std::string asked = "steering probe: " + deg(config_.probe_angle) +
+  const std::string asked = "steering probe: " + degrees(config_.probe_angle) +
                             " to the left asked at standstill, the wheels stand at " + seen;
-  set("steering_unit_111", to_string(g.u111),
-      asked + ": 0x111 reads " + std::string(to_string(g.u111)) + " (" + deg(actual) + " steered)");
-  set("steering_sign_111", to_string(g.s111),
+  set(S::kSteeringUnit111, to_string(g.u111),
+      asked + ": 0x111 reads " + std::string(to_string(g.u111)) + " (" + degrees(actual) +
+          " steered)");
+  set(S::kSteeringSign111, to_string(g.s111),
       std::string("steering probe: the wheels turned ") + (g.commanded > 0 ? "left" : "right") +
           ": 0x111 is " + std::string(to_string(g.s111)));
   const double r_mean = d.reference_residual[0], r_inner = d.reference_residual[1];
   if (d.reference) {
     const bool inner = *d.reference == SteeringReference::kInnerFront;
     min_margin_ = std::min(min_margin_, d.reference_confidence);
-    set("steering_reference", to_string(*d.reference),
+    set(S::kSteeringReference, to_string(*d.reference),
         std::string("steering probe: ") +
             (inner ? "the inner front wheel" : "the front wheels' mean") +
-            " stands at the commanded " + deg(actual) + " (off by " +
-            deg(inner ? r_inner : r_mean) + "; the " + (inner ? "mean" : "inner wheel") +
-            " is off by " + deg(inner ? r_mean : r_inner) + ")");
+            " stands at the commanded " + degrees(actual) + " (off by " +
+            degrees(inner ? r_inner : r_mean) + "; the " + (inner ? "mean" : "inner wheel") +
+            " is off by " + degrees(inner ? r_mean : r_inner) + ")");
   } else {
     note("steering probe: the reference (inner or mean front wheel) is not decidable at " +
-         deg(actual) + " (residuals " + deg(r_mean) + " mean, " + deg(r_inner) + " inner): kept " +
-         std::string(to_string(status_.profile.steering_reference)));
+         degrees(actual) + " (residuals " + degrees(r_mean) + " mean, " + degrees(r_inner) +
+         " inner): kept " + std::string(to_string(status_.profile.steering_reference)));
   }
   // 0x221: its angle against what the chassis should report for the wheels as they stand.
   if (motion_) {
@@ -798,10 +824,10 @@ void ChassisIdentifier::evaluate_steer(Timestamp now) {
     const Angle221Decision a = decide_221(*motion_, *measured, status_.profile, config_);
     if (a.reading) {
       min_margin_ = std::min(min_margin_, a.confidence);
-      set("steering_unit_221", to_string(a.reading->unit),
-          "steering probe: 0x221 reports " + deg(a.expected) + " in " +
+      set(S::kSteeringUnit221, to_string(a.reading->unit),
+          "steering probe: 0x221 reports " + degrees(a.expected) + " in " +
               std::string(to_string(a.reading->unit)));
-      set("steering_sign_221", to_string(a.reading->sign),
+      set(S::kSteeringSign221, to_string(a.reading->sign),
           "steering probe: 0x221's angle is " + std::string(to_string(a.reading->sign)));
     } else {
       note("steering probe: 0x221's angle fits no reading clearly: kept its preset");
@@ -813,7 +839,7 @@ void ChassisIdentifier::evaluate_steer(Timestamp now) {
 }
 
 void ChassisIdentifier::decide_passive(Timestamp now) {
-  const std::string listened = secs(now - status_.started);
+  const std::string listened = duration_text(now - status_.started);
   if (!forced_revision_) {
     if (!agx_signatures_.empty() || uart_seen_) {
       status_.revision = "agx_v2";
@@ -838,7 +864,7 @@ void ChassisIdentifier::decide_passive(Timestamp now) {
     std::string ids;
     for (std::uint32_t id : padded_ids_)
       ids += (ids.empty() ? "" : ", ") + text::hex(id);
-    set("tx_dlc", "8",
+    set(S::kTxDlc, "8",
         "the chassis pads its frames (" + ids +
             " longer than their layout): commands padded to 8 bytes");
   } else {
@@ -847,11 +873,11 @@ void ChassisIdentifier::decide_passive(Timestamp now) {
   }
   // 0x211 byte 7.
   if (byte7_steps_ >= kMinByte7Steps && byte7_increments_ * 10 >= byte7_steps_ * 9) {
-    set("error_word", "agx16",
+    set(S::kErrorWord, "agx16",
         "0x211 byte 7 rose by one in " + std::to_string(byte7_increments_) + " of " +
             std::to_string(byte7_steps_) + " frames: a counter, so bytes 4-5 are the error word");
   } else if (byte7_steps_ >= kMinByte7Steps && byte7_changes_ == 0) {
-    set("error_word", to_string(status_.profile.error_word),
+    set(S::kErrorWord, to_string(status_.profile.error_word),
         "0x211 byte 7 constant over " + std::to_string(byte7_steps_ + 1) +
             " frames: no counter; the preset's layout stands");
   } else {
@@ -860,15 +886,15 @@ void ChassisIdentifier::decide_passive(Timestamp now) {
   }
   // Motion-mode numbering.
   if (max_mode_raw_ > 2 && status_.profile.mode_numbering == ModeNumbering::kManual) {
-    set("mode_numbering", "agx_v2",
+    set(S::kModeNumbering, "agx_v2",
         "0x291 reported mode " + std::to_string(max_mode_raw_) +
             ": beyond the manual's 0-2, so the vendor's numbering");
   }
   // BMS voltage scale.
   if (bms_frames_ > 0 && bms_agree_01_ != bms_agree_001_) {
     const bool tenth = bms_agree_01_ > bms_agree_001_;
-    set("bms_voltage_scale", tenth ? "0.1" : "0.01",
-        "0x361 voltage agrees with 0x211's " + fmt("%.1f", status_voltage_.value_or(0.0)) +
+    set(S::kBmsVoltageScale, tenth ? "0.1" : "0.01",
+        "0x361 voltage agrees with 0x211's " + format("%.1f", status_voltage_.value_or(0.0)) +
             " V in " + (tenth ? "0.1 V" : "0.01 V") + " (" +
             std::to_string(std::max(bms_agree_01_, bms_agree_001_)) + " of " +
             std::to_string(bms_frames_) + " frames)");
@@ -893,10 +919,10 @@ bool ChassisIdentifier::judge_rigid_body(bool quiet_if_unclear) {
                               " samples) form one rigid-body motion only under 0x271 " +
                               std::string(to_string(verdict_271_->unit)) + ", " +
                               std::string(to_string(verdict_271_->sign)) + " (relative residual " +
-                              fmt("%.3f", rank.best_residual) + ", next " +
-                              fmt("%.3f", rank.second_residual) + ")";
-      set("steering_unit_271", to_string(verdict_271_->unit), why);
-      set("steering_sign_271", to_string(verdict_271_->sign), why);
+                              format("%.3f", rank.best_residual) + ", next " +
+                              format("%.3f", rank.second_residual) + ")";
+      set(S::kSteeringUnit271, to_string(verdict_271_->unit), why);
+      set(S::kSteeringSign271, to_string(verdict_271_->sign), why);
       return true;
     }
     if (!quiet_if_unclear) {
@@ -927,7 +953,7 @@ void ChassisIdentifier::decide(Timestamp now) {
   }
   status_.confidence = min_margin_;
   status_.message =
-      "identified in " + secs(now - status_.started) + ": " + describe(status_.profile);
+      "identified in " + duration_text(now - status_.started) + ": " + describe(status_.profile);
 }
 
 void ChassisIdentifier::finish(Timestamp now) {
@@ -944,11 +970,12 @@ void ChassisIdentifier::finish(Timestamp now) {
 
 bool ChassisIdentifier::adopt(std::string_view name, std::string_view value, std::string evidence) {
   auto it = std::find(status_.undecided.begin(), status_.undecided.end(), name);
-  if (!status_.decided_ok() || it == status_.undecided.end()) return false;
+  const auto setting = kProtocolSettingNames.parse(name);
+  if (!status_.decided_ok() || it == status_.undecided.end() || !setting) return false;
   ProtocolProfile p = status_.profile;
-  if (!set_setting(p, name, value)) return false;
+  if (!set_setting(p, *setting, value)) return false;
   status_.undecided.erase(it);
-  set(name, value, "learned while driving: " + evidence);
+  set(*setting, value, "learned while driving: " + evidence);
   status_.message = "identified: " + describe(status_.profile);
   return true;
 }

@@ -4,18 +4,6 @@
 
 namespace ranger {
 
-std::string_view to_string(ModeSwitchPhase p) {
-  switch (p) {
-    case ModeSwitchPhase::kIdle:
-      return "idle";
-    case ModeSwitchPhase::kStopping:
-      return "stopping";
-    case ModeSwitchPhase::kAwaitingConfirmation:
-      return "awaiting_confirmation";
-  }
-  return "unknown";
-}
-
 std::optional<protocol::MotionMode> ModeSwitchSequencer::update(protocol::MotionMode wanted,
                                                                 protocol::MotionMode current,
                                                                 bool at_standstill, Timestamp now) {

@@ -23,13 +23,6 @@ extern const std::size_t kEmbeddedModelCount;
 
 namespace {
 
-std::string_view trim(std::string_view s) {
-  const auto first = s.find_first_not_of(" \t\r");
-  if (first == std::string_view::npos) return {};
-  const auto last = s.find_last_not_of(" \t\r");
-  return s.substr(first, last - first + 1);
-}
-
 using text::join;
 
 bool valid_key(std::string_view key) {
@@ -39,128 +32,141 @@ bool valid_key(std::string_view key) {
   });
 }
 
-}  // namespace
+// The keys the library reads as numbers, and where each goes.
+struct NumberKey {
+  const char* key;
+  double& (*field)(ModelPreset&);
+};
+const NumberKey kNumberKeys[] = {
+    {"wheelbase", [](ModelPreset& m) -> double& { return m.geometry.wheelbase; }},
+    {"track", [](ModelPreset& m) -> double& { return m.geometry.track; }},
+    {"wheel_radius", [](ModelPreset& m) -> double& { return m.geometry.wheel_radius; }},
+    {"max_linear_speed", [](ModelPreset& m) -> double& { return m.limits.max_linear_speed; }},
+    {"max_speed_at_large_steering",
+     [](ModelPreset& m) -> double& { return m.limits.max_speed_at_large_steering; }},
+    {"max_ackermann_steering",
+     [](ModelPreset& m) -> double& { return m.limits.max_ackermann_steering; }},
+    {"max_oblique_steering",
+     [](ModelPreset& m) -> double& { return m.limits.max_oblique_steering; }},
+    {"max_spin_wheel_speed",
+     [](ModelPreset& m) -> double& { return m.limits.max_spin_wheel_speed; }},
+};
 
-Result<ModelPreset> parse_model(std::string_view text, std::string_view origin) {
-  const std::string where(origin);
-  auto fail = [&](std::size_t line, const std::string& what) -> Error {
+// One model file being read: its flat `key: value` pairs, and errors that name the file and line.
+class ModelFile {
+ public:
+  explicit ModelFile(std::string_view origin) : where_(origin) {}
+
+  Error fail(std::size_t line, const std::string& what) const {
     return Error{Errc::kInvalidArgument,
-                 where + ": " + (line > 0 ? "line " + std::to_string(line) + ": " : "") + what};
-  };
+                 where_ + ": " + (line > 0 ? "line " + std::to_string(line) + ": " : "") + what};
+  }
 
-  // Pass 1: the flat key/value pairs, in order.
+  // Pass 1: the pairs, in order; the profile settings among them in file order.
+  Status read(std::string_view text) {
+    for (const text::KeyValueLine& l : text::key_value_lines(text)) {
+      if (Status st = add(l); !st) return st;
+    }
+    return ok_status();
+  }
+
+  // Pass 2: every key is one the library knows, a setting or the URDF's (description/...).
+  Status check_keys() const {
+    std::vector<std::string> known = {"model", "display_name", "protocol"};
+    for (const NumberKey& n : kNumberKeys)
+      known.emplace_back(n.key);
+    for (const auto& [key, entry] : entries_) {
+      if (key.rfind("description/", 0) == 0) continue;
+      const bool is_setting = kProtocolSettingNames.parse(key).has_value();
+      if (!is_setting && std::find(known.begin(), known.end(), key) == known.end()) {
+        return fail(entry.line, "unknown key '" + key + "' (valid: " + join(known) +
+                                    ", a protocol setting, or description/...)");
+      }
+    }
+    return ok_status();
+  }
+
   struct Entry {
     std::string value;
     std::size_t line;
   };
-  std::map<std::string, Entry, std::less<>> entries;
-  std::vector<std::string> setting_order;  // profile settings in file order
-  std::size_t line_no = 0;
-  std::size_t pos = 0;
-  while (pos <= text.size()) {
-    const std::size_t nl = text.find('\n', pos);
-    std::string_view line =
-        text.substr(pos, nl == std::string_view::npos ? std::string_view::npos : nl - pos);
-    pos = nl == std::string_view::npos ? text.size() + 1 : nl + 1;
-    ++line_no;
-    if (const auto hash = line.find('#'); hash != std::string_view::npos) {
-      line = line.substr(0, hash);
+  std::optional<Entry> find(const std::string& key) const {
+    const auto it = entries_.find(key);
+    if (it == entries_.end()) return std::nullopt;
+    return it->second;
+  }
+  Result<Entry> required(const std::string& key) const {
+    auto e = find(key);
+    if (!e) return fail(0, key + ": missing");
+    return *e;
+  }
+  const std::vector<std::string>& settings() const { return settings_; }
+
+ private:
+  Status add(const text::KeyValueLine& l) {
+    if (l.indented) {
+      return fail(l.line, "not flat: a model file has one 'key: value' per line, no nesting");
     }
-    if (trim(line).empty()) continue;
-    if (line.front() == ' ' || line.front() == '\t' || line.front() == '-') {
-      return fail(line_no, "not flat: a model file has one 'key: value' per line, no nesting");
-    }
-    const auto colon = line.find(':');
-    if (colon == std::string_view::npos) return fail(line_no, "expected 'key: value'");
-    const std::string key(trim(line.substr(0, colon)));
-    std::string value(trim(line.substr(colon + 1)));
-    if (!valid_key(key)) return fail(line_no, "'" + key + "' is not a key");
+    if (!l.colon) return fail(l.line, "expected 'key: value'");
+    const std::string key(l.key);
+    std::string value(l.value);
+    if (!valid_key(key)) return fail(l.line, "'" + key + "' is not a key");
     if (value.size() >= 2 && (value.front() == '"' || value.front() == '\'') &&
         value.back() == value.front()) {
       value = value.substr(1, value.size() - 2);
     }
-    if (value.empty()) return fail(line_no, key + ": no value (nesting is not allowed)");
-    if (entries.count(key) != 0) {
-      return fail(line_no, key + ": given twice (first on line " +
-                               std::to_string(entries.find(key)->second.line) + ")");
+    if (value.empty()) return fail(l.line, key + ": no value (nesting is not allowed)");
+    if (const auto first = find(key)) {
+      return fail(l.line,
+                  key + ": given twice (first on line " + std::to_string(first->line) + ")");
     }
-    entries.emplace(key, Entry{value, line_no});
-    for (const ProfileSetting& s : profile_settings()) {
-      if (s.name == key) setting_order.push_back(key);
-    }
+    entries_.emplace(key, Entry{value, l.line});
+    if (kProtocolSettingNames.parse(key)) settings_.push_back(key);
+    return ok_status();
   }
 
-  // Pass 2: the keys the library knows.
-  static const std::vector<std::string> kNumberKeys = {
-      "wheelbase",
-      "track",
-      "wheel_radius",
-      "max_linear_speed",
-      "max_speed_at_large_steering",
-      "max_ackermann_steering",
-      "max_oblique_steering",
-      "max_spin_wheel_speed",
-  };
-  std::vector<std::string> known = {"model", "display_name", "protocol"};
-  known.insert(known.end(), kNumberKeys.begin(), kNumberKeys.end());
-  for (const auto& [key, entry] : entries) {
-    if (key.rfind("description/", 0) == 0) continue;  // the URDF's
-    const bool is_setting =
-        std::find(setting_order.begin(), setting_order.end(), key) != setting_order.end();
-    if (!is_setting && std::find(known.begin(), known.end(), key) == known.end()) {
-      return fail(entry.line, "unknown key '" + key + "' (valid: " + join(known) +
-                                  ", a protocol setting, or description/...)");
-    }
-  }
-  auto text_of = [&](const std::string& key) -> std::optional<Entry> {
-    const auto it = entries.find(key);
-    if (it == entries.end()) return std::nullopt;
-    return it->second;
-  };
-  auto required = [&](const std::string& key) -> Result<Entry> {
-    auto e = text_of(key);
-    if (!e) return fail(0, key + ": missing");
-    return *e;
-  };
+  std::string where_;
+  std::map<std::string, Entry, std::less<>> entries_;
+  std::vector<std::string> settings_;  // profile settings in file order
+};
+
+}  // namespace
+
+Result<ModelPreset> parse_model(std::string_view text, std::string_view origin) {
+  ModelFile file(origin);
+  if (Status st = file.read(text); !st) return st.error();
+  if (Status st = file.check_keys(); !st) return st.error();
 
   ModelPreset m;
-  auto name = required("model");
+  auto name = file.required("model");
   if (!name) return name.error();
   m.name = name->value;
-  m.display_name = text_of("display_name") ? text_of("display_name")->value : m.name;
-  std::map<std::string, double> numbers;
-  for (const std::string& key : kNumberKeys) {
-    auto e = required(key);
+  const auto display_name = file.find("display_name");
+  m.display_name = display_name ? display_name->value : m.name;
+  for (const NumberKey& n : kNumberKeys) {
+    auto e = file.required(n.key);
     if (!e) return e.error();
-    auto v = parse_double(key, e->value);
-    if (!v) return fail(e->line, v.error().message);
-    numbers[key] = *v;
+    auto v = parse_double(n.key, e->value);
+    if (!v) return file.fail(e->line, v.error().message);
+    n.field(m) = *v;
   }
-  m.geometry.wheelbase = numbers["wheelbase"];
-  m.geometry.track = numbers["track"];
-  m.geometry.wheel_radius = numbers["wheel_radius"];
-  m.limits.max_linear_speed = numbers["max_linear_speed"];
-  m.limits.max_speed_at_large_steering = numbers["max_speed_at_large_steering"];
-  m.limits.max_ackermann_steering = numbers["max_ackermann_steering"];
-  m.limits.max_oblique_steering = numbers["max_oblique_steering"];
-  m.limits.max_spin_wheel_speed = numbers["max_spin_wheel_speed"];
-  if (Status st = m.geometry.validate(); !st) return fail(0, st.error().message);
-  if (Status st = m.limits.validate(); !st) return fail(0, st.error().message);
+  if (Status st = m.geometry.validate(); !st) return file.fail(0, st.error().message);
+  if (Status st = m.limits.validate(); !st) return file.fail(0, st.error().message);
 
-  auto protocol = required("protocol");
+  auto protocol = file.required("protocol");
   if (!protocol) return protocol.error();
   m.protocol = protocol->value;
-  for (const std::string& key : setting_order)
-    m.settings.emplace_back(key, entries.find(key)->second.value);
+  for (const std::string& key : file.settings())
+    m.settings.emplace_back(key, file.find(key)->value);
   auto profile = model_profile(m, m.protocol);
   if (!profile) {
     // Name the line: either the preset or one setting is bad.
     std::size_t line = protocol->line;
     for (const auto& [key, value] : m.settings) {
       ProtocolProfile scratch;
-      if (!set_setting(scratch, key, value)) line = entries.find(key)->second.line;
+      if (!set_setting(scratch, key, value)) line = file.find(key)->line;
     }
-    return fail(line, profile.error().message);
+    return file.fail(line, profile.error().message);
   }
   m.profile = *profile;
   return m;

@@ -15,13 +15,8 @@ using protocol::MotionMode;
 
 }  // namespace
 
-std::string_view to_string(OdometrySource s) {
-  return s == OdometrySource::kMotion ? "motion" : "wheels";
-}
-
 Result<OdometrySource> parse_odometry_source(std::string_view text) {
-  if (text == "wheels") return OdometrySource::kWheels;
-  if (text == "motion") return OdometrySource::kMotion;
+  if (const auto source = kOdometrySourceNames.parse(text)) return *source;
   return Error{Errc::kInvalidArgument,
                "odometry source '" + std::string(text) + "' is neither 'wheels' nor 'motion'"};
 }

@@ -2,10 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
+#include <iterator>
 #include <variant>
 
 #include "ranger_can/control/kinematics.hpp"
+#include "ranger_can/text.hpp"
 #include "ranger_can/wire/codec.hpp"
 #include "ranger_can/wire/interpretation.hpp"
 
@@ -13,30 +14,59 @@ namespace ranger {
 namespace {
 
 using protocol::MotionMode;
-constexpr double kDeg = M_PI / 180.0;
-
-std::string deg(double rad) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.2f deg", rad / kDeg);
-  return buf;
-}
-std::string num(const char* f, double v) {
-  char buf[48];
-  std::snprintf(buf, sizeof buf, f, v);
-  return buf;
-}
+using text::degrees;
+using text::format;
+using S = ProtocolSetting;
 
 // The other value of a two-valued setting, as text ("left_positive" for "right_positive").
-std::string other_value(const ProtocolProfile& profile, const std::string& name) {
-  const Result<std::string> now = get_setting(profile, name);
-  for (const ProfileSetting& s : profile_settings()) {
-    if (s.name != name) continue;
-    for (std::string_view v : s.values) {
-      if (!now || v != *now) return std::string(v);
-    }
+std::string other_value(const ProtocolProfile& profile, ProtocolSetting setting) {
+  const Result<std::string> now = get_setting(profile, setting);
+  for (std::string_view v : profile_setting(setting).values) {
+    if (!now || v != *now) return std::string(v);
   }
   return "?";
 }
+
+// A finding that names `setting` and its other value.
+PlausibilityFinding finding(std::string check, ProtocolSetting setting,
+                            const ProtocolProfile& profile, std::string detail) {
+  PlausibilityFinding x;
+  x.check = std::move(check);
+  x.setting = std::string(to_string(setting));
+  x.try_value = other_value(profile, setting);
+  x.detail = std::move(detail);
+  return x;
+}
+
+// What a steering mismatch says and which setting it suspects (`or_setting`: a second suspect
+// the evidence cannot tell from the first). The text is `before`, then (with `how`) "several
+// times more/less", then `after`.
+struct MismatchText {
+  SteeringMismatch mismatch;
+  ProtocolSetting setting;
+  std::optional<ProtocolSetting> or_setting;
+  const char* before;
+  bool how;
+  const char* after;
+};
+constexpr MismatchText kMismatchTexts[] = {
+    {SteeringMismatch::kSign111, S::kSteeringSign111, std::nullopt,
+     "the wheels turned the other way (0x221 agrees with them)", false, ""},
+    {SteeringMismatch::kSign271, S::kSteeringSign271, std::nullopt,
+     "0x271 shows the other way, 0x221 the commanded one", false, ""},
+    {SteeringMismatch::kSign111Or271, S::kSteeringSign111, S::kSteeringSign271,
+     "the wheels turned the other way", false, ""},
+    {SteeringMismatch::kUnit111, S::kSteeringUnit111, std::nullopt, "the wheels steered ", true,
+     " than asked (0x221 agrees with them)"},
+    {SteeringMismatch::kUnit271, S::kSteeringUnit271, std::nullopt, "0x271 shows ", true,
+     " than asked, 0x221 what was asked"},
+    {SteeringMismatch::kUnit111Or271, S::kSteeringUnit111, S::kSteeringUnit271,
+     "the wheels steered ", true, " than asked"},
+    {SteeringMismatch::kSign221, S::kSteeringSign221, std::nullopt, "0x221 reports the other way",
+     false, ""},
+    {SteeringMismatch::kUnit221, S::kSteeringUnit221, std::nullopt,
+     "0x221 reports several times more or less", false, ""},
+};
 
 bool steerable(MotionMode m) {
   return m == MotionMode::kAckermann || m == MotionMode::kOblique;
@@ -89,7 +119,8 @@ ReferenceJudgement judge_reference(const std::array<double, kWheelCount>& measur
     j.error_other = std::max(j.error_other, std::fabs(measured[i] - other[i]));
     j.gap = std::max(j.gap, std::fabs(ours[i] - other[i]));
   }
-  j.other_fits = j.error >= 0.5 * j.gap && j.error_other <= 0.3 * j.gap && j.error >= 0.15 * kDeg;
+  j.other_fits =
+      j.error >= 0.5 * j.gap && j.error_other <= 0.3 * j.gap && j.error >= deg_to_rad(0.15);
   return j;
 }
 
@@ -196,11 +227,10 @@ void PlausibilityMonitor::on_frame(const CanFrame& frame, Timestamp now) {
     byte7_ = b7;
     if (byte7_steps_ >= 10 && byte7_increments_ * 10 >= byte7_steps_ * 9) {
       hold(counter_,
-           {"error_word", "error_word", "agx16",
-            "0x211 byte 7 rises by one per frame (" + std::to_string(byte7_increments_) + " of " +
-                std::to_string(byte7_steps_) +
-                "): a counter, read as phantom motor faults under manual32",
-            false, now},
+           finding("error_word", S::kErrorWord, profile_,
+                   "0x211 byte 7 rises by one per frame (" + std::to_string(byte7_increments_) +
+                       " of " + std::to_string(byte7_steps_) +
+                       "): a counter, read as phantom motor faults under manual32"),
            now, {}, {});
     } else if (byte7_steps_ >= 10) {
       counter_.clear();
@@ -218,9 +248,9 @@ void PlausibilityMonitor::on_frame(const CanFrame& frame, Timestamp now) {
     const double tol = std::max(2.0, 0.05 * ref);
     if (std::fabs(v - ref) > tol && std::fabs(v_other - ref) <= tol) {
       hold(bms_,
-           {"bms_voltage", "bms_voltage_scale", other_value(profile_, "bms_voltage_scale"),
-            "0x361 reads " + num("%.2f", v) + " V where 0x211 reports " + num("%.1f", ref) + " V",
-            false, now},
+           finding("bms_voltage", S::kBmsVoltageScale, profile_,
+                   "0x361 reads " + format("%.2f", v) + " V where 0x211 reports " +
+                       format("%.1f", ref) + " V"),
            now, {}, {});
     } else {
       bms_.clear();
@@ -234,14 +264,11 @@ void PlausibilityMonitor::on_rejected(const CanFrame& frame, Errc code, Timestam
   if (frame.id != out_of_range_id_) out_of_range_ = 0;
   out_of_range_id_ = frame.id;
   if (++out_of_range_ < config_.out_of_range_frames) return;
-  const std::string setting =
-      frame.id == protocol::kSteeringAnglesId ? "steering_unit_271" : "steering_unit_221";
+  const bool is_271 = frame.id == protocol::kSteeringAnglesId;
   hold(range_,
-       {"steering_unit", setting, other_value(profile_, setting),
-        std::to_string(out_of_range_) + " frames of " +
-            (frame.id == protocol::kSteeringAnglesId ? std::string("0x271") : "0x221") +
-            " in a row read as beyond 100 deg",
-        false, now},
+       finding("steering_unit", is_271 ? S::kSteeringUnit271 : S::kSteeringUnit221, profile_,
+               std::to_string(out_of_range_) + " frames of " + (is_271 ? "0x271" : "0x221") +
+                   " in a row read as beyond 100 deg"),
        now, {}, {});
   range_.finding->since = now - range_.stop_after;  // the run itself was the persistence
 }
@@ -281,7 +308,8 @@ void PlausibilityMonitor::check_steering(Timestamp now, const ControllerState& c
     reference_.clear();
     return;
   }
-  if (!steer_cmd_ || steer_mode_ != mode || std::fabs(cmd.steering_angle - *steer_cmd_) > kDeg) {
+  if (!steer_cmd_ || steer_mode_ != mode ||
+      std::fabs(cmd.steering_angle - *steer_cmd_) > kRadPerDeg) {
     steer_cmd_ = cmd.steering_angle;
     steer_mode_ = mode;
     steer_since_ = now;
@@ -332,57 +360,19 @@ void PlausibilityMonitor::check_steering(Timestamp now, const ControllerState& c
   }
   reference_.clear();
   // The finding's text (built only now: this check runs at every driver step).
-  const std::string how = j.more ? "several times more" : "several times less";
-  std::string what, setting;
-  switch (j.mismatch) {
-    case SteeringMismatch::kNone:
-      return;
-    case SteeringMismatch::kSign111:
-      what = "the wheels turned the other way (0x221 agrees with them)";
-      setting = "steering_sign_111";
-      break;
-    case SteeringMismatch::kSign271:
-      what = "0x271 shows the other way, 0x221 the commanded one";
-      setting = "steering_sign_271";
-      break;
-    case SteeringMismatch::kSign111Or271:
-      what = "the wheels turned the other way";
-      setting = "steering_sign_111";
-      break;
-    case SteeringMismatch::kUnit111:
-      what = "the wheels steered " + how + " than asked (0x221 agrees with them)";
-      setting = "steering_unit_111";
-      break;
-    case SteeringMismatch::kUnit271:
-      what = "0x271 shows " + how + " than asked, 0x221 what was asked";
-      setting = "steering_unit_271";
-      break;
-    case SteeringMismatch::kUnit111Or271:
-      what = "the wheels steered " + how + " than asked";
-      setting = "steering_unit_111";
-      break;
-    case SteeringMismatch::kSign221:
-      what = "0x221 reports the other way";
-      setting = "steering_sign_221";
-      break;
-    case SteeringMismatch::kUnit221:
-      what = "0x221 reports several times more or less";
-      setting = "steering_unit_221";
-      break;
-  }
-  PlausibilityFinding x;
-  x.check = "steering";
-  x.setting = setting;
-  x.try_value = other_value(profile_, setting);
-  if (j.mismatch == SteeringMismatch::kSign111Or271) {
-    x.setting = "steering_sign_111 or steering_sign_271";
-  } else if (j.mismatch == SteeringMismatch::kUnit111Or271) {
-    x.setting = "steering_unit_111 or steering_unit_271";
-  }
-  x.detail = what + ": commanded " + deg((wanted[kRightFront] + wanted[kLeftFront]) / 2) +
-             " at the front wheels, 0x271 shows " +
-             deg((measured[kRightFront] + measured[kLeftFront]) / 2) +
-             (s221 ? ", 0x221 scale " + num("%.2f", *s221) : std::string());
+  const MismatchText* m =
+      std::find_if(std::begin(kMismatchTexts), std::end(kMismatchTexts),
+                   [&](const MismatchText& t) { return t.mismatch == j.mismatch; });
+  if (m == std::end(kMismatchTexts)) return;
+  const std::string how = !m->how ? "" : j.more ? "several times more" : "several times less";
+  PlausibilityFinding x =
+      finding("steering", m->setting, profile_,
+              m->before + how + m->after + ": commanded " +
+                  degrees((wanted[kRightFront] + wanted[kLeftFront]) / 2) +
+                  " at the front wheels, 0x271 shows " +
+                  degrees((measured[kRightFront] + measured[kLeftFront]) / 2) +
+                  (s221 ? ", 0x221 scale " + format("%.2f", *s221) : std::string()));
+  if (m->or_setting) x.setting += " or " + std::string(to_string(*m->or_setting));
   hold(steering_, x, now, {}, {});
 }
 
@@ -399,13 +389,12 @@ void PlausibilityMonitor::check_reference(Timestamp now, const MotionCommand& cm
     reference_.clear();
     return;
   }
-  PlausibilityFinding x;
-  x.check = "steering_reference";
-  x.setting = "steering_reference";
-  x.try_value = other_value(profile_, "steering_reference");
-  x.detail = "the wheels stand as the other reading commands (off by " + deg(j.error) + ", the " +
-             x.try_value + " reading by " + deg(j.error_other) + ")";
-  hold(reference_, x, now, {}, {});
+  const std::string other_reading = other_value(profile_, S::kSteeringReference);
+  hold(reference_,
+       finding("steering_reference", S::kSteeringReference, profile_,
+               "the wheels stand as the other reading commands (off by " + degrees(j.error) +
+                   ", the " + other_reading + " reading by " + degrees(j.error_other) + ")"),
+       now, {}, {});
 }
 
 void PlausibilityMonitor::check_yaw(Timestamp now, const ControllerState& c,
@@ -425,22 +414,23 @@ void PlausibilityMonitor::check_yaw(Timestamp now, const ControllerState& c,
   ++status_.checks;
   const double wz = odo.twist.wz;
   const MotionMode mode = *c.motion_mode;
-  PlausibilityFinding x;
-  x.check = "yaw";
+  ProtocolSetting setting;
+  std::string what;
   if (wz * wz_cmd < 0 && std::fabs(wz) >= 0.3 * std::fabs(wz_cmd)) {
-    x.setting = mode == MotionMode::kSpin ? "spin_sign" : "steering_sign_111";
-    x.detail = "turns the other way: ";
+    setting = mode == MotionMode::kSpin ? S::kSpinSign : S::kSteeringSign111;
+    what = "turns the other way: ";
   } else if (mode == MotionMode::kSpin && std::fabs(wz) < 0.1 * std::fabs(wz_cmd)) {
-    x.setting = "spin_field";
-    x.detail = "nothing turns: ";
+    setting = S::kSpinField;
+    what = "nothing turns: ";
   } else {
     yaw_.clear();
     return;
   }
-  x.detail +=
-      "commanded " + num("%.2f", wz_cmd) + " rad/s, the wheels show " + num("%.2f", wz) + " rad/s";
-  x.try_value = other_value(profile_, x.setting);
-  hold(yaw_, x, now, {}, {});
+  hold(yaw_,
+       finding("yaw", setting, profile_,
+               what + "commanded " + format("%.2f", wz_cmd) + " rad/s, the wheels show " +
+                   format("%.2f", wz) + " rad/s"),
+       now, {}, {});
 }
 
 void PlausibilityMonitor::check_speed(Timestamp now, const ControllerState& c,
@@ -478,13 +468,12 @@ void PlausibilityMonitor::check_speed(Timestamp now, const ControllerState& c,
     speed_.clear();
     return;
   }
-  PlausibilityFinding x;
-  x.check = "feedback_speed";
-  x.setting = "feedback_speed";
-  x.try_value = other_value(profile_, "feedback_speed");
-  x.detail = "0x221 reports " + num("%.3f", reported) + " m/s while turning: the wheels' mean " +
-             num("%.3f", mean) + " m/s, the body centre's " + num("%.3f", t.vx) + " m/s";
-  hold(speed_, x, now, {}, {});
+  hold(speed_,
+       finding("feedback_speed", S::kFeedbackSpeed, profile_,
+               "0x221 reports " + format("%.3f", reported) +
+                   " m/s while turning: the wheels' mean " + format("%.3f", mean) +
+                   " m/s, the body centre's " + format("%.3f", t.vx) + " m/s"),
+       now, {}, {});
 }
 
 void PlausibilityMonitor::check_rigid(Timestamp now, const ChassisFeedback& fb) {
@@ -550,11 +539,12 @@ void PlausibilityMonitor::check_rigid(Timestamp now, const ChassisFeedback& fb) 
   x.check = "rigid_body";
   std::string settings, values;
   if (units[best_h / 2] != profile_.steering_unit_271) {
-    settings = "steering_unit_271";
+    settings = std::string(to_string(S::kSteeringUnit271));
     values = std::string(to_string(units[best_h / 2]));
   }
   if (signs[best_h % 2] != profile_.steering_sign_271) {
-    settings += std::string(settings.empty() ? "" : " and ") + "steering_sign_271";
+    settings +=
+        std::string(settings.empty() ? "" : " and ") + std::string(to_string(S::kSteeringSign271));
     values +=
         std::string(values.empty() ? "" : " and ") + std::string(to_string(signs[best_h % 2]));
   }
@@ -562,7 +552,7 @@ void PlausibilityMonitor::check_rigid(Timestamp now, const ChassisFeedback& fb) 
   x.try_value = values;
   x.detail =
       "the wheels' angles and speeds are no rigid-body motion under the settings (residual " +
-      num("%.3f", ours) + "), they are under " + values + " (" + num("%.3f", best) +
+      format("%.3f", ours) + "), they are under " + values + " (" + format("%.3f", best) +
       "); check the 0x111 steering settings with them";
   hold(rigid_, x, now, {}, {});
 }

@@ -2,39 +2,12 @@
 
 namespace ranger {
 
-namespace {
-constexpr StopCause kAllCauses[] = {StopCause::kLinkLost,   StopCause::kRemote,
-                                    StopCause::kEstop,      StopCause::kCriticalError,
-                                    StopCause::kLowBattery, StopCause::kModeSwitchFailed,
-                                    StopCause::kImplausible};
-}  // namespace
-
-std::string_view to_string(StopCause c) {
-  switch (c) {
-    case StopCause::kLinkLost:
-      return "link_lost";
-    case StopCause::kRemote:
-      return "remote";
-    case StopCause::kEstop:
-      return "emergency_stop";
-    case StopCause::kCriticalError:
-      return "critical_error";
-    case StopCause::kLowBattery:
-      return "low_battery";
-    case StopCause::kModeSwitchFailed:
-      return "motion_mode_switch_failed";
-    case StopCause::kImplausible:
-      return "implausible_feedback";
-  }
-  return "unknown";
-}
-
 std::string describe(StopCauses causes) {
   std::string out;
-  for (StopCause c : kAllCauses) {
-    if (!has(causes, c)) continue;
+  for (const auto& [cause, name] : kStopCauseNames) {
+    if (!has(causes, cause)) continue;
     if (!out.empty()) out += ',';
-    out += to_string(c);
+    out += name;
   }
   return out;
 }

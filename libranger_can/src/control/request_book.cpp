@@ -141,38 +141,6 @@ constexpr Rule kRules[] = {
 
 }  // namespace
 
-std::string_view to_string(RequestOutcome::Kind k) {
-  switch (k) {
-    case Kind::kClearErrors:
-      return "clear_errors";
-    case Kind::kUltrasonic:
-      return "ultrasonic";
-    case Kind::kResume:
-      return "resume";
-    case Kind::kLights:
-      return "lights";
-    case Kind::kPark:
-      return "park";
-    case Kind::kFirmwareVersion:
-      return "firmware_version";
-  }
-  return "unknown";
-}
-
-std::string_view to_string(RequestOutcome::State s) {
-  switch (s) {
-    case State::kPending:
-      return "pending";
-    case State::kSent:
-      return "sent";
-    case State::kAnswered:
-      return "answered";
-    case State::kFailed:
-      return "failed";
-  }
-  return "unknown";
-}
-
 std::uint64_t RequestBook::add(RequestOutcome::Kind kind, std::string what, bool on,
                                const LightsRequest& lights) {
   std::lock_guard<std::mutex> lock(mutex_);

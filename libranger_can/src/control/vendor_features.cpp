@@ -26,34 +26,6 @@ bool same_light(protocol::LightMode m1, std::uint8_t b1, protocol::LightMode m2,
 
 }  // namespace
 
-std::string_view to_string(VendorFrames v) {
-  switch (v) {
-    case VendorFrames::kUnknown:
-      return "unknown";
-    case VendorFrames::kPresent:
-      return "present";
-    case VendorFrames::kAbsent:
-      return "absent";
-  }
-  return "unknown";
-}
-
-std::string_view to_string(FirmwareVersion::State s) {
-  switch (s) {
-    case FirmwareVersion::State::kNotAsked:
-      return "not_asked";
-    case FirmwareVersion::State::kAsked:
-      return "asked";
-    case FirmwareVersion::State::kAnswered:
-      return "answered";
-    case FirmwareVersion::State::kUnanswered:
-      return "unanswered";
-    case FirmwareVersion::State::kUnsupported:
-      return "unsupported";
-  }
-  return "unknown";
-}
-
 RemoteState remote_state_from(const RemoteControlState& rc, Timestamp received) {
   RemoteState r;
   r.swa = rc.swa;

@@ -2,8 +2,6 @@
 
 #include <cctype>
 #include <cmath>
-#include <cstdio>
-#include <sstream>
 #include <vector>
 
 #include "ranger_can/parse.hpp"
@@ -41,17 +39,23 @@ const char* const kChassisCommandHelp =
 
 namespace {
 
-std::vector<std::string> split(std::string_view line) {
-  std::vector<std::string> words;
-  std::istringstream in{std::string(line)};
-  std::string w;
-  while (in >> w)
-    words.push_back(w);
-  return words;
-}
+using Words = std::vector<std::string>;
+using protocol::RemoteSwitch;
+
+// The remote's switch positions as the chassis language names them (SWC alone has a middle).
+constexpr auto kLeverNames = text::enum_names<RemoteSwitch>({
+    {RemoteSwitch::kUp, "top"},
+    {RemoteSwitch::kMiddle, "middle"},
+    {RemoteSwitch::kDown, "bottom"},
+});
 
 Error usage(const std::string& what) {
   return Error{Errc::kInvalidArgument, what};
+}
+
+Status need(const Words& w, std::size_t n, const std::string& form) {
+  if (w.size() != n) return usage("usage: " + form);
+  return ok_status();
 }
 
 Result<bool> parse_on_off(const std::string& command, const std::string& word) {
@@ -60,11 +64,181 @@ Result<bool> parse_on_off(const std::string& command, const std::string& word) {
   return usage(command + ": expected 'on' or 'off', got '" + word + "'");
 }
 
-std::string fixed(double v, int decimals) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  return buf;
+// Wraps a chassis call that prints nothing.
+ChassisAction act(std::function<void(VirtualChassis&)> f) {
+  return ChassisAction([f = std::move(f)](VirtualChassis& c) {
+    f(c);
+    return std::string();
+  });
 }
+
+// `command on|off`, calling `set` with the flag.
+Result<ChassisAction> on_off_action(const Words& w, void (VirtualChassis::*set)(bool)) {
+  if (auto s = need(w, 2, w[0] + " on|off"); !s) return s.error();
+  auto on = parse_on_off(w[0], w[1]);
+  if (!on) return on.error();
+  return act([set, on = *on](VirtualChassis& c) { (c.*set)(on); });
+}
+
+// ---- one parser per command ----
+
+Result<ChassisAction> parse_sticks(const Words& w) {
+  if (auto s = need(w, 4, "remote sticks LEFT RIGHT (each -1..1)"); !s) return s.error();
+  auto left = parse_double_in("remote sticks LEFT", w[2], -1.0, 1.0);
+  if (!left) return left.error();
+  auto right = parse_double_in("remote sticks RIGHT", w[3], -1.0, 1.0);
+  if (!right) return right.error();
+  return act([l = *left, r = *right](VirtualChassis& c) { c.set_remote_sticks(l, r); });
+}
+
+Result<ChassisAction> parse_lever(const Words& w) {
+  const bool three = w[1] == "swc";
+  const std::string form = "remote " + w[1] + (three ? " top|middle|bottom" : " top|bottom");
+  if (auto s = need(w, 3, form); !s) return s.error();
+  const auto position = kLeverNames.parse(w[2]);
+  if (!position || (*position == RemoteSwitch::kMiddle && !three)) {
+    return usage(form + ": unknown position '" + w[2] + "'");
+  }
+  void (VirtualChassis::*set)(RemoteSwitch) = w[1] == "swa"   ? &VirtualChassis::set_remote_swa
+                                              : w[1] == "swc" ? &VirtualChassis::set_remote_swc
+                                                              : &VirtualChassis::set_remote_swd;
+  return act([set, p = *position](VirtualChassis& c) { (c.*set)(p); });
+}
+
+Result<ChassisAction> parse_remote(const Words& w, std::string_view) {
+  if (w.size() >= 2 && w[1] == "sticks") return parse_sticks(w);
+  if (w.size() >= 2 && (w[1] == "swa" || w[1] == "swc" || w[1] == "swd")) return parse_lever(w);
+  if (auto s = need(w, 2, "remote on|can|off|lost|swa|swc|swd|sticks ..."); !s) return s.error();
+  if (w[1] == "on") return act([](VirtualChassis& c) { c.remote_takeover(); });
+  if (w[1] == "can") return act([](VirtualChassis& c) { c.remote_hand_back(false); });
+  if (w[1] == "off") return act([](VirtualChassis& c) { c.remote_hand_back(true); });
+  if (w[1] == "lost") return act([](VirtualChassis& c) { c.remote_signal_lost(); });
+  return usage("remote: expected on|can|off|lost|swa|swc|swd|sticks, got '" + w[1] + "'");
+}
+
+Result<ChassisAction> parse_estop(const Words& w, std::string_view) {
+  return on_off_action(w, &VirtualChassis::set_emergency_stop);
+}
+
+Result<ChassisAction> parse_error(const Words& w, std::string_view) {
+  if (w.size() != 2 && w.size() != 3) return usage("usage: error BIT|NAME [on|off]");
+  if (auto bit = check_error_bit(w[1]); !bit) return bit.error();
+  bool on = true;
+  if (w.size() == 3) {
+    auto v = parse_on_off(w[0], w[2]);
+    if (!v) return v.error();
+    on = *v;
+  }
+  // The bit of the name in the chassis's own layout.
+  return ChassisAction([name = w[1], on](VirtualChassis& c) -> std::string {
+    const auto bit = parse_error_bit(name, c.profile().error_word);
+    if (!bit) return bit.error().message;
+    c.set_error_bit(*bit, on);
+    return "";
+  });
+}
+
+Result<ChassisAction> parse_clear(const Words& w, std::string_view) {
+  if (w.size() > 2) return usage("usage: clear [CODE]");
+  std::int64_t code = 0;
+  if (w.size() == 2) {
+    auto c = parse_integer("clear CODE", w[1], 0, protocol::kMaxErrorClearCode);
+    if (!c) return c.error();
+    code = *c;
+  }
+  return act([code](VirtualChassis& c) { c.clear_errors(static_cast<std::uint8_t>(code)); });
+}
+
+Result<ChassisAction> parse_battery(const Words& w, std::string_view) {
+  if (auto s = need(w, 2, "battery PCT"); !s) return s.error();
+  auto pct = parse_double_in("battery PCT", w[1], 0.0, 100.0);
+  if (!pct) return pct.error();
+  return act([pct = *pct](VirtualChassis& c) { c.set_battery_soc(pct); });
+}
+
+Result<ChassisAction> parse_silent(const Words& w, std::string_view) {
+  if (auto s = need(w, 2, "silent SEC|on|off"); !s) return s.error();
+  if (w[1] == "on" || w[1] == "off") {
+    return act([on = w[1] == "on"](VirtualChassis& c) { c.set_silent(on); });
+  }
+  auto sec = parse_double_in("silent SEC", w[1], 0.0, 86400.0);
+  if (!sec) return sec.error();
+  return act([d = from_seconds(*sec)](VirtualChassis& c) { c.silence_for(d); });
+}
+
+Result<ChassisAction> parse_garbage(const Words& w, std::string_view) {
+  if (auto s = need(w, 2, "garbage N"); !s) return s.error();
+  auto n = parse_integer("garbage N", w[1], 1, 100000);
+  if (!n) return n.error();
+  return act([n = static_cast<int>(*n)](VirtualChassis& c) { c.inject_garbage(n); });
+}
+
+Result<ChassisAction> parse_stuck(const Words& w, std::string_view) {
+  return on_off_action(w, &VirtualChassis::set_mode_switch_stuck);
+}
+
+Result<ChassisAction> parse_ultrasonic(const Words& w, std::string_view) {
+  if (w.size() == 2) {
+    auto on = parse_on_off(w[0], w[1]);
+    if (!on) return on.error();
+    return act([on = *on](VirtualChassis& c) { c.set_ultrasonic_enabled(on); });
+  }
+  if (w.size() != 3) return usage("usage: ultrasonic N|all MM  or  ultrasonic on|off");
+  auto mm = parse_integer("ultrasonic MM", w[2], -4, 32767);
+  if (!mm) return mm.error();
+  const auto raw = static_cast<std::int16_t>(*mm);
+  if (w[1] == "all") {
+    return act([raw](VirtualChassis& c) {
+      for (int n = 1; n <= protocol::kUltrasonicCount; ++n)
+        c.set_ultrasonic(n, raw);
+    });
+  }
+  auto n = parse_integer("ultrasonic N", w[1], 1, protocol::kUltrasonicCount);
+  if (!n) return n.error();
+  return act([n = static_cast<int>(*n), raw](VirtualChassis& c) { c.set_ultrasonic(n, raw); });
+}
+
+Result<ChassisAction> parse_version(const Words&, std::string_view line) {
+  // The rest of the line, as typed (inner spaces kept).
+  const std::string text(text::trim(line.substr(line.find("version") + 7)));
+  if (text.empty()) return usage("usage: version TEXT");
+  if (text.size() > 64) return usage("version: at most 64 characters");
+  for (char ch : text) {
+    if (static_cast<unsigned char>(ch) < 0x20 || static_cast<unsigned char>(ch) > 0x7E) {
+      return usage("version: printable ASCII only");
+    }
+  }
+  return act([text](VirtualChassis& c) { c.set_version(text); });
+}
+
+Result<ChassisAction> parse_pose(const Words& w, std::string_view) {
+  if (auto s = need(w, 4, "pose X Y YAW"); !s) return s.error();
+  auto x = parse_double("pose X", w[1]);
+  if (!x) return x.error();
+  auto y = parse_double("pose Y", w[2]);
+  if (!y) return y.error();
+  auto yaw = parse_double("pose YAW", w[3]);
+  if (!yaw) return yaw.error();
+  return act([p = Pose2D{*x, *y, wrap_angle(*yaw)}](VirtualChassis& c) { c.set_pose(p); });
+}
+
+Result<ChassisAction> parse_status(const Words& w, std::string_view) {
+  if (auto s = need(w, 1, "status"); !s) return s.error();
+  return ChassisAction(
+      [](VirtualChassis& c) { return describe_chassis(c.snapshot(), c.profile().error_word); });
+}
+
+// The commands, in the order help and messages list them.
+struct Command {
+  std::string_view word;
+  Result<ChassisAction> (*parse)(const Words& w, std::string_view line);
+};
+const Command kCommands[] = {
+    {"remote", parse_remote},   {"estop", parse_estop},     {"error", parse_error},
+    {"clear", parse_clear},     {"battery", parse_battery}, {"silent", parse_silent},
+    {"garbage", parse_garbage}, {"stuck", parse_stuck},     {"ultrasonic", parse_ultrasonic},
+    {"pose", parse_pose},       {"version", parse_version}, {"status", parse_status},
+};
 
 }  // namespace
 
@@ -94,30 +268,28 @@ Result<int> check_error_bit(const std::string& text) {
 }
 
 std::string describe_chassis(const sim::ChassisSnapshot& s, ErrorWordLayout layout) {
+  using text::fixed;
   std::string out;
   out += "control " + std::string(protocol::to_string(s.control_mode));
   out += ", motion " + std::string(protocol::to_string(s.motion_mode));
   if (s.switching)
     out += " (switching to " + std::string(protocol::to_string(s.switch_target)) + ")";
   out += ", vehicle " + std::string(protocol::to_string(s.vehicle_status));
-  out +=
-      ", speed " + fixed(s.speed, 3) + ", steering " + fixed(s.steering * 180 / M_PI, 1) + " deg";
+  out += ", speed " + fixed(s.speed, 3) + ", steering " + fixed(rad_to_deg(s.steering), 1) + " deg";
   out += ", twist (" + fixed(s.twist.vx, 3) + ", " + fixed(s.twist.vy, 3) + ", " +
          fixed(s.twist.wz, 3) + ")";
   out += ", pose (" + fixed(s.pose.x, 3) + ", " + fixed(s.pose.y, 3) + ", " +
-         fixed(s.pose.yaw * 180 / M_PI, 1) + " deg)";
+         fixed(rad_to_deg(s.pose.yaw), 1) + " deg)";
   out += ", battery " + fixed(s.battery.soc, 1) + "% " + fixed(s.battery.voltage, 1) + " V";
   out += ", errors ";
   const auto names = protocol::error_bit_names(s.error_bits, layout);
   out += names.empty() ? "none" : text::join(names, ",");
   out += s.motion_allowed ? ", motion allowed" : ", motion refused: " + s.motion_refused_reason;
-  auto position = [](protocol::RemoteSwitch p) {
-    return p == protocol::RemoteSwitch::kUp     ? "top"
-           : p == protocol::RemoteSwitch::kDown ? "bottom"
-                                                : "middle";
+  auto position = [](RemoteSwitch p) {
+    return std::string(kLeverNames.contains(p) ? kLeverNames.name(p) : "middle");
   };
-  out += std::string(", remote SWA ") + position(s.remote.swa) + " SWC " + position(s.remote.swc) +
-         " SWD " + position(s.remote.swd) + " sticks (" + fixed(s.remote.left, 2) + ", " +
+  out += ", remote SWA " + position(s.remote.swa) + " SWC " + position(s.remote.swc) + " SWD " +
+         position(s.remote.swd) + " sticks (" + fixed(s.remote.left, 2) + ", " +
          fixed(s.remote.right, 2) + ")";
   out += ", lights " + describe_lights(s.lights);
   if (s.silent) out += ", SILENT";
@@ -125,170 +297,15 @@ std::string describe_chassis(const sim::ChassisSnapshot& s, ErrorWordLayout layo
 }
 
 Result<ChassisAction> parse_chassis_command(std::string_view line) {
-  const auto w = split(line);
-  if (w.empty() || w[0][0] == '#')
+  const auto w = text::split_words(line);
+  if (w.empty() || w[0][0] == '#') {
     return ChassisAction([](VirtualChassis&) { return std::string(); });
-  const std::string& cmd = w[0];
-  auto need = [&](std::size_t n, const char* form) -> Status {
-    if (w.size() != n) return usage("usage: " + std::string(form));
-    return ok_status();
-  };
-  // Wraps a chassis call that prints nothing.
-  auto act = [](std::function<void(VirtualChassis&)> f) {
-    return ChassisAction([f = std::move(f)](VirtualChassis& c) {
-      f(c);
-      return std::string();
-    });
-  };
-
-  if (cmd == "remote") {
-    if (w.size() >= 2 && w[1] == "sticks") {
-      if (auto s = need(4, "remote sticks LEFT RIGHT (each -1..1)"); !s) return s.error();
-      auto left = parse_double_in("remote sticks LEFT", w[2], -1.0, 1.0);
-      if (!left) return left.error();
-      auto right = parse_double_in("remote sticks RIGHT", w[3], -1.0, 1.0);
-      if (!right) return right.error();
-      return act([l = *left, r = *right](VirtualChassis& c) { c.set_remote_sticks(l, r); });
-    }
-    if (w.size() >= 2 && (w[1] == "swa" || w[1] == "swc" || w[1] == "swd")) {
-      const bool three = w[1] == "swc";
-      const std::string form = "remote " + w[1] + (three ? " top|middle|bottom" : " top|bottom");
-      if (auto s = need(3, form.c_str()); !s) return s.error();
-      protocol::RemoteSwitch position;
-      if (w[2] == "top") {
-        position = protocol::RemoteSwitch::kUp;
-      } else if (w[2] == "bottom") {
-        position = protocol::RemoteSwitch::kDown;
-      } else if (w[2] == "middle" && three) {
-        position = protocol::RemoteSwitch::kMiddle;
-      } else {
-        return usage(form + ": unknown position '" + w[2] + "'");
-      }
-      if (w[1] == "swa") return act([position](VirtualChassis& c) { c.set_remote_swa(position); });
-      if (w[1] == "swc") return act([position](VirtualChassis& c) { c.set_remote_swc(position); });
-      return act([position](VirtualChassis& c) { c.set_remote_swd(position); });
-    }
-    if (auto s = need(2, "remote on|can|off|lost|swa|swc|swd|sticks ..."); !s) return s.error();
-    if (w[1] == "on") return act([](VirtualChassis& c) { c.remote_takeover(); });
-    if (w[1] == "can") return act([](VirtualChassis& c) { c.remote_hand_back(false); });
-    if (w[1] == "off") return act([](VirtualChassis& c) { c.remote_hand_back(true); });
-    if (w[1] == "lost") return act([](VirtualChassis& c) { c.remote_signal_lost(); });
-    return usage("remote: expected on|can|off|lost|swa|swc|swd|sticks, got '" + w[1] + "'");
   }
-  if (cmd == "estop") {
-    if (auto s = need(2, "estop on|off"); !s) return s.error();
-    auto on = parse_on_off(cmd, w[1]);
-    if (!on) return on.error();
-    return act([on = *on](VirtualChassis& c) { c.set_emergency_stop(on); });
+  for (const Command& c : kCommands) {
+    if (w[0] == c.word) return c.parse(w, line);
   }
-  if (cmd == "error") {
-    if (w.size() != 2 && w.size() != 3) return usage("usage: error BIT|NAME [on|off]");
-    if (auto bit = check_error_bit(w[1]); !bit) return bit.error();
-    bool on = true;
-    if (w.size() == 3) {
-      auto v = parse_on_off(cmd, w[2]);
-      if (!v) return v.error();
-      on = *v;
-    }
-    // The bit of the name in the chassis's own layout.
-    return ChassisAction([name = w[1], on](VirtualChassis& c) -> std::string {
-      const auto bit = parse_error_bit(name, c.profile().error_word);
-      if (!bit) return bit.error().message;
-      c.set_error_bit(*bit, on);
-      return "";
-    });
-  }
-  if (cmd == "clear") {
-    if (w.size() > 2) return usage("usage: clear [CODE]");
-    std::int64_t code = 0;
-    if (w.size() == 2) {
-      auto c = parse_integer("clear CODE", w[1], 0, protocol::kMaxErrorClearCode);
-      if (!c) return c.error();
-      code = *c;
-    }
-    return act([code](VirtualChassis& c) { c.clear_errors(static_cast<std::uint8_t>(code)); });
-  }
-  if (cmd == "battery") {
-    if (auto s = need(2, "battery PCT"); !s) return s.error();
-    auto pct = parse_double_in("battery PCT", w[1], 0.0, 100.0);
-    if (!pct) return pct.error();
-    return act([pct = *pct](VirtualChassis& c) { c.set_battery_soc(pct); });
-  }
-  if (cmd == "silent") {
-    if (auto s = need(2, "silent SEC|on|off"); !s) return s.error();
-    if (w[1] == "on" || w[1] == "off") {
-      return act([on = w[1] == "on"](VirtualChassis& c) { c.set_silent(on); });
-    }
-    auto sec = parse_double_in("silent SEC", w[1], 0.0, 86400.0);
-    if (!sec) return sec.error();
-    return act([d = from_seconds(*sec)](VirtualChassis& c) { c.silence_for(d); });
-  }
-  if (cmd == "garbage") {
-    if (auto s = need(2, "garbage N"); !s) return s.error();
-    auto n = parse_integer("garbage N", w[1], 1, 100000);
-    if (!n) return n.error();
-    return act([n = static_cast<int>(*n)](VirtualChassis& c) { c.inject_garbage(n); });
-  }
-  if (cmd == "stuck") {
-    if (auto s = need(2, "stuck on|off"); !s) return s.error();
-    auto on = parse_on_off(cmd, w[1]);
-    if (!on) return on.error();
-    return act([on = *on](VirtualChassis& c) { c.set_mode_switch_stuck(on); });
-  }
-  if (cmd == "ultrasonic") {
-    if (w.size() == 2) {
-      auto on = parse_on_off(cmd, w[1]);
-      if (!on) return on.error();
-      return act([on = *on](VirtualChassis& c) { c.set_ultrasonic_enabled(on); });
-    }
-    if (w.size() != 3) return usage("usage: ultrasonic N|all MM  or  ultrasonic on|off");
-    auto mm = parse_integer("ultrasonic MM", w[2], -4, 32767);
-    if (!mm) return mm.error();
-    const auto raw = static_cast<std::int16_t>(*mm);
-    if (w[1] == "all") {
-      return act([raw](VirtualChassis& c) {
-        for (int n = 1; n <= protocol::kUltrasonicCount; ++n)
-          c.set_ultrasonic(n, raw);
-      });
-    }
-    auto n = parse_integer("ultrasonic N", w[1], 1, protocol::kUltrasonicCount);
-    if (!n) return n.error();
-    return act([n = static_cast<int>(*n), raw](VirtualChassis& c) { c.set_ultrasonic(n, raw); });
-  }
-  if (cmd == "version") {
-    // The rest of the line, as typed (inner spaces kept).
-    const std::string_view rest = line.substr(line.find("version") + 7);
-    const auto first = rest.find_first_not_of(" \t");
-    const auto last = rest.find_last_not_of(" \t\r\n");
-    if (first == std::string_view::npos) return usage("usage: version TEXT");
-    std::string text(rest.substr(first, last - first + 1));
-    if (text.size() > 64) return usage("version: at most 64 characters");
-    for (char ch : text) {
-      if (static_cast<unsigned char>(ch) < 0x20 || static_cast<unsigned char>(ch) > 0x7E) {
-        return usage("version: printable ASCII only");
-      }
-    }
-    return act([text](VirtualChassis& c) { c.set_version(text); });
-  }
-  if (cmd == "pose") {
-    if (auto s = need(4, "pose X Y YAW"); !s) return s.error();
-    auto x = parse_double("pose X", w[1]);
-    if (!x) return x.error();
-    auto y = parse_double("pose Y", w[2]);
-    if (!y) return y.error();
-    auto yaw = parse_double("pose YAW", w[3]);
-    if (!yaw) return yaw.error();
-    return act([p = Pose2D{*x, *y, wrap_angle(*yaw)}](VirtualChassis& c) { c.set_pose(p); });
-  }
-  if (cmd == "status") {
-    if (auto s = need(1, "status"); !s) return s.error();
-    return ChassisAction(
-        [](VirtualChassis& c) { return describe_chassis(c.snapshot(), c.profile().error_word); });
-  }
-  std::string names;
-  for (const auto& n : chassis_command_names())
-    names += (names.empty() ? "" : ", ") + n;
-  return usage("unknown command '" + cmd + "' (valid: " + names + ")");
+  return usage("unknown command '" + w[0] + "' (valid: " + text::join(chassis_command_names()) +
+               ")");
 }
 
 Result<std::string> apply_chassis_command(std::string_view line, VirtualChassis& chassis) {
@@ -298,9 +315,12 @@ Result<std::string> apply_chassis_command(std::string_view line, VirtualChassis&
 }
 
 const std::vector<std::string>& chassis_command_names() {
-  static const std::vector<std::string> names = {"remote",     "estop",  "error",   "clear",
-                                                 "battery",    "silent", "garbage", "stuck",
-                                                 "ultrasonic", "pose",   "version", "status"};
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> out;
+    for (const Command& c : kCommands)
+      out.emplace_back(c.word);
+    return out;
+  }();
   return names;
 }
 

@@ -12,6 +12,7 @@
 #include "ranger_can/clock.hpp"
 #include "ranger_can/control/parameters.hpp"
 #include "ranger_can/control/rearm.hpp"
+#include "ranger_can/json.hpp"
 #include "ranger_can/parse.hpp"
 #include "ranger_can/sim/sim_bus_source.hpp"
 #include "ranger_can/text.hpp"
@@ -60,29 +61,9 @@ Error problem(const std::string& what) {
 
 using text::join;
 
-std::vector<std::string> split(std::string_view text) {
-  std::vector<std::string> words;
-  std::size_t i = 0;
-  while (i < text.size()) {
-    while (i < text.size() && std::isspace(static_cast<unsigned char>(text[i])) != 0)
-      ++i;
-    std::size_t j = i;
-    while (j < text.size() && std::isspace(static_cast<unsigned char>(text[j])) == 0)
-      ++j;
-    if (j > i) words.emplace_back(text.substr(i, j - i));
-    i = j;
-  }
-  return words;
-}
-
-std::string_view strip(std::string_view text) {
-  const auto hash = text.find('#');
-  if (hash != std::string_view::npos) text = text.substr(0, hash);
-  while (!text.empty() && std::isspace(static_cast<unsigned char>(text.front())) != 0)
-    text.remove_prefix(1);
-  while (!text.empty() && std::isspace(static_cast<unsigned char>(text.back())) != 0)
-    text.remove_suffix(1);
-  return text;
+// The line without its comment, trimmed.
+std::string_view strip(std::string_view line) {
+  return text::trim(line.substr(0, line.find('#')));
 }
 
 // The text with every byte a terminal would not print as itself written as \xNN: an error message
@@ -95,9 +76,7 @@ std::string printable(const std::string& text) {
     if (u >= 0x20 && u < 0x7F) {
       out += c;
     } else {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\x%02X", u);
-      out += buf;
+      out += text::format("\\x%02X", u);
     }
   }
   return out;
@@ -106,27 +85,27 @@ std::string printable(const std::string& text) {
 // ---- names the checks accept ----
 
 const std::vector<std::string>& refusal_names() {
-  static const std::vector<std::string> names = text::names_of(kAllMotionRefusals);
+  static const std::vector<std::string> names = kMotionRefusalNames.names();
   return names;
 }
 
-// An `all` list's names and "null" (the field has no value yet).
+// An enum's names and "null" (the field has no value yet).
 template <typename Enum, std::size_t N>
-std::vector<std::string> names_or_null(const Enum (&all)[N]) {
-  std::vector<std::string> names = text::names_of(all);
+std::vector<std::string> names_or_null(const text::EnumNames<Enum, N>& table) {
+  std::vector<std::string> names = table.names();
   names.emplace_back("null");
   return names;
 }
 
 const std::vector<std::string>& control_mode_names() {
-  static const std::vector<std::string> names = names_or_null(protocol::kAllControlModes);
+  static const std::vector<std::string> names = names_or_null(protocol::kControlModeNames);
   return names;
 }
 
 // The identification's phases (protocol auto), and "none" for a protocol that was given.
 const std::vector<std::string>& identification_names() {
   static const std::vector<std::string> names = [] {
-    std::vector<std::string> out = text::names_of(kAllIdentificationPhases);
+    std::vector<std::string> out = kIdentificationPhaseNames.names();
     out.emplace_back("none");
     return out;
   }();
@@ -134,7 +113,7 @@ const std::vector<std::string>& identification_names() {
 }
 
 const std::vector<std::string>& motion_mode_names() {
-  static const std::vector<std::string> names = names_or_null(protocol::kAllMotionModes);
+  static const std::vector<std::string> names = names_or_null(protocol::kMotionModeNames);
   return names;
 }
 
@@ -150,7 +129,7 @@ std::vector<std::string> fault_table_names() {
 // layout) and a reserved bit's "reserved_bit_N".
 const std::vector<std::string>& fault_names() {
   static const std::vector<std::string> names = [] {
-    std::vector<std::string> n = text::names_of(kAllControllerFaults);
+    std::vector<std::string> n = kControllerFaultNames.names();
     for (auto& name : fault_table_names())
       n.push_back(std::move(name));
     for (int bit = 0; bit < 32; ++bit)
@@ -205,7 +184,7 @@ std::string expect_help() {
                     "faster than 1 mm/s | not faster") +
          help_entry("  expect fault NAME | no-fault NAME | no-faults", "") +
          help_entry("", "NAME as in the output's faults: the driver's (" +
-                            join(text::names_of(kAllControllerFaults)) +
+                            join(kControllerFaultNames.names()) +
                             "), a 0x211 fault of either error-word layout (" +
                             join(fault_table_names()) + ") or reserved_bit_N") +
          help_entry("  expect FIELD OP NUMBER",
@@ -224,147 +203,138 @@ Error not_one_of(const std::string& what, const std::string& got,
 
 // ---- numbers as printed ----
 
-std::string fixed(double v, int decimals) {
-  if (!std::isfinite(v)) return "null";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  std::string s = buf;
-  if (s[0] == '-' && s.find_first_not_of("-0.") == std::string::npos) s.erase(0, 1);  // -0.000
-  return s;
+// `v` as the samples print it: kDecimals decimals, no sign on a zero, null if not finite.
+std::string printed(double v) {
+  std::string out;
+  append_json_fixed(out, v, kDecimals);
+  return out;
 }
 
-double as_printed(double v, int decimals) {
-  return std::strtod(fixed(v, decimals).c_str(), nullptr);
+double as_printed(double v) {
+  return std::strtod(printed(v).c_str(), nullptr);
 }
 
 std::string seconds_text(std::chrono::milliseconds t) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%lld.%03lld", static_cast<long long>(t.count() / 1000),
-                static_cast<long long>(t.count() % 1000));
-  return buf;
-}
-
-void append_string(std::string& out, std::string_view s) {
-  out += '"';
-  out += text::json_escape(s);
-  out += '"';
-}
-
-void append_list(std::string& out, const std::vector<std::string>& items) {
-  out += '[';
-  for (std::size_t i = 0; i < items.size(); ++i) {
-    if (i > 0) out += ',';
-    append_string(out, items[i]);
-  }
-  out += ']';
-}
-
-void append_optional(std::string& out, const std::optional<std::string>& v) {
-  if (v) {
-    append_string(out, *v);
-  } else {
-    out += "null";
-  }
+  return text::fixed(static_cast<double>(t.count()) / 1000.0, 3);
 }
 
 // ---- parsing ----
 
-const std::vector<std::string>& driver_action_names() {
-  static const std::vector<std::string> names = {"cmd",  "resume", "mode", "clear-errors",
-                                                 "wait", "expect", "park"};
-  return names;
+using Kind = Expectation::Kind;
+
+// The text fields a check compares: the values each may hold, and its value in a sample.
+struct TextField {
+  std::string_view name;
+  const std::vector<std::string>& (*valid)();
+  std::string (*value)(const ScenarioSample&);
+};
+const TextField kTextFields[] = {
+    {"refusal", refusal_names, [](const ScenarioSample& s) { return s.refusal; }},
+    {"control_mode", control_mode_names,
+     [](const ScenarioSample& s) { return s.control_mode.value_or("null"); }},
+    {"motion_mode", motion_mode_names,
+     [](const ScenarioSample& s) { return s.motion_mode.value_or("null"); }},
+    {"rearm_required", bool_names,
+     [](const ScenarioSample& s) { return std::string(s.rearm_required ? "true" : "false"); }},
+    {"identification", identification_names,
+     [](const ScenarioSample& s) { return s.identification; }},
+};
+const TextField* find_text_field(std::string_view name) {
+  for (const TextField& f : kTextFields) {
+    if (f.name == name) return &f;
+  }
+  return nullptr;
 }
 
-const char* op_text(Expectation::Op op) {
-  switch (op) {
-    case Expectation::Op::kGreater:
-      return ">";
-    case Expectation::Op::kLess:
-      return "<";
-    case Expectation::Op::kGreaterEqual:
-      return ">=";
-    case Expectation::Op::kLessEqual:
-      return "<=";
-    case Expectation::Op::kEqual:
-      return "==";
-  }
-  return "?";
+// The checks that take no argument, and those that name a fault.
+constexpr auto kBareChecks = text::enum_names<Kind>({
+    {Kind::kMoving, "moving"},
+    {Kind::kStill, "still"},
+    {Kind::kNoFaults, "no-faults"},
+});
+constexpr auto kFaultChecks = text::enum_names<Kind>({
+    {Kind::kFault, "fault"},
+    {Kind::kNoFault, "no-fault"},
+});
+
+const char* const kExpectUsage =
+    "expect: give one of: refusal NAME, control_mode NAME, motion_mode NAME, rearm_required "
+    "true|false, identification PHASE, moving, still, fault NAME, no-fault NAME, no-faults, "
+    "FIELD OP NUMBER";
+
+Status need_words(const std::vector<std::string>& w, std::size_t n, const std::string& form) {
+  if (w.size() != n) return problem("usage: " + form);
+  return ok_status();
 }
 
-std::optional<Expectation::Op> parse_op(const std::string& text) {
-  for (auto op : {Expectation::Op::kGreater, Expectation::Op::kLess, Expectation::Op::kGreaterEqual,
-                  Expectation::Op::kLessEqual, Expectation::Op::kEqual}) {
-    if (text == op_text(op)) return op;
+// expect fault NAME | no-fault NAME
+Status parse_fault_check(const std::vector<std::string>& w, Expectation& e) {
+  const std::string& what = w[1];
+  if (auto st = need_words(w, 3, "expect " + what + " NAME"); !st) return st;
+  if (!contains(fault_names(), w[2])) {
+    return problem("expect " + what + ": unknown fault '" + w[2] +
+                   "' (the driver's: link_lost, emergency_stop, vehicle_abnormal, low_battery, "
+                   "motion_mode_switch_failed, ...; or a 0x211 error bit's name, e.g. "
+                   "over_current)");
   }
-  return std::nullopt;
+  e.kind = *kFaultChecks.parse(what);
+  e.text = w[2];
+  return ok_status();
+}
+
+// expect FIELD NAME (a text field)
+Status parse_text_check(const std::vector<std::string>& w, const TextField& f, Expectation& e) {
+  const std::string& what = w[1];
+  const std::vector<std::string>& valid = f.valid();
+  if (auto st = need_words(w, 3, "expect " + what + " " + join(valid, "|")); !st) return st;
+  if (!contains(valid, w[2])) return not_one_of("expect " + what, w[2], valid);
+  e.kind = Kind::kEquals;
+  e.text = w[2];
+  return ok_status();
+}
+
+// expect FIELD OP NUMBER (a number field)
+Status parse_compare(const std::vector<std::string>& w, Expectation& e) {
+  const std::string& what = w[1];
+  if (w.size() != 4) {
+    return problem("usage: expect " + what + " " + join(kOpNames.names(), "|") + " NUMBER");
+  }
+  const auto op = kOpNames.parse(w[2]);
+  if (!op) {
+    return problem("expect " + what + ": unknown operator '" + w[2] +
+                   "' (valid: " + join(kOpNames.names()) + ")");
+  }
+  auto number = parse_double("expect " + what, w[3]);
+  if (!number) return number.error();
+  e.kind = Kind::kCompare;
+  e.op = *op;
+  e.number = *number;
+  e.text = w[3];  // as written, for messages
+  return ok_status();
 }
 
 Result<Expectation> parse_expect(const std::vector<std::string>& w) {
   // w[0] == "expect"
-  const std::string usage =
-      "expect: give one of: refusal NAME, control_mode NAME, motion_mode NAME, rearm_required "
-      "true|false, identification PHASE, moving, still, fault NAME, no-fault NAME, no-faults, "
-      "FIELD OP NUMBER";
-  if (w.size() < 2) return problem(usage);
+  if (w.size() < 2) return problem(kExpectUsage);
   const std::string& what = w[1];
   Expectation e;
   e.field = what;
-  auto need = [&](std::size_t n, const std::string& form) -> Status {
-    if (w.size() != n) return problem("usage: expect " + form);
-    return ok_status();
-  };
-  if (what == "moving" || what == "still" || what == "no-faults") {
-    if (auto st = need(2, what); !st) return st.error();
-    e.kind = what == "moving"  ? Expectation::Kind::kMoving
-             : what == "still" ? Expectation::Kind::kStill
-                               : Expectation::Kind::kNoFaults;
-    return e;
+  Status st = ok_status();
+  if (const auto kind = kBareChecks.parse(what)) {
+    st = need_words(w, 2, "expect " + what);
+    e.kind = *kind;
+  } else if (kFaultChecks.parse(what)) {
+    st = parse_fault_check(w, e);
+  } else if (const TextField* f = find_text_field(what)) {
+    st = parse_text_check(w, *f, e);
+  } else if (contains(sample_number_fields(), what)) {
+    st = parse_compare(w, e);
+  } else {
+    return problem("expect: unknown check '" + what + "' (" + std::string(kExpectUsage).substr(8) +
+                   "; FIELD: " + join(sample_number_fields()) + ")");
   }
-  if (what == "fault" || what == "no-fault") {
-    if (auto st = need(3, what + " NAME"); !st) return st.error();
-    if (!contains(fault_names(), w[2])) {
-      return problem("expect " + what + ": unknown fault '" + w[2] +
-                     "' (the driver's: link_lost, emergency_stop, vehicle_abnormal, low_battery, "
-                     "motion_mode_switch_failed, ...; or a 0x211 error bit's name, e.g. "
-                     "over_current)");
-    }
-    e.kind = what == "fault" ? Expectation::Kind::kFault : Expectation::Kind::kNoFault;
-    e.text = w[2];
-    return e;
-  }
-  const struct {
-    const char* field;
-    const std::vector<std::string>& valid;
-  } text_fields[] = {{"refusal", refusal_names()},
-                     {"control_mode", control_mode_names()},
-                     {"motion_mode", motion_mode_names()},
-                     {"rearm_required", bool_names()},
-                     {"identification", identification_names()}};
-  for (const auto& f : text_fields) {
-    if (what != f.field) continue;
-    if (auto st = need(3, what + " " + join(f.valid, "|")); !st) return st.error();
-    if (!contains(f.valid, w[2])) return not_one_of("expect " + what, w[2], f.valid);
-    e.kind = Expectation::Kind::kEquals;
-    e.text = w[2];
-    return e;
-  }
-  if (contains(sample_number_fields(), what)) {
-    if (w.size() != 4) return problem("usage: expect " + what + " >|<|>=|<=|== NUMBER");
-    const auto op = parse_op(w[2]);
-    if (!op) {
-      return problem("expect " + what + ": unknown operator '" + w[2] +
-                     "' (valid: >, <, >=, <=, ==)");
-    }
-    auto number = parse_double("expect " + what, w[3]);
-    if (!number) return number.error();
-    e.kind = Expectation::Kind::kCompare;
-    e.op = *op;
-    e.number = *number;
-    e.text = w[3];  // as written, for messages
-    return e;
-  }
-  return problem("expect: unknown check '" + what + "' (" + usage.substr(8) +
-                 "; FIELD: " + join(sample_number_fields()) + ")");
+  if (!st) return st.error();
+  return e;
 }
 
 // "name=value" pieces of --param.
@@ -394,78 +364,123 @@ Result<std::chrono::milliseconds> parse_milliseconds(std::string_view what,
   return std::chrono::milliseconds(static_cast<long long>(whole));
 }
 
+namespace {
+
+// ---- the driver's actions: one parser per verb ----
+
+using Words = std::vector<std::string>;
+
+Status parse_cmd(const Words& w, ScenarioAction& a) {
+  if (w.size() == 2 && w[1] == "none") {
+    a.kind = ScenarioAction::Kind::kCommandNone;
+    return ok_status();
+  }
+  if (w.size() != 4) return problem("usage: cmd VX VY WZ  or  cmd none");
+  double v[3];
+  const char* names[3] = {"cmd VX", "cmd VY", "cmd WZ"};
+  for (int i = 0; i < 3; ++i) {
+    auto n = parse_double(names[i], w[1 + i]);
+    if (!n) return n.error();
+    v[i] = *n;
+  }
+  a.kind = ScenarioAction::Kind::kCommand;
+  a.twist = BodyTwist{v[0], v[1], v[2]};
+  return ok_status();
+}
+
+Status parse_resume(const Words& w, ScenarioAction& a) {
+  if (w.size() != 1) return problem("usage: resume (takes no argument)");
+  a.kind = ScenarioAction::Kind::kResume;
+  return ok_status();
+}
+
+Status parse_park(const Words& w, ScenarioAction& a) {
+  if (w.size() != 2 || (w[1] != "on" && w[1] != "off")) return problem("usage: park on|off");
+  a.kind = ScenarioAction::Kind::kPark;
+  a.enable = w[1] == "on";
+  return ok_status();
+}
+
+// `mode`'s words: auto and every mode a commander may pin (park has an action of its own).
+const std::vector<std::string>& mode_words() {
+  static const std::vector<std::string> words = [] {
+    std::vector<std::string> out = {"auto"};
+    for (const auto& [mode, name] : protocol::kMotionModeNames) {
+      if (mode != MotionMode::kPark) out.emplace_back(name);
+    }
+    return out;
+  }();
+  return words;
+}
+
+Status parse_mode(const Words& w, ScenarioAction& a) {
+  if (w.size() != 2) return problem("usage: mode " + join(mode_words(), "|"));
+  if (!contains(mode_words(), w[1])) return not_one_of("mode", w[1], mode_words());
+  a.kind = ScenarioAction::Kind::kMode;
+  a.mode = protocol::kMotionModeNames.parse(w[1]);  // nullopt: auto
+  return ok_status();
+}
+
+Status parse_clear_errors(const Words& w, ScenarioAction& a) {
+  if (w.size() != 2) return problem("usage: clear-errors CODE (0-16 or 0x00-0x10)");
+  auto code = parse_integer("clear-errors CODE", w[1], 0, protocol::kMaxErrorClearCode);
+  if (!code) return code.error();
+  a.kind = ScenarioAction::Kind::kClearErrors;
+  a.code = static_cast<std::uint8_t>(*code);
+  return ok_status();
+}
+
+Status parse_wait(const Words& w, ScenarioAction& a) {
+  if (w.size() != 2) return problem("usage: wait SEC");
+  auto ms = parse_milliseconds("wait SEC", w[1]);
+  if (!ms) return ms.error();
+  a.kind = ScenarioAction::Kind::kWait;
+  a.wait = *ms;
+  return ok_status();
+}
+
+Status parse_expect_action(const Words& w, ScenarioAction& a) {
+  auto e = parse_expect(w);
+  if (!e) return e.error();
+  a.kind = ScenarioAction::Kind::kExpect;
+  a.expect = std::move(*e);
+  return ok_status();
+}
+
+struct Verb {
+  std::string_view word;
+  Status (*parse)(const Words& w, ScenarioAction& a);
+};
+const Verb kVerbs[] = {
+    {"cmd", parse_cmd},   {"resume", parse_resume},
+    {"mode", parse_mode}, {"clear-errors", parse_clear_errors},
+    {"wait", parse_wait}, {"expect", parse_expect_action},
+    {"park", parse_park},
+};
+
+const std::vector<std::string>& driver_action_names() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> out;
+    for (const Verb& v : kVerbs)
+      out.emplace_back(v.word);
+    return out;
+  }();
+  return names;
+}
+
+}  // namespace
+
 Result<std::optional<ScenarioAction>> parse_scenario_line(std::string_view raw, std::size_t line) {
   const std::string_view text = strip(raw);
   if (text.empty()) return std::optional<ScenarioAction>();
-  const auto w = split(text);
+  const auto w = text::split_words(text);
   ScenarioAction a;
   a.line = line;
   a.text = std::string(text);
   const std::string& verb = w[0];
-  if (verb == "cmd") {
-    if (w.size() == 2 && w[1] == "none") {
-      a.kind = ScenarioAction::Kind::kCommandNone;
-      return std::optional<ScenarioAction>(std::move(a));
-    }
-    if (w.size() != 4) return problem("usage: cmd VX VY WZ  or  cmd none");
-    double v[3];
-    const char* names[3] = {"cmd VX", "cmd VY", "cmd WZ"};
-    for (int i = 0; i < 3; ++i) {
-      auto n = parse_double(names[i], w[1 + i]);
-      if (!n) return n.error();
-      v[i] = *n;
-    }
-    a.kind = ScenarioAction::Kind::kCommand;
-    a.twist = BodyTwist{v[0], v[1], v[2]};
-    return std::optional<ScenarioAction>(std::move(a));
-  }
-  if (verb == "resume") {
-    if (w.size() != 1) return problem("usage: resume (takes no argument)");
-    a.kind = ScenarioAction::Kind::kResume;
-    return std::optional<ScenarioAction>(std::move(a));
-  }
-  if (verb == "park") {
-    if (w.size() != 2 || (w[1] != "on" && w[1] != "off")) return problem("usage: park on|off");
-    a.kind = ScenarioAction::Kind::kPark;
-    a.enable = w[1] == "on";
-    return std::optional<ScenarioAction>(std::move(a));
-  }
-  if (verb == "mode") {
-    const std::string usage = "usage: mode auto|ackermann|oblique|spin|side_slip";
-    if (w.size() != 2) return problem(usage);
-    a.kind = ScenarioAction::Kind::kMode;
-    if (w[1] == "auto") return std::optional<ScenarioAction>(std::move(a));
-    for (MotionMode m :
-         {MotionMode::kAckermann, MotionMode::kOblique, MotionMode::kSpin, MotionMode::kSideSlip}) {
-      if (w[1] == protocol::to_string(m)) {
-        a.mode = m;
-        return std::optional<ScenarioAction>(std::move(a));
-      }
-    }
-    return problem("mode: unknown '" + w[1] +
-                   "' (valid: auto, ackermann, oblique, spin, side_slip)");
-  }
-  if (verb == "clear-errors") {
-    if (w.size() != 2) return problem("usage: clear-errors CODE (0-16 or 0x00-0x10)");
-    auto code = parse_integer("clear-errors CODE", w[1], 0, protocol::kMaxErrorClearCode);
-    if (!code) return code.error();
-    a.kind = ScenarioAction::Kind::kClearErrors;
-    a.code = static_cast<std::uint8_t>(*code);
-    return std::optional<ScenarioAction>(std::move(a));
-  }
-  if (verb == "wait") {
-    if (w.size() != 2) return problem("usage: wait SEC");
-    auto ms = parse_milliseconds("wait SEC", w[1]);
-    if (!ms) return ms.error();
-    a.kind = ScenarioAction::Kind::kWait;
-    a.wait = *ms;
-    return std::optional<ScenarioAction>(std::move(a));
-  }
-  if (verb == "expect") {
-    auto e = parse_expect(w);
-    if (!e) return e.error();
-    a.kind = ScenarioAction::Kind::kExpect;
-    a.expect = std::move(*e);
+  for (const Verb& v : kVerbs) {
+    if (verb != v.word) continue;
+    if (Status st = v.parse(w, a); !st) return st.error();
     return std::optional<ScenarioAction>(std::move(a));
   }
   if (contains(chassis_command_names(), verb)) {
@@ -605,68 +620,79 @@ std::optional<double> sample_number(const ScenarioSample& s, std::string_view fi
                 {"odom.vx", s.odom_twist.vx},   {"odom.vy", s.odom_twist.vy},
                 {"odom.wz", s.odom_twist.wz},   {"steer_first_factor", s.steer_first_factor}};
   for (const auto& f : fields) {
-    if (f.name == field) return as_printed(f.value, kDecimals);
+    if (f.name == field) return as_printed(f.value);
   }
   return std::nullopt;
 }
 
+namespace {
+
+// The sample's fields, into an object `w` has begun.
+void write_sample(JsonWriter& w, const ScenarioSample& s) {
+  auto pose = [&](const Pose2D& p, const BodyTwist& v) {
+    w.key("x").fixed(p.x, kDecimals).key("y").fixed(p.y, kDecimals);
+    w.key("yaw").fixed(p.yaw, kDecimals);
+    w.key("vx").fixed(v.vx, kDecimals).key("vy").fixed(v.vy, kDecimals);
+    w.key("wz").fixed(v.wz, kDecimals);
+  };
+  w.key("t").fixed(static_cast<double>(s.t.count()) / 1000.0, 3);
+  w.key("truth").begin_object();
+  pose(s.truth, s.truth_twist);
+  w.key("speed").fixed(s.truth_speed, kDecimals).end_object();
+  w.key("odom").begin_object();
+  pose(s.odom, s.odom_twist);
+  w.end_object();
+  w.key("control_mode").string_or_null(s.control_mode);
+  w.key("motion_mode").string_or_null(s.motion_mode);
+  w.key("refusal").string(s.refusal);
+  w.key("faults").strings(s.faults);
+  w.key("rearm_required").boolean(s.rearm_required);
+  w.key("latched").strings(s.latched);
+  w.key("steer_first_factor").fixed(s.steer_first_factor, kDecimals);
+  w.key("identification").string(s.identification);
+}
+
+// "events":[...] of the driver's events (each one JSON object), none when there are none.
+void write_events(JsonWriter& w, const std::vector<std::string>& events) {
+  if (events.empty()) return;
+  w.key("events").begin_array();
+  for (const std::string& e : events)
+    w.raw(e);
+  w.end_array();
+}
+
+}  // namespace
+
 std::string to_json(const ScenarioSample& s) {
   std::string out;
   out.reserve(512);
-  auto num = [&](const char* key, double v) {
-    out += '"';
-    out += key;
-    out += "\":";
-    out += fixed(v, kDecimals);
-  };
-  out += "{\"t\":" + seconds_text(s.t);
-  out += ",\"truth\":{";
-  num("x", s.truth.x);
-  out += ',';
-  num("y", s.truth.y);
-  out += ',';
-  num("yaw", s.truth.yaw);
-  out += ',';
-  num("vx", s.truth_twist.vx);
-  out += ',';
-  num("vy", s.truth_twist.vy);
-  out += ',';
-  num("wz", s.truth_twist.wz);
-  out += ',';
-  num("speed", s.truth_speed);
-  out += "},\"odom\":{";
-  num("x", s.odom.x);
-  out += ',';
-  num("y", s.odom.y);
-  out += ',';
-  num("yaw", s.odom.yaw);
-  out += ',';
-  num("vx", s.odom_twist.vx);
-  out += ',';
-  num("vy", s.odom_twist.vy);
-  out += ',';
-  num("wz", s.odom_twist.wz);
-  out += "},\"control_mode\":";
-  append_optional(out, s.control_mode);
-  out += ",\"motion_mode\":";
-  append_optional(out, s.motion_mode);
-  out += ",\"refusal\":";
-  append_string(out, s.refusal);
-  out += ",\"faults\":";
-  append_list(out, s.faults);
-  out += ",\"rearm_required\":";
-  out += s.rearm_required ? "true" : "false";
-  out += ",\"latched\":";
-  append_list(out, s.latched);
-  out += ',';
-  num("steer_first_factor", s.steer_first_factor);
-  out += ",\"identification\":";
-  append_string(out, s.identification);
-  out += '}';
+  JsonWriter w(out);
+  w.begin_object();
+  write_sample(w, s);
+  w.end_object();
   return out;
 }
 
 // ---- the runner ----
+
+namespace {
+// `v OP number`.
+bool holds(double v, Expectation::Op op, double number) {
+  switch (op) {
+    case Expectation::Op::kGreater:
+      return v > number;
+    case Expectation::Op::kLess:
+      return v < number;
+    case Expectation::Op::kGreaterEqual:
+      return v >= number;
+    case Expectation::Op::kLessEqual:
+      return v <= number;
+    case Expectation::Op::kEqual:
+      return v == number;
+  }
+  return false;
+}
+}  // namespace
 
 struct ScenarioRunner::Impl {
   ScenarioOptions options;
@@ -752,14 +778,7 @@ struct ScenarioRunner::Impl {
     s.refusal = std::string(to_string(c.refusal));
     s.faults = c.faults;
     s.rearm_required = c.rearm_required();
-    const std::string latched = describe(c.latched_causes);
-    std::size_t start = 0;
-    while (start < latched.size()) {
-      const auto comma = latched.find(',', start);
-      const auto end = comma == std::string::npos ? latched.size() : comma;
-      s.latched.push_back(latched.substr(start, end - start));
-      start = end + 1;
-    }
+    s.latched = text::split(describe(c.latched_causes), ',');
     s.steer_first_factor = c.steer_first_factor;
     s.identification =
         snap->identification ? std::string(to_string(snap->identification->phase)) : "none";
@@ -770,53 +789,30 @@ struct ScenarioRunner::Impl {
   std::optional<std::string> check(const Expectation& e) const {
     const ScenarioSample s = sample();
     switch (e.kind) {
-      case Expectation::Kind::kEquals: {
-        std::string got;
-        if (e.field == "refusal") got = s.refusal;
-        if (e.field == "control_mode") got = s.control_mode.value_or("null");
-        if (e.field == "motion_mode") got = s.motion_mode.value_or("null");
-        if (e.field == "rearm_required") got = s.rearm_required ? "true" : "false";
-        if (e.field == "identification") got = s.identification;
+      case Kind::kEquals: {
+        std::string got = find_text_field(e.field)->value(s);
         if (got == e.text) return std::nullopt;
         return got;
       }
-      case Expectation::Kind::kCompare: {
+      case Kind::kCompare: {
         const double v = *sample_number(s, e.field);
-        bool ok = false;
-        switch (e.op) {
-          case Expectation::Op::kGreater:
-            ok = v > e.number;
-            break;
-          case Expectation::Op::kLess:
-            ok = v < e.number;
-            break;
-          case Expectation::Op::kGreaterEqual:
-            ok = v >= e.number;
-            break;
-          case Expectation::Op::kLessEqual:
-            ok = v <= e.number;
-            break;
-          case Expectation::Op::kEqual:
-            ok = v == e.number;
-            break;
-        }
-        if (ok) return std::nullopt;
-        return e.field == "t" ? seconds_text(s.t) : fixed(v, kDecimals);
+        if (holds(v, e.op, e.number)) return std::nullopt;
+        return e.field == "t" ? seconds_text(s.t) : printed(v);
       }
-      case Expectation::Kind::kMoving:
-      case Expectation::Kind::kStill: {
+      case Kind::kMoving:
+      case Kind::kStill: {
         const double v = *sample_number(s, "truth.speed");
         const bool moving = v > kStillSpeed;
-        if (moving == (e.kind == Expectation::Kind::kMoving)) return std::nullopt;
-        return "truth.speed " + fixed(v, kDecimals);
+        if (moving == (e.kind == Kind::kMoving)) return std::nullopt;
+        return "truth.speed " + printed(v);
       }
-      case Expectation::Kind::kFault:
-      case Expectation::Kind::kNoFault:
-      case Expectation::Kind::kNoFaults: {
+      case Kind::kFault:
+      case Kind::kNoFault:
+      case Kind::kNoFaults: {
         const bool present = contains(s.faults, e.text);
-        if (e.kind == Expectation::Kind::kFault && present) return std::nullopt;
-        if (e.kind == Expectation::Kind::kNoFault && !present) return std::nullopt;
-        if (e.kind == Expectation::Kind::kNoFaults && s.faults.empty()) return std::nullopt;
+        if (e.kind == Kind::kFault && present) return std::nullopt;
+        if (e.kind == Kind::kNoFault && !present) return std::nullopt;
+        if (e.kind == Kind::kNoFaults && s.faults.empty()) return std::nullopt;
         return "faults [" + join(s.faults) + "]";
       }
     }
@@ -831,7 +827,7 @@ std::string describe_expectation(const Expectation& e) {
     case Expectation::Kind::kEquals:
       return e.field + " " + e.text;
     case Expectation::Kind::kCompare: {
-      return e.field + " " + op_text(e.op) + " " + e.text;
+      return e.field + " " + std::string(kOpNames.name(e.op)) + " " + e.text;
     }
     case Expectation::Kind::kMoving:
       return "moving (truth.speed > " + number_text(kStillSpeed) + ")";
@@ -959,18 +955,19 @@ Result<ScenarioResult> run_scenario(const Scenario& scenario, const ScenarioOpti
   if (!runner) return runner.error();
   std::size_t failures_shown = 0;
   std::string line;
-  std::string events;  // the driver's events since the last sample: ,{...},{...}
+  std::vector<std::string> events;  // the driver's events since the last sample
   ScenarioOutput output;
-  output.event = [&](const DriverEvent& e) { events += "," + to_json(e, kEpoch); };
+  output.event = [&](const DriverEvent& e) { events.push_back(to_json(e, kEpoch)); };
   // A sample carries the events since the one before ("events":[...], only when there are).
-  const auto with_events = [&](std::string json) {
-    if (!events.empty()) json.insert(json.size() - 1, ",\"events\":[" + events.substr(1) + "]");
-    events.clear();
-    return json + '\n';
-  };
   output.sample = [&](const ScenarioSample& s) {
-    line = with_events(to_json(s));
-    out << line;
+    line.clear();
+    JsonWriter w(line);
+    w.begin_object();
+    write_sample(w, s);
+    write_events(w, events);
+    w.end_object();
+    events.clear();
+    out << line << '\n';
   };
   output.failure = [&](const std::string& text) {
     if (failures_shown < kMaxReportedErrors) err << prefix << text << "\n";
@@ -979,7 +976,14 @@ Result<ScenarioResult> run_scenario(const Scenario& scenario, const ScenarioOpti
   output.note = [&](const std::string& text) { err << prefix << text << "\n"; };
   const ScenarioResult result = (*runner)->run(scenario, output);
   // Events after the last sample (a script that ends between samples).
-  if (!events.empty()) out << with_events("{\"t\":" + seconds_text((*runner)->now()) + "}");
+  if (!events.empty()) {
+    line.clear();
+    JsonWriter w(line);
+    w.begin_object().key("t").fixed(static_cast<double>((*runner)->now().count()) / 1000.0, 3);
+    write_events(w, events);
+    w.end_object();
+    out << line << '\n';
+  }
   out.flush();
   if (result.failures > kMaxReportedErrors) {
     err << prefix << (result.failures - kMaxReportedErrors)

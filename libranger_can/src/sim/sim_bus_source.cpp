@@ -74,11 +74,6 @@ ProtocolProfile preset(std::string_view revision) {
   return p ? *p : manual_profile();
 }
 
-void set(ProtocolProfile& profile, std::string_view name, std::string_view value) {
-  const Status st = set_setting(profile, name, value);
-  (void)st;  // the names and values below are the settings table's (checked by the tests)
-}
-
 }  // namespace
 
 Result<VirtualChassisConfig> apply_variant(std::string_view variant, VirtualChassisConfig config) {
@@ -88,16 +83,15 @@ Result<VirtualChassisConfig> apply_variant(std::string_view variant, VirtualChas
     p = preset("agx_v2");
     config.vendor_frames = true;
   } else if (variant == "padded") {
-    set(p, "tx_dlc", "8");
+    p.tx_dlc = 8;
   } else if (variant == "spin_cw") {
-    set(p, "spin_sign", "cw");
+    p.spin_sign = -1;
   } else if (variant == "steer_left_positive") {
-    for (const char* s : {"steering_sign_111", "steering_sign_221", "steering_sign_271"})
-      set(p, s, "left_positive");
+    p.steering_sign_111 = p.steering_sign_221 = p.steering_sign_271 = SteeringSign::kLeftPositive;
   } else if (variant == "speed221_body") {
-    set(p, "feedback_speed", "body_centre");
+    p.feedback_speed = FeedbackSpeed::kBodyCentre;
   } else if (variant == "inner_angle") {
-    set(p, "steering_reference", "inner_front");
+    p.steering_reference = SteeringReference::kInnerFront;
   } else if (variant == "mini_v1") {
     auto model = model_preset("ranger_mini_v1");
     if (!model) return model.error();
@@ -110,8 +104,8 @@ Result<VirtualChassisConfig> apply_variant(std::string_view variant, VirtualChas
     // the manual's lengths and mode numbers; no 0x271 (no wheel angle whose value geometry
     // fixes), and 0x221 reports angle 0 in spin mode (its spin position would tell the unit).
     p = preset("agx_v2");
-    set(p, "tx_dlc", "0");
-    set(p, "mode_numbering", "manual");
+    p.tx_dlc = 0;
+    p.mode_numbering = ModeNumbering::kManual;
     config.vendor_frames = false;
     config.steering_angles_frame = false;
     config.spin_angle_reported = false;

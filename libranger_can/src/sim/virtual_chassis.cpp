@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <initializer_list>
 #include <type_traits>
 #include <utility>
 
+#include "ranger_can/text.hpp"
 #include "ranger_can/wire/interpretation.hpp"
 
 namespace ranger::sim {
@@ -38,10 +38,7 @@ constexpr double kParkStandstillSpeed = 0.01;
 constexpr std::size_t kMaxEvents = 1000;
 
 std::string names_of(std::uint32_t bits, ErrorWordLayout layout) {
-  std::string out;
-  for (const auto& n : protocol::error_bit_names(bits, layout))
-    out += (out.empty() ? "" : ",") + n;
-  return out;
+  return text::join(protocol::error_bit_names(bits, layout), ",");
 }
 
 // The nominal period of a frame (the frame table).
@@ -72,9 +69,7 @@ double front_angle_from_mean(double mean, const VehicleGeometry& g, SteeringRefe
 }
 
 std::string format_pct(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.1f%%", v);
-  return buf;
+  return text::fixed(v, 1) + "%";
 }
 
 }  // namespace
@@ -261,12 +256,8 @@ void VirtualChassis::update_conditions(Timestamp) {
     const std::uint32_t raised = errors & ~last_reported_errors_;
     const std::uint32_t cleared = last_reported_errors_ & ~errors;
     const ErrorWordLayout layout = config_.profile.error_word;
-    std::string text = "error bits 0x" + [&] {
-      char buf[16];
-      std::snprintf(buf, sizeof buf, protocol::error_word_bits(layout) == 16 ? "%04X" : "%08X",
-                    errors);
-      return std::string(buf);
-    }();
+    std::string text =
+        "error bits " + text::hex(errors, protocol::error_word_bits(layout) == 16 ? 4 : 8);
     if (raised) text += " raised: " + names_of(raised, layout);
     if (cleared) {
       text += std::string(raised ? ";" : "") + " cleared: " + names_of(cleared, layout);
@@ -682,13 +673,8 @@ bool VirtualChassis::clear_errors(std::uint8_t code) {
     return false;
   }
   latched_errors_ &= ~clear;
-  event("clear errors 0x" +
-        [&] {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "%02X", code);
-          return std::string(buf);
-        }() +
-        " (" + protocol::error_clear_description(code) + ")");
+  event("clear errors " + text::hex(code, 2) + " (" + protocol::error_clear_description(code) +
+        ")");
   // Clearing under-voltage "tries to restore power": the fault comes straight back if the SOC is
   // still below the cut-off (update_conditions re-latches it).
   update_conditions(now_);

@@ -2,22 +2,6 @@
 
 namespace ranger {
 
-std::string_view to_string(BusState s) {
-  switch (s) {
-    case BusState::kActive:
-      return "active";
-    case BusState::kErrorWarning:
-      return "error-warning";
-    case BusState::kErrorPassive:
-      return "error-passive";
-    case BusState::kBusOff:
-      return "bus-off";
-    case BusState::kDown:
-      return "down";
-  }
-  return "unknown";
-}
-
 std::size_t Bus::receive_queued(std::vector<Result<CanFrame>>& out, std::size_t max) {
   std::size_t n = 0;
   while (n < max) {

@@ -1,7 +1,6 @@
 #include "ranger_can/transport/error_frame.hpp"
 #include "ranger_can/text.hpp"
 
-#include <cstdio>
 #include <vector>
 
 namespace ranger {
@@ -22,60 +21,77 @@ CanFrame make(std::uint32_t classes, std::uint8_t controller_status) {
 namespace {
 
 using text::join;
+using namespace can_error;
+
+// A bit and what it says, in the order the description lists them.
+struct BitText {
+  std::uint32_t bit;
+  const char* text;
+};
+constexpr BitText kLeadingClasses[] = {{kBusOff, "bus-off"}, {kRestarted, "controller restarted"}};
+constexpr BitText kControllerBits[] = {
+    {kCtrlRxOverflow, "rx buffer overflow"}, {kCtrlTxOverflow, "tx buffer overflow"},
+    {kCtrlRxWarning, "rx error-warning"},    {kCtrlTxWarning, "tx error-warning"},
+    {kCtrlRxPassive, "rx error-passive"},    {kCtrlTxPassive, "tx error-passive"},
+    {kCtrlActive, "back to error-active"},
+};
+constexpr BitText kTrailingClasses[] = {
+    {kNoAck, "no ACK on transmission (chassis off or bitrate wrong?)"},
+    {kTxTimeout, "transmit timeout"},
+    {kLostArbitration, "lost arbitration"},
+    {kProtocol, "protocol violation"},
+    {kTransceiver, "transceiver status"},
+    {kBusError, "bus error"},
+};
+
+template <std::size_t N>
+void add_texts(std::uint32_t bits, const BitText (&table)[N], std::vector<std::string>& out) {
+  for (const BitText& b : table) {
+    if (bits & b.bit) out.emplace_back(b.text);
+  }
+}
+
+// The bus state the frame reports, if any (bus-off wins over a restart).
+void set_state(std::uint32_t c, std::uint8_t ctrl, ErrorFrameReport& r) {
+  const bool controller = (c & kController) != 0;
+  if (c & kBusOff) {
+    r.new_state = BusState::kBusOff;
+  } else if (c & kRestarted) {
+    r.new_state = BusState::kActive;
+  } else if (controller && (ctrl & (kCtrlRxPassive | kCtrlTxPassive))) {
+    r.new_state = BusState::kErrorPassive;
+  } else if (controller && (ctrl & (kCtrlRxWarning | kCtrlTxWarning))) {
+    r.new_state = BusState::kErrorWarning;
+  } else if (controller && (ctrl & kCtrlActive)) {
+    r.new_state = BusState::kActive;
+  }
+  if (c & kRestarted) r.restarted = true;  // counted, but bus-off wins
+}
 
 }  // namespace
 
 ErrorFrameReport interpret_error_frame(const CanFrame& frame) {
-  using namespace can_error;
   ErrorFrameReport r;
   if (!frame.is_error) return r;
   const std::uint32_t c = frame.id;
   const std::uint8_t ctrl = frame.data[1];
   std::vector<std::string> parts;
-
-  if (c & kBusOff) parts.emplace_back("bus-off");
-  if (c & kRestarted) parts.emplace_back("controller restarted");
+  add_texts(c, kLeadingClasses, parts);
   if (c & kController) {
     std::vector<std::string> details;
-    if (ctrl & kCtrlRxOverflow) details.emplace_back("rx buffer overflow");
-    if (ctrl & kCtrlTxOverflow) details.emplace_back("tx buffer overflow");
-    if (ctrl & kCtrlRxWarning) details.emplace_back("rx error-warning");
-    if (ctrl & kCtrlTxWarning) details.emplace_back("tx error-warning");
-    if (ctrl & kCtrlRxPassive) details.emplace_back("rx error-passive");
-    if (ctrl & kCtrlTxPassive) details.emplace_back("tx error-passive");
-    if (ctrl & kCtrlActive) details.emplace_back("back to error-active");
+    add_texts(ctrl, kControllerBits, details);
     if (details.empty()) details.emplace_back("unspecified");
     parts.push_back("controller: " + join(details, ", "));
     r.controller_problem = true;
   }
-  if (c & kNoAck) parts.emplace_back("no ACK on transmission (chassis off or bitrate wrong?)");
-  if (c & kTxTimeout) parts.emplace_back("transmit timeout");
-  if (c & kLostArbitration) parts.emplace_back("lost arbitration");
-  if (c & kProtocol) parts.emplace_back("protocol violation");
-  if (c & kTransceiver) parts.emplace_back("transceiver status");
-  if (c & kBusError) parts.emplace_back("bus error");
+  add_texts(c, kTrailingClasses, parts);
   if (c & kCounters) {
-    char buf[48];
-    std::snprintf(buf, sizeof buf, "error counters tx=%u rx=%u", unsigned{frame.data[6]},
-                  unsigned{frame.data[7]});
-    parts.emplace_back(buf);
+    parts.push_back(text::format("error counters tx=%u rx=%u", unsigned{frame.data[6]},
+                                 unsigned{frame.data[7]}));
   }
   if (parts.empty()) parts.emplace_back("error frame without class bits");
   r.description = join(parts, "; ");
-
-  if (c & kBusOff) {
-    r.new_state = BusState::kBusOff;
-  } else if (c & kRestarted) {
-    r.new_state = BusState::kActive;
-    r.restarted = true;
-  } else if ((c & kController) && (ctrl & (kCtrlRxPassive | kCtrlTxPassive))) {
-    r.new_state = BusState::kErrorPassive;
-  } else if ((c & kController) && (ctrl & (kCtrlRxWarning | kCtrlTxWarning))) {
-    r.new_state = BusState::kErrorWarning;
-  } else if ((c & kController) && (ctrl & kCtrlActive)) {
-    r.new_state = BusState::kActive;
-  }
-  if ((c & kRestarted) && (c & kBusOff)) r.restarted = true;  // counted, but bus-off wins
+  set_state(c, ctrl, r);
   return r;
 }
 

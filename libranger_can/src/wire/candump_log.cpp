@@ -9,6 +9,8 @@
 #include <cstdio>
 #include <string>
 
+#include "ranger_can/text.hpp"
+
 namespace ranger {
 
 namespace {
@@ -159,9 +161,8 @@ Status parse_id(std::string_view s, CanFrame* frame, bool* extended) {
 
 // A well-formed frame of another device on the bus: kUnknownId, not a parse error.
 Error extended_id_error(std::uint32_t id) {
-  char buf[48];
-  std::snprintf(buf, sizeof buf, "extended ID 0x%08X is not a RANGER frame", id & kCanEffMask);
-  return Error{Errc::kUnknownId, buf};
+  return Error{Errc::kUnknownId,
+               "extended ID " + text::hex(id & kCanEffMask, 8) + " is not a RANGER frame"};
 }
 
 // "0096000000000000" (optionally dot-separated, as cansend accepts) -> data/dlc.

@@ -63,9 +63,8 @@ using protocol::VehicleStatus;
 constexpr double kMillis = 1000.0;  // mm/s per m/s, mrad per rad
 constexpr double kDeci = 10.0;      // 0.1 V, 0.1 A, 0.1 degC
 constexpr double kCenti = 100.0;    // 0.01 V, 0.01 deg
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kRadPerCentideg = kPi / 18000.0;
-constexpr double kCentidegPerRad = 18000.0 / kPi;
+constexpr double kRadPerCentideg = M_PI / 18000.0;
+constexpr double kCentidegPerRad = 18000.0 / M_PI;
 
 // Valid ranges of the 0x111 fields (manual 3.2; open point 1 for the linear speed).
 constexpr double kMaxLinearSpeedMmps = interpretation::kMaxLinearSpeedMps * kMillis;
@@ -181,14 +180,14 @@ Error dlc_above_8(const CanFrame& f) {
 
 Error implausible_angle(std::uint32_t id, const char* what, std::int16_t raw, AngleUnit unit,
                         double rad) {
-  char buf[200];
-  std::snprintf(buf, sizeof buf,
-                ": %s %d x %s = %.1f deg is beyond any model's reach (%.0f deg): impossible under "
-                "this profile",
-                what, static_cast<int>(raw),
-                unit == AngleUnit::kMilliradian ? "0.001 rad" : "0.01 deg", rad * 180.0 / kPi,
-                interpretation::kMaxPlausibleSteeringRad * 180.0 / kPi);
-  return Error{Errc::kOutOfRange, id_text(id) + buf};
+  return Error{
+      Errc::kOutOfRange,
+      id_text(id) + text::format(": %s %d x %s = %.1f deg is beyond any model's reach "
+                                 "(%.0f deg): impossible under this profile",
+                                 what, static_cast<int>(raw),
+                                 unit == AngleUnit::kMilliradian ? "0.001 rad" : "0.01 deg",
+                                 rad_to_deg(rad),
+                                 rad_to_deg(interpretation::kMaxPlausibleSteeringRad))};
 }
 
 // ---- Decoding ---------------------------------------------------------------------------------
@@ -365,9 +364,9 @@ Message decode_version(const CanFrame& f) {
   return v;
 }
 
-}  // namespace
-
-Result<Message> decode(const CanFrame& f, const ProtocolProfile& p) {
+// Whether `f` is a RANGER frame its decoder can read: not an error frame, a known ID, at least its
+// layout's length (the one length check: every decoder reads its layout's leading bytes only).
+std::optional<Error> check_decodable(const CanFrame& f) {
   if (f.is_error) {
     return Error{Errc::kInvalidArgument,
                  "error frame (class " + hex(f.id, 8) + ") carries no RANGER message"};
@@ -377,10 +376,23 @@ Result<Message> decode(const CanFrame& f, const ProtocolProfile& p) {
     return Error{Errc::kUnknownId, "ID " + hex(f.id) + " is not part of the RANGER protocol (DLC " +
                                        std::to_string(f.dlc) + ")"};
   }
-  // The one length check: every decoder below reads its layout's `layout` leading bytes only.
   if (f.dlc > CanFrame::kMaxDlc) return dlc_above_8(f);
   if (f.dlc < layout) return too_short(f, layout);
+  return std::nullopt;
+}
+
+}  // namespace
+
+Result<Message> decode(const CanFrame& f, const ProtocolProfile& p) {
+  if (auto error = check_decodable(f)) return std::move(*error);
   const std::uint8_t* d = f.data.data();
+  // The motors' frames: one layout each for the eight motors.
+  if (f.id >= kHighSpeedFirst && f.id < kHighSpeedFirst + protocol::kMotorCount) {
+    return decode_high_speed(static_cast<int>(f.id - protocol::kMotorHighSpeedBaseId), d);
+  }
+  if (f.id >= kLowSpeedFirst && f.id < kLowSpeedFirst + protocol::kMotorCount) {
+    return decode_low_speed(static_cast<int>(f.id - protocol::kMotorLowSpeedBaseId), d, p);
+  }
   switch (f.id) {
     case protocol::kMotionCommandId:
       return decode_motion_command(d, p);
@@ -404,24 +416,6 @@ Result<Message> decode(const CanFrame& f, const ProtocolProfile& p) {
       return decode_light<LightState>(d);
     case protocol::kRemoteControlStateId:
       return decode_remote_control(d);
-    case kHighSpeedFirst + 0:
-    case kHighSpeedFirst + 1:
-    case kHighSpeedFirst + 2:
-    case kHighSpeedFirst + 3:
-    case kHighSpeedFirst + 4:
-    case kHighSpeedFirst + 5:
-    case kHighSpeedFirst + 6:
-    case kHighSpeedFirst + 7:
-      return decode_high_speed(static_cast<int>(f.id - protocol::kMotorHighSpeedBaseId), d);
-    case kLowSpeedFirst + 0:
-    case kLowSpeedFirst + 1:
-    case kLowSpeedFirst + 2:
-    case kLowSpeedFirst + 3:
-    case kLowSpeedFirst + 4:
-    case kLowSpeedFirst + 5:
-    case kLowSpeedFirst + 6:
-    case kLowSpeedFirst + 7:
-      return decode_low_speed(static_cast<int>(f.id - protocol::kMotorLowSpeedBaseId), d, p);
     case protocol::kSteeringAnglesId:
       return decode_steering_angles(f.id, d, p);
     case protocol::kWheelSpeedsId:

@@ -25,18 +25,6 @@ std::vector<std::uint32_t> ids_of(std::uint8_t revisions) {
 
 }  // namespace
 
-std::string_view to_string(Direction d) {
-  switch (d) {
-    case Direction::kToChassis:
-      return "to_chassis";
-    case Direction::kFromChassis:
-      return "from_chassis";
-    case Direction::kBoth:
-      return "both";
-  }
-  return "unknown";
-}
-
 std::vector<std::uint32_t> manual_ids() {
   return ids_of(kInManual);
 }
@@ -135,76 +123,6 @@ std::optional<std::uint8_t> motion_mode_to_wire(MotionMode mode, ModeNumbering n
   return std::nullopt;
 }
 
-std::string_view to_string(MotionMode m) {
-  switch (m) {
-    case MotionMode::kAckermann:
-      return "ackermann";
-    case MotionMode::kOblique:
-      return "oblique";
-    case MotionMode::kSpin:
-      return "spin";
-    case MotionMode::kPark:
-      return "park";
-    case MotionMode::kSideSlip:
-      return "side_slip";
-  }
-  return "unknown";
-}
-
-std::string_view to_string(ControlMode m) {
-  switch (m) {
-    case ControlMode::kStandby:
-      return "standby";
-    case ControlMode::kCan:
-      return "can";
-    case ControlMode::kUart:
-      return "uart";
-    case ControlMode::kRemote:
-      return "remote";
-  }
-  return "unknown";
-}
-
-std::string_view to_string(VehicleStatus s) {
-  switch (s) {
-    case VehicleStatus::kNormal:
-      return "normal";
-    case VehicleStatus::kEmergencyStop:
-      return "emergency_stop";
-    case VehicleStatus::kAbnormal:
-      return "abnormal";
-  }
-  return "unknown";
-}
-
-std::string_view to_string(RemoteSwitch s) {
-  switch (s) {
-    case RemoteSwitch::kUndefined:
-      return "undefined";
-    case RemoteSwitch::kMiddle:
-      return "middle";
-    case RemoteSwitch::kUp:
-      return "up";
-    case RemoteSwitch::kDown:
-      return "down";
-  }
-  return "unknown";
-}
-
-std::string_view to_string(LightMode m) {
-  switch (m) {
-    case LightMode::kOff:
-      return "off";
-    case LightMode::kOn:
-      return "on";
-    case LightMode::kBreathing:
-      return "breathing";
-    case LightMode::kCustom:
-      return "custom";
-  }
-  return "unknown";
-}
-
 std::string error_clear_description(std::uint8_t code) {
   if (code == 0x00) return "all non-critical faults";
   if (code >= 0x01 && code <= 0x08) {
@@ -283,40 +201,6 @@ bool is_critical_error(std::uint32_t error_word, ErrorWordLayout layout) {
 
 bool is_critical_error(std::uint32_t error_word) {
   return is_critical_error(error_word, ErrorWordLayout::kManual32);
-}
-
-std::string_view to_string(Fault f) {
-  switch (f) {
-    case Fault::kBatteryUnderVoltage:
-      return "battery_under_voltage";
-    case Fault::kBatteryWarning:
-      return "battery_warning";
-    case Fault::kUltrasonicTriggered:
-      return "ultrasonic_triggered";
-    case Fault::kRemoteSignalLost:
-      return "remote_signal_lost";
-    case Fault::kHostCommunicationLost:
-      return "host_communication_lost";
-    case Fault::kDriverStatusError:
-      return "driver_status_error";
-    case Fault::kOverTemperature:
-      return "over_temperature";
-    case Fault::kOverCurrent:
-      return "over_current";
-    case Fault::kMotorCommunication:
-      return "motor_communication";
-    case Fault::kSteeringCalibration:
-      return "steering_calibration";
-    case Fault::kSteeringCalibrationTimeout:
-      return "steering_calibration_timeout";
-    case Fault::kSafetyEdge:
-      return "safety_edge";
-    case Fault::kSteeringServoWarning:
-      return "steering_servo_warning";
-    case Fault::kSteeringEncoder:
-      return "steering_encoder";
-  }
-  return "unknown";
 }
 
 const FaultInfo* find_fault(Fault fault, int motor) {
@@ -411,17 +295,8 @@ std::vector<std::string> bms_status_names(std::uint8_t status1, std::uint8_t sta
 std::string_view ultrasonic_status_name(std::int16_t raw) {
   if (raw == interpretation::kUltrasonicNoReading) return "no_reading";
   if (raw > 0) return "ok";
-  switch (static_cast<UltrasonicCode>(raw)) {
-    case UltrasonicCode::kOffline:
-      return "offline";
-    case UltrasonicCode::kChecksumFailed:
-      return "checksum_failed";
-    case UltrasonicCode::kAbnormalData:
-      return "abnormal_data";
-    case UltrasonicCode::kSystemException:
-      return "system_exception";
-  }
-  return "unknown_code";
+  const auto code = static_cast<UltrasonicCode>(raw);
+  return kUltrasonicCodeNames.contains(code) ? kUltrasonicCodeNames.name(code) : "unknown_code";
 }
 
 }  // namespace ranger::protocol

@@ -1,11 +1,10 @@
 #include "cli_frame_format.hpp"
 
-#include <cstdarg>
-#include <cstdio>
 #include <initializer_list>
 #include <utility>
 #include <vector>
 
+#include "ranger_can/text.hpp"
 #include "ranger_can/wire/interpretation.hpp"
 #include "ranger_can/wire/protocol.hpp"
 
@@ -15,20 +14,9 @@ namespace {
 
 namespace proto = ranger::protocol;
 
-constexpr double kDegPerRad = 57.29577951308232;  // display only: text lines show degrees
 constexpr const char* kWheelTags[4] = {"rf", "rr", "lr", "lf"};  // manual order RF, RR, LR, LF
 
-void appendf(std::string& out, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
-void appendf(std::string& out, const char* fmt, ...) {
-  char buf[256];
-  va_list ap;
-  va_start(ap, fmt);
-  const int n = std::vsnprintf(buf, sizeof buf, fmt, ap);
-  va_end(ap);
-  if (n > 0)
-    out.append(buf, static_cast<std::size_t>(n) < sizeof buf ? static_cast<std::size_t>(n)
-                                                             : sizeof buf - 1);
-}
+using text::format;
 
 void append_hex_data(std::string& out, const CanFrame& f, char separator) {
   static constexpr char kHex[] = "0123456789ABCDEF";
@@ -41,10 +29,7 @@ void append_hex_data(std::string& out, const CanFrame& f, char separator) {
 }
 
 void write_names(JsonWriter& w, std::string_view key, const std::vector<std::string>& names) {
-  w.key(key).begin_array();
-  for (const auto& n : names)
-    w.string(n);
-  w.end_array();
+  w.key(key).strings(names);
 }
 
 void append_names(std::string& out, const std::vector<std::string>& names) {
@@ -52,12 +37,7 @@ void append_names(std::string& out, const std::vector<std::string>& names) {
     out += "none";
     return;
   }
-  out += '[';
-  for (std::size_t i = 0; i < names.size(); ++i) {
-    if (i > 0) out += ',';
-    out += names[i];
-  }
-  out += ']';
+  out += "[" + text::join(names, ",") + "]";
 }
 
 std::string bms_slot(int battery) {
@@ -227,68 +207,69 @@ struct TextFields {
   const ProtocolProfile& p;
 
   void operator()(const MotionCommand& m) const {
-    appendf(out, "linear=%.3f m/s ", m.linear_speed);
-    if (show_v2_fields(p, {m.yaw_rate})) appendf(out, "yaw_rate=%.3f rad/s ", m.yaw_rate);
-    appendf(out, "spin=%.3f m/s steering=%.2f deg", m.spin_speed, m.steering_angle * kDegPerRad);
+    out += format("linear=%.3f m/s ", m.linear_speed);
+    if (show_v2_fields(p, {m.yaw_rate})) out += format("yaw_rate=%.3f rad/s ", m.yaw_rate);
+    out += format("spin=%.3f m/s steering=%.2f deg", m.spin_speed, rad_to_deg(m.steering_angle));
   }
   void operator()(const MotionModeCommand& m) const {
-    appendf(out, "mode=%d (%s)", mode_wire_value(m, p),
-            std::string(mode_name(m.mode, m.mode_known)).c_str());
+    out += format("mode=%d (%s)", mode_wire_value(m, p),
+                  std::string(mode_name(m.mode, m.mode_known)).c_str());
   }
   void operator()(const ControlModeCommand& m) const {
-    appendf(out, "mode=%d (%s)", static_cast<int>(m.mode), proto::to_string(m.mode).data());
+    out += format("mode=%d (%s)", static_cast<int>(m.mode), proto::to_string(m.mode).data());
   }
   void operator()(const ErrorClearCommand& m) const {
-    appendf(out, "code=0x%02X (%s)", m.code, proto::error_clear_description(m.code).c_str());
+    out += format("code=0x%02X (%s)", m.code, proto::error_clear_description(m.code).c_str());
   }
   void operator()(const UltrasonicSettingCommand& m) const {
     out += m.enable ? "enable=yes" : "enable=no";
   }
   void operator()(const SystemStatus& s) const {
-    appendf(out, "vehicle=%s control=%s battery=%.1f V errors=0x%0*X ",
-            proto::to_string(s.vehicle_status).data(), proto::to_string(s.control_mode).data(),
-            s.battery_voltage, proto::error_word_bits(p.error_word) / 4, s.error_bits);
+    out +=
+        format("vehicle=%s control=%s battery=%.1f V errors=0x%0*X ",
+               proto::to_string(s.vehicle_status).data(), proto::to_string(s.control_mode).data(),
+               s.battery_voltage, proto::error_word_bits(p.error_word) / 4, s.error_bits);
     append_names(out, proto::error_bit_names(s.error_bits, p.error_word));
     if (proto::is_critical_error(s.error_bits, p.error_word)) out += " CRITICAL";
-    if (s.counter) appendf(out, " counter=%d", *s.counter);
+    if (s.counter) out += format(" counter=%d", *s.counter);
   }
   void operator()(const MotionFeedback& m) const {
-    appendf(out, "speed=%.3f m/s ", m.speed);
+    out += format("speed=%.3f m/s ", m.speed);
     if (show_v2_fields(p, {m.yaw_rate, m.lateral_speed})) {
-      appendf(out, "yaw_rate=%.3f rad/s lateral=%.3f m/s ", m.yaw_rate, m.lateral_speed);
+      out += format("yaw_rate=%.3f rad/s lateral=%.3f m/s ", m.yaw_rate, m.lateral_speed);
     }
-    appendf(out, "steering=%.2f deg", m.steering_angle * kDegPerRad);
+    out += format("steering=%.2f deg", rad_to_deg(m.steering_angle));
   }
   void operator()(const MotorHighSpeedFeedback& m) const {
-    appendf(out, "motor=%d rpm=%.0f current=%.1f A position=%d", m.motor, m.rpm, m.current,
-            static_cast<int>(m.position));
+    out += format("motor=%d rpm=%.0f current=%.1f A position=%d", m.motor, m.rpm, m.current,
+                  static_cast<int>(m.position));
   }
   void operator()(const MotorLowSpeedFeedback& m) const {
-    appendf(out, "motor=%d voltage=%.1f V driver=%.0f degC motor=%.0f degC status=", m.motor,
-            m.driver_voltage, m.driver_temperature, m.motor_temperature);
+    out += format("motor=%d voltage=%.1f V driver=%.0f degC motor=%.0f degC status=", m.motor,
+                  m.driver_voltage, m.driver_temperature, m.motor_temperature);
     append_names(out, proto::driver_status_names(m.driver_status));
   }
   void operator()(const SteeringAnglesFeedback& m) const {
     for (int i = 0; i < 4; ++i)
-      appendf(out, "%s=%.2f ", kWheelTags[i], m.angles[i] * kDegPerRad);
+      out += format("%s=%.2f ", kWheelTags[i], rad_to_deg(m.angles[i]));
     out += "deg";
   }
   void operator()(const WheelSpeedsFeedback& m) const {
     for (int i = 0; i < 4; ++i)
-      appendf(out, "%s=%.3f ", kWheelTags[i], m.speeds[i]);
+      out += format("%s=%.3f ", kWheelTags[i], m.speeds[i]);
     out += "m/s";
   }
   void operator()(const MotionModeFeedback& m) const {
-    appendf(out, "mode=%d (%s) switching=%s", m.mode_raw,
-            std::string(mode_name(m.mode, m.mode_known)).c_str(), m.switching ? "yes" : "no");
+    out += format("mode=%d (%s) switching=%s", m.mode_raw,
+                  std::string(mode_name(m.mode, m.mode_known)).c_str(), m.switching ? "yes" : "no");
   }
   void operator()(const UltrasonicFeedback& m) const {
     for (int i = 0; i < 4; ++i) {
       if (i > 0) out += ' ';
       if (interpretation::ultrasonic_distance_m(m.raw[i])) {  // 0 is no reading, not 0 mm
-        appendf(out, "s%d=%d mm", m.first_sensor + i, m.raw[i]);
+        out += format("s%d=%d mm", m.first_sensor + i, m.raw[i]);
       } else {
-        appendf(out, "s%d=%s", m.first_sensor + i, proto::ultrasonic_status_name(m.raw[i]).data());
+        out += format("s%d=%s", m.first_sensor + i, proto::ultrasonic_status_name(m.raw[i]).data());
       }
     }
   }
@@ -296,35 +277,35 @@ struct TextFields {
     out += m.enabled ? "enabled=yes" : "enabled=no";
   }
   void operator()(const BmsData& b) const {
-    appendf(out,
-            "battery=%s soc=%.0f%% soh=%.0f%% voltage=%.2f V current=%.1f A temperature=%.1f degC",
-            bms_slot(b.battery).c_str(), b.soc, b.soh, b.voltage, b.current, b.temperature);
+    out += format(
+        "battery=%s soc=%.0f%% soh=%.0f%% voltage=%.2f V current=%.1f A temperature=%.1f degC",
+        bms_slot(b.battery).c_str(), b.soc, b.soh, b.voltage, b.current, b.temperature);
   }
   void operator()(const BmsAlarm& a) const {
-    appendf(out, "battery=%s alarms=", bms_slot(a.battery).c_str());
+    out += format("battery=%s alarms=", bms_slot(a.battery).c_str());
     append_names(out, proto::bms_status_names(a.alarm1, a.alarm2));
     out += " warnings=";
     append_names(out, proto::bms_status_names(a.warning1, a.warning2));
   }
   template <typename Light>
   void light(const Light& l) const {
-    appendf(out, "enable=%s front=%s/%d rear=%s/%d counter=%d", l.enable ? "yes" : "no",
-            proto::to_string(l.front_mode).data(), l.front_custom,
-            proto::to_string(l.rear_mode).data(), l.rear_custom, l.counter);
+    out += format("enable=%s front=%s/%d rear=%s/%d counter=%d", l.enable ? "yes" : "no",
+                  proto::to_string(l.front_mode).data(), l.front_custom,
+                  proto::to_string(l.rear_mode).data(), l.rear_custom, l.counter);
   }
   void operator()(const LightCommand& l) const { light(l); }
   void operator()(const LightState& l) const { light(l); }
   void operator()(const RemoteControlState& r) const {
-    appendf(out,
-            "swa=%s swb=%s swc=%s swd=%s right_h=%d right_v=%d left_v=%d left_h=%d var_a=%d "
-            "counter=%d",
-            proto::to_string(r.swa).data(), proto::to_string(r.swb).data(),
-            proto::to_string(r.swc).data(), proto::to_string(r.swd).data(), r.stick_right_h,
-            r.stick_right_v, r.stick_left_v, r.stick_left_h, r.var_a, r.counter);
+    out += format(
+        "swa=%s swb=%s swc=%s swd=%s right_h=%d right_v=%d left_v=%d left_h=%d var_a=%d "
+        "counter=%d",
+        proto::to_string(r.swa).data(), proto::to_string(r.swb).data(),
+        proto::to_string(r.swc).data(), proto::to_string(r.swd).data(), r.stick_right_h,
+        r.stick_right_v, r.stick_left_v, r.stick_left_h, r.var_a, r.counter);
   }
   void operator()(const OdometerFeedback& o) const {
-    appendf(out, "left=%d right=%d (raw)", static_cast<int>(o.left_wheel),
-            static_cast<int>(o.right_wheel));
+    out += format("left=%d right=%d (raw)", static_cast<int>(o.left_wheel),
+                  static_cast<int>(o.right_wheel));
   }
   void operator()(const VersionRequest&) const { out += "request"; }
   void operator()(const VersionResponse& v) const {
@@ -334,7 +315,7 @@ struct TextFields {
       if (u >= 0x20 && u < 0x7F && c != '"' && c != '\\') {
         out += c;
       } else {
-        appendf(out, "\\x%02X", u);
+        out += format("\\x%02X", u);
       }
     }
     out += '"';
@@ -384,16 +365,16 @@ void append_frame_text(std::string& out, const CanFrame& frame, std::string_view
   out += ' ';
   out.append(iface.data(), iface.size());
   if (frame.is_error) {
-    appendf(out, " %08X", frame.id);
+    out += format(" %08X", frame.id);
   } else {
-    appendf(out, " %03X", frame.id);
+    out += format(" %03X", frame.id);
   }
-  appendf(out, " %-28s ", std::string(name_of(frame)).c_str());
+  out += format(" %-28s ", std::string(name_of(frame)).c_str());
   const Result<Message> decoded = decode(frame, profile);
   if (decoded) {
     append_message_text(out, *decoded, profile);
     if (const int extra = proto::extra_bytes(frame); extra > 0) {
-      appendf(out, "  [+%d byte%s ignored]", extra, extra == 1 ? "" : "s");
+      out += format("  [+%d byte%s ignored]", extra, extra == 1 ? "" : "s");
     }
   } else {
     out += "error: " + decoded.error().message + "  [";

@@ -13,7 +13,7 @@
 #include <string>
 #include <string_view>
 
-#include "cli_json.hpp"
+#include "ranger_can/json.hpp"
 #include "ranger_can/wire/codec.hpp"
 #include "ranger_can/wire/frame.hpp"
 

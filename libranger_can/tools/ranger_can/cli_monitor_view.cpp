@@ -6,8 +6,8 @@
 #include <type_traits>
 #include <vector>
 
-#include "cli_json.hpp"
 #include "ranger_can/control/geometry.hpp"
+#include "ranger_can/json.hpp"
 #include "ranger_can/text.hpp"
 #include "ranger_can/wire/interpretation.hpp"
 #include "ranger_can/wire/protocol.hpp"
@@ -16,7 +16,7 @@ namespace ranger::cli {
 
 namespace {
 
-constexpr double kRadToDeg = 180.0 / M_PI;
+using text::format;
 
 struct Style {
   bool color;
@@ -26,17 +26,11 @@ struct Style {
   std::string bold(const std::string& s) const { return color ? "\x1b[1m" + s + "\x1b[0m" : s; }
 };
 
-std::string fmt(const char* format, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, v);
-  return buf;
-}
-
 // A REP-103 angle shown unambiguously: "12.50 deg left".
 std::string rep103_steering_text(double rep103_rad) {
-  const double rep = rep103_rad * kRadToDeg;
+  const double rep = rad_to_deg(rep103_rad);
   if (std::abs(rep) < 0.005) return "  0.00 deg straight";
-  return fmt("%6.2f deg ", std::abs(rep)) + (rep > 0 ? "left " : "right");
+  return format("%6.2f deg ", std::abs(rep)) + (rep > 0 ? "left " : "right");
 }
 // 0x221's and 0x111's angles in the manual's signs; each frame has its own reading.
 std::string steering_text(double manual_rad) {
@@ -46,15 +40,15 @@ std::string command_steering_text(double manual_rad) {
   return rep103_steering_text(interpretation::rep103_from_manual_command_steering(manual_rad));
 }
 std::string wheel_angle_text(double manual_rad) {
-  const double rep = interpretation::rep103_from_manual_wheel_angle(manual_rad) * kRadToDeg;
+  const double rep = rad_to_deg(interpretation::rep103_from_manual_wheel_angle(manual_rad));
   if (std::abs(rep) < 0.005) return "  0.00 deg      ";
-  return fmt("%6.2f deg ", std::abs(rep)) + (rep > 0 ? "left " : "right");
+  return format("%6.2f deg ", std::abs(rep)) + (rep > 0 ? "left " : "right");
 }
 
 std::string age_text(Timestamp received, Timestamp now) {
   const double ms = std::chrono::duration<double, std::milli>(now - received).count();
-  if (ms < 1000) return fmt("%.0f ms ago", ms);
-  return fmt("%.1f s ago", ms / 1000);
+  if (ms < 1000) return format("%.0f ms ago", ms);
+  return format("%.1f s ago", ms / 1000);
 }
 
 // Nominal frames per second of a feedback ID (0 for commands and on-change frames): the frame
@@ -70,6 +64,18 @@ double nominal_rate(std::uint32_t id) {
 std::string ultrasonic_text(std::int16_t raw) {
   if (raw >= 0) return std::to_string(raw) + " mm";
   return std::string(protocol::ultrasonic_status_name(raw));
+}
+
+// The names of the bits set in one BMS status pair, "none" for none.
+std::string bms_names(std::uint8_t s1, std::uint8_t s2) {
+  std::vector<std::string_view> out;
+  for (const auto& bit : protocol::bms_status1_bits()) {
+    if (s1 & (1u << bit.index)) out.push_back(bit.name);
+  }
+  for (const auto& bit : protocol::bms_status2_bits()) {
+    if (s2 & (1u << bit.index)) out.push_back(bit.name);
+  }
+  return out.empty() ? std::string("none") : text::join(out, ",");
 }
 
 }  // namespace
@@ -105,49 +111,52 @@ double ChassisMonitor::rate(std::uint32_t id, Timestamp now) const {
 
 std::string ChassisMonitor::render_text(std::string_view iface, const BusStatus& bus, Timestamp now,
                                         bool color) const {
-  const Style st{color};
-  std::string o;
-  auto line = [&](const std::string& s) { o += s + "\n"; };
+  return text_header(iface, bus, now, color) + text_chassis(now, color) + text_motion(color) +
+         text_host(now, color) + text_wheels(color) + text_batteries(color) + text_ultrasonic() +
+         text_vendor() + text_rates(now, color);
+}
 
+std::string ChassisMonitor::text_header(std::string_view iface, const BusStatus& bus, Timestamp now,
+                                        bool color) const {
+  const Style st{color};
   std::string bus_state(to_string(bus.state));
   bus_state = bus.state == BusState::kActive ? st.green(bus_state) : st.red(bus_state);
   double total_rate = 0;
   for (const FrameIdCounts& c : stats_.counts())
     total_rate += rate(c.id, now);
-  line(st.bold("RANGER monitor  " + std::string(iface)) + "   bus " + bus_state +
-       (bus.detail.empty() ? "" : " (" + bus.detail + ")") + "   frames " +
-       std::to_string(stats_.total()) + fmt("  %.0f/s", total_rate) + "   undecodable " +
-       std::to_string(decode_errors_) + "   error frames " +
-       std::to_string(error_frames_ + bus.stats.error_frames) + "   dropped rx/tx " +
-       std::to_string(bus.stats.rx_dropped) + "/" + std::to_string(bus.stats.tx_dropped));
+  return st.bold("RANGER monitor  " + std::string(iface)) + "   bus " + bus_state +
+         (bus.detail.empty() ? "" : " (" + bus.detail + ")") + "   frames " +
+         std::to_string(stats_.total()) + format("  %.0f/s", total_rate) + "   undecodable " +
+         std::to_string(decode_errors_) + "   error frames " +
+         std::to_string(error_frames_ + bus.stats.error_frames) + "   dropped rx/tx " +
+         std::to_string(bus.stats.rx_dropped) + "/" + std::to_string(bus.stats.tx_dropped) + "\n";
+}
 
+std::string ChassisMonitor::text_chassis(Timestamp now, bool color) const {
+  const Style st{color};
   if (!fb_.system_status) {
-    line(st.red(stats_.total() == 0 ? "no frames received yet: is the chassis on and the bus up?"
-                                    : "no 0x211 system status received yet"));
-  } else {
-    const auto& s = fb_.system_status->value;
-    const bool stale = now - fb_.system_status->received > std::chrono::milliseconds(500);
-    std::string control(protocol::to_string(s.control_mode));
-    if (s.control_mode != protocol::ControlMode::kCan) control = st.yellow(control);
-    std::string vehicle(protocol::to_string(s.vehicle_status));
-    if (s.vehicle_status != protocol::VehicleStatus::kNormal) vehicle = st.red(vehicle);
-    std::string age = "last 0x211 " + age_text(fb_.system_status->received, now);
-    if (stale) age = st.red(age + "  CHASSIS SILENT");
-    line("Chassis   control " + control + "   vehicle " + vehicle +
-         fmt("   battery %.1f V", s.battery_voltage) + "   " + age);
-    const auto names = protocol::error_bit_names(s.error_bits, profile_.error_word);
-    if (names.empty()) {
-      line("Errors    " + st.green("none"));
-    } else {
-      std::string errs;
-      for (const auto& n : names)
-        errs += (errs.empty() ? "" : ", ") + n;
-      char word[16];
-      std::snprintf(word, sizeof word, "0x%08X", s.error_bits);
-      line("Errors    " + st.red(errs) + "  (" + word + ")");
-    }
+    return st.red(stats_.total() == 0 ? "no frames received yet: is the chassis on and the bus up?"
+                                      : "no 0x211 system status received yet") +
+           "\n";
   }
+  const auto& s = fb_.system_status->value;
+  const bool stale = now - fb_.system_status->received > std::chrono::milliseconds(500);
+  std::string control(protocol::to_string(s.control_mode));
+  if (s.control_mode != protocol::ControlMode::kCan) control = st.yellow(control);
+  std::string vehicle(protocol::to_string(s.vehicle_status));
+  if (s.vehicle_status != protocol::VehicleStatus::kNormal) vehicle = st.red(vehicle);
+  std::string age = "last 0x211 " + age_text(fb_.system_status->received, now);
+  if (stale) age = st.red(age + "  CHASSIS SILENT");
+  std::string out = "Chassis   control " + control + "   vehicle " + vehicle +
+                    format("   battery %.1f V", s.battery_voltage) + "   " + age + "\n";
+  const auto names = protocol::error_bit_names(s.error_bits, profile_.error_word);
+  if (names.empty()) return out + "Errors    " + st.green("none") + "\n";
+  return out + "Errors    " + st.red(text::join(names)) + "  (" + text::hex(s.error_bits, 8) +
+         ")\n";
+}
 
+std::string ChassisMonitor::text_motion(bool color) const {
+  const Style st{color};
   std::string motion = "Motion    mode ";
   if (fb_.motion_mode) {
     const auto& m = fb_.motion_mode->value;
@@ -158,17 +167,21 @@ std::string ChassisMonitor::render_text(std::string_view iface, const BusStatus&
   }
   if (fb_.motion) {
     const auto& m = fb_.motion->value;
-    motion += fmt("   speed %+.3f m/s", m.speed) + "   steering " + steering_text(m.steering_angle);
+    motion +=
+        format("   speed %+.3f m/s", m.speed) + "   steering " + steering_text(m.steering_angle);
   }
-  line(motion);
+  return motion + "\n";
+}
 
+std::string ChassisMonitor::text_host(Timestamp now, bool color) const {
+  const Style st{color};
   std::string host = "Host      ";
   if (motion_command_) {
     const auto& c = motion_command_->value;
-    host += fmt("0x111 speed %+.3f m/s", c.linear_speed) + "  steer " +
-            command_steering_text(c.steering_angle) + fmt("  spin %+.3f m/s", c.spin_speed) +
+    host += format("0x111 speed %+.3f m/s", c.linear_speed) + "  steer " +
+            command_steering_text(c.steering_angle) + format("  spin %+.3f m/s", c.spin_speed) +
             "  (" + age_text(motion_command_->received, now) +
-            fmt(", %.1f/s)", rate(protocol::kMotionCommandId, now));
+            format(", %.1f/s)", rate(protocol::kMotionCommandId, now));
   } else {
     host += st.yellow("no 0x111 seen");
   }
@@ -178,74 +191,76 @@ std::string ChassisMonitor::render_text(std::string_view iface, const BusStatus&
   if (motion_mode_command_) {
     host += "   0x141 " + std::string(protocol::to_string(motion_mode_command_->value.mode));
   }
-  if (error_clear_command_) host += fmt("   0x441 %.0f", error_clear_command_->value.code);
-  line(host);
-
-  line(
-      "Wheels         steering           speed      drive rpm      A   steer rpm      A   drv/mot "
-      "degC  driver status");
-  for (int i = 0; i < kWheelCount; ++i) {
-    std::string row = "  " + std::string(kWheelNames[i]);
-    row.resize(14, ' ');
-    row += fb_.steering_angles ? wheel_angle_text(fb_.steering_angles->value.angles[i])
-                               : std::string("      ?         ");
-    row +=
-        fb_.wheel_speeds ? fmt("  %+7.3f m/s", fb_.wheel_speeds->value.speeds[i]) : "        ?    ";
-    const auto& drive = fb_.motor_high_speed[i];
-    const auto& steer = fb_.motor_high_speed[i + kWheelCount];
-    row += drive ? fmt("  %+9.1f", drive->value.rpm) + fmt(" %+6.1f", drive->value.current)
-                 : "          ?      ?";
-    row += steer ? fmt("  %+9.1f", steer->value.rpm) + fmt(" %+6.1f", steer->value.current)
-                 : "          ?      ?";
-    const auto& low = fb_.motor_low_speed[i];
-    if (low) {
-      row += fmt("   %3.0f", low->value.driver_temperature) +
-             fmt("/%-3.0f", low->value.motor_temperature);
-      std::string status;
-      for (int m : {i, i + kWheelCount}) {
-        const auto& l = fb_.motor_low_speed[m];
-        if (!l) continue;
-        for (const auto& n : protocol::driver_status_names(l->value.driver_status)) {
-          status += (status.empty() ? "" : ",") + n + "(m" + std::to_string(m + 1) + ")";
-        }
-      }
-      row += "      " + (status.empty() ? st.green("ok") : st.red(status));
-    }
-    line(row);
+  if (error_clear_command_) {
+    host += format("   0x441 %.0f", static_cast<double>(error_clear_command_->value.code));
   }
+  return host + "\n";
+}
 
+std::string ChassisMonitor::text_wheels(bool color) const {
+  std::string out =
+      "Wheels         steering           speed      drive rpm      A   steer rpm      A   drv/mot "
+      "degC  driver status\n";
+  for (int i = 0; i < kWheelCount; ++i)
+    out += text_wheel(i, color) + "\n";
+  return out;
+}
+
+std::string ChassisMonitor::text_wheel(int i, bool color) const {
+  const Style st{color};
+  std::string row = "  " + std::string(kWheelNames[i]);
+  row.resize(14, ' ');
+  row += fb_.steering_angles ? wheel_angle_text(fb_.steering_angles->value.angles[i])
+                             : std::string("      ?         ");
+  row += fb_.wheel_speeds ? format("  %+7.3f m/s", fb_.wheel_speeds->value.speeds[i])
+                          : "        ?    ";
+  for (const auto& motor : {fb_.motor_high_speed[i], fb_.motor_high_speed[i + kWheelCount]}) {
+    row += motor ? format("  %+9.1f", motor->value.rpm) + format(" %+6.1f", motor->value.current)
+                 : "          ?      ?";
+  }
+  const auto& low = fb_.motor_low_speed[i];
+  if (!low) return row;
+  row += format("   %3.0f", low->value.driver_temperature) +
+         format("/%-3.0f", low->value.motor_temperature);
+  std::string status;
+  for (int m : {i, i + kWheelCount}) {
+    const auto& l = fb_.motor_low_speed[m];
+    if (!l) continue;
+    for (const auto& n : protocol::driver_status_names(l->value.driver_status)) {
+      status += (status.empty() ? "" : ",") + n + "(m" + std::to_string(m + 1) + ")";
+    }
+  }
+  return row + "      " + (status.empty() ? st.green("ok") : st.red(status));
+}
+
+std::string ChassisMonitor::text_batteries(bool color) const {
+  const Style st{color};
+  std::string out;
   for (int b = 0; b <= protocol::kBatteryCount; ++b) {
     if (!fb_.bms[b]) continue;
     const auto& d = fb_.bms[b]->value;
     std::string row = b == 0 ? "Battery   pack  " : "          bat " + std::to_string(b) + " ";
-    std::string soc = fmt("SOC %5.1f%%", d.soc);
+    std::string soc = format("SOC %5.1f%%", d.soc);
     if (d.soc < 10) {
       soc = st.red(soc);
     } else if (d.soc < 15) {
       soc = st.yellow(soc);
     }
-    row += soc + fmt("  SOH %5.1f%%", d.soh) + fmt("  %6.2f V", d.voltage) +
-           fmt("  %+6.1f A", d.current) + fmt("  %5.1f degC", d.temperature);
+    row += soc + format("  SOH %5.1f%%", d.soh) + format("  %6.2f V", d.voltage) +
+           format("  %+6.1f A", d.current) + format("  %5.1f degC", d.temperature);
     if (fb_.bms_alarm[b]) {
       const auto& a = fb_.bms_alarm[b]->value;
-      auto names = [](std::uint8_t s1, std::uint8_t s2) {
-        std::string out;
-        for (const auto& bit : protocol::bms_status1_bits()) {
-          if (s1 & (1u << bit.index)) out += (out.empty() ? "" : ",") + std::string(bit.name);
-        }
-        for (const auto& bit : protocol::bms_status2_bits()) {
-          if (s2 & (1u << bit.index)) out += (out.empty() ? "" : ",") + std::string(bit.name);
-        }
-        return out.empty() ? std::string("none") : out;
-      };
-      const std::string alarms = names(a.alarm1, a.alarm2);
-      const std::string warnings = names(a.warning1, a.warning2);
+      const std::string alarms = bms_names(a.alarm1, a.alarm2);
+      const std::string warnings = bms_names(a.warning1, a.warning2);
       row += "  alarms " + (alarms == "none" ? alarms : st.red(alarms)) + "  warnings " +
              (warnings == "none" ? warnings : st.yellow(warnings));
     }
-    line(row);
+    out += row + "\n";
   }
+  return out;
+}
 
+std::string ChassisMonitor::text_ultrasonic() const {
   std::string us = "Ultrasonic avoidance ";
   us += fb_.ultrasonic_setting ? (fb_.ultrasonic_setting->value.enabled ? "enabled" : "disabled")
                                : "? (no 0x45A yet)";
@@ -256,30 +271,37 @@ std::string ChassisMonitor::render_text(std::string_view iface, const BusStatus&
             ultrasonic_text(fb_.ultrasonic[k]->value.raw[i]);
     }
   }
-  line(us);
+  return us + "\n";
+}
 
-  // The vendor's additions (agx_v2): the remote control, the lights, the firmware version.
+// The vendor's additions (agx_v2): the remote control, the lights, the firmware version.
+std::string ChassisMonitor::text_vendor() const {
+  std::string out;
   if (fb_.remote_control_state) {
     const RemoteState r =
         remote_state_from(fb_.remote_control_state->value, fb_.remote_control_state->received);
-    line("Remote   SWA " + std::string(protocol::to_string(r.swa)) + "  SWB " +
-         std::string(protocol::to_string(r.swb)) + "  SWC " +
-         std::string(protocol::to_string(r.swc)) + "  SWD " +
-         std::string(protocol::to_string(r.swd)) +
-         fmt("   left stick (%+.2f fwd,", r.left_vertical) +
-         fmt(" %+.2f right)", r.left_horizontal) +
-         fmt("  right stick (%+.2f fwd,", r.right_vertical) +
-         fmt(" %+.2f right)", r.right_horizontal) + fmt("  knob %+.2f", r.knob));
+    out += "Remote   SWA " + std::string(protocol::to_string(r.swa)) + "  SWB " +
+           std::string(protocol::to_string(r.swb)) + "  SWC " +
+           std::string(protocol::to_string(r.swc)) + "  SWD " +
+           std::string(protocol::to_string(r.swd)) +
+           format("   left stick (%+.2f fwd,", r.left_vertical) +
+           format(" %+.2f right)", r.left_horizontal) +
+           format("  right stick (%+.2f fwd,", r.right_vertical) +
+           format(" %+.2f right)", r.right_horizontal) + format("  knob %+.2f", r.knob) + "\n";
   }
   if (fb_.light_state) {
     const LightState& l = fb_.light_state->value;
-    line("Lights   " + describe(l.front_mode, l.front_custom, l.rear_mode, l.rear_custom) +
-         (l.enable ? "  (under CAN control)" : "  (the chassis's own)"));
+    out += "Lights   " + describe(l.front_mode, l.front_custom, l.rear_mode, l.rear_custom) +
+           (l.enable ? "  (under CAN control)" : "  (the chassis's own)") + "\n";
   }
-  if (!fb_.version.empty()) line("Firmware " + fb_.version);
+  if (!fb_.version.empty()) out += "Firmware " + fb_.version + "\n";
+  return out;
+}
 
-  // Frame rates: every ID seen, plus the periodic feedback IDs that are missing.
-  line("Rates /s  (expected in brackets; " + st.red("red") + " = more than 20% off)");
+// Frame rates: every ID seen, plus the periodic feedback IDs that are missing.
+std::string ChassisMonitor::text_rates(Timestamp now, bool color) const {
+  const Style st{color};
+  std::string out = "Rates /s  (expected in brackets; " + st.red("red") + " = more than 20% off)\n";
   std::vector<std::uint32_t> ids;
   for (const FrameIdCounts& c : stats_.counts())
     ids.push_back(c.id);
@@ -294,18 +316,18 @@ std::string ChassisMonitor::render_text(std::string_view iface, const BusStatus&
   for (auto id : ids) {
     const double r = rate(id, now);
     const double nominal = nominal_rate(id);
-    std::string cell = text::hex(id) + fmt(" %5.1f", r);
-    cell += nominal > 0 ? fmt(" (%2.0f)", nominal) : "     ";
+    std::string cell = text::hex(id) + format(" %5.1f", r);
+    cell += nominal > 0 ? format(" (%2.0f)", nominal) : "     ";
     if (nominal > 0 && std::abs(r - nominal) > 0.2 * nominal) cell = st.red(cell);
     row += "  " + cell;
     if (++in_row == 6) {
-      line(row);
+      out += row + "\n";
       row.clear();
       in_row = 0;
     }
   }
-  if (!row.empty()) line(row);
-  return o;
+  if (!row.empty()) out += row + "\n";
+  return out;
 }
 
 std::string ChassisMonitor::render_json(std::string_view iface, const BusStatus& bus,

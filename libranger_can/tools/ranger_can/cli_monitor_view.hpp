@@ -54,6 +54,19 @@ class ChassisMonitor {
     Timestamp received{0};
   };
 
+  // render_text's parts, each one or more lines ending with '\n'.
+  std::string text_header(std::string_view iface, const BusStatus& bus, Timestamp now,
+                          bool color) const;
+  std::string text_chassis(Timestamp now, bool color) const;
+  std::string text_motion(bool color) const;
+  std::string text_host(Timestamp now, bool color) const;
+  std::string text_wheels(bool color) const;
+  std::string text_wheel(int wheel, bool color) const;
+  std::string text_batteries(bool color) const;
+  std::string text_ultrasonic() const;
+  std::string text_vendor() const;
+  std::string text_rates(Timestamp now, bool color) const;
+
   ProtocolProfile profile_;
   ChassisFeedback fb_;
   std::optional<Seen<MotionCommand>> motion_command_;  // commands from other nodes (the host)

@@ -7,6 +7,7 @@
 #include <ostream>
 #include <stdexcept>
 
+#include "ranger_can/frontend/node_parameters.hpp"
 #include "ranger_can/parse.hpp"
 #include "ranger_can/text.hpp"
 
@@ -51,6 +52,16 @@ ValueRule checked_by(std::function<Status(const std::string&)> check) {
   ValueRule r;
   r.kind = ValueRule::Kind::kCustom;
   r.check = std::move(check);
+  return r;
+}
+
+ValueRule parameter_rule(std::string_view name) {
+  ValueRule r;
+  r.kind = ValueRule::Kind::kParameter;
+  r.parameter = find_node_parameter(name);
+  if (r.parameter == nullptr) {
+    throw std::logic_error("'" + std::string(name) + "' is not a row of the parameter table");
+  }
   return r;
 }
 
@@ -144,6 +155,29 @@ Error usage(std::string message) {
   return Error{Errc::kInvalidArgument, std::move(message)};
 }
 
+// `text` read as the row's type, then checked against the row: "--soc = 150 is out of range:
+// valid [0, 100] %".
+Status check_parameter_text(const std::string& what, const Parameter& row,
+                            const std::string& text) {
+  ParameterValue v(text);
+  if (row.type == ParameterType::kNumber || row.type == ParameterType::kSeconds) {
+    auto d = parse_double(what, text);
+    if (!d) return d.error();
+    v = *d;
+  } else if (row.type == ParameterType::kInteger) {
+    auto n = parse_integer(what, text, std::numeric_limits<std::int64_t>::min(),
+                           std::numeric_limits<std::int64_t>::max());
+    if (!n) return n.error();
+    v = static_cast<long long>(*n);
+  } else if (row.type == ParameterType::kBool && (text == "true" || text == "false")) {
+    v = text == "true";
+  }
+  if (auto checked = check_parameter(row, v); !checked) {
+    return usage(what + " " + checked.error().message);
+  }
+  return ok_status();
+}
+
 Status check_value(const std::string& what, const ValueRule& rule, const std::string& value) {
   switch (rule.kind) {
     case ValueRule::Kind::kAny:
@@ -171,6 +205,8 @@ Status check_value(const std::string& what, const ValueRule& rule, const std::st
       if (!s) return usage(what + ": " + s.error().message);
       return ok_status();
     }
+    case ValueRule::Kind::kParameter:
+      return check_parameter_text(what, *rule.parameter, value);
   }
   return ok_status();
 }
@@ -217,6 +253,63 @@ bool is_help(const std::string& a) {
   return a == "-h" || a == "--help";
 }
 
+// The option `a` names ("--name", "--name=value" or "-x"), and the value given inline.
+const OptionSpec* find_option(const CommandSpec& spec, const std::string& a, std::string& name,
+                              std::optional<std::string>& inline_value) {
+  name = a;
+  if (a.rfind("--", 0) == 0) {
+    const auto eq = a.find('=');
+    if (eq != std::string::npos) {
+      inline_value = a.substr(eq + 1);
+      name = a.substr(0, eq);
+    }
+    for (const auto& o : spec.options) {
+      if (o.name == name) return &o;
+    }
+  } else if (a.size() == 2) {
+    for (const auto& o : spec.options) {
+      if (o.short_name == a[1]) return &o;
+    }
+  }
+  return nullptr;
+}
+
+// The option args[i] names, with its value (inline, or the next argument: i moves past it).
+Status take_option(const CommandSpec& spec, const Args& args, std::size_t& i, ParsedArgs& parsed) {
+  std::string name;
+  std::optional<std::string> inline_value;
+  const OptionSpec* found = find_option(spec, args[i], name, inline_value);
+  if (found == nullptr) return usage(unknown_option(spec, name));
+  const OptionSpec& o = *found;
+  if (!o.repeatable && parsed.has(o.name)) return usage(o.name + " given more than once");
+  std::string value;
+  if (o.value_name.empty()) {
+    if (inline_value) return usage(o.name + " takes no value");
+  } else if (inline_value) {
+    value = *inline_value;
+  } else if (i + 1 < args.size()) {
+    value = args[++i];
+  } else {
+    return usage(o.name + " needs a value (" + o.value_name + ")");
+  }
+  if (!o.value_name.empty()) {
+    if (Status s = check_value(o.name, o.rule, value); !s) return s;
+  }
+  parsed.add(o.name, std::move(value));
+  return ok_status();
+}
+
+// The required positionals from `next` on are all given.
+Status check_required(const CommandSpec& spec, std::size_t next, const ParsedArgs& parsed) {
+  for (std::size_t k = next; k < spec.positionals.size(); ++k) {
+    const PositionalSpec& p = spec.positionals[k];
+    if (p.arity == PositionalSpec::Arity::kRequired && !parsed.has(p.name)) {
+      return usage("missing " + p.name + (p.example.empty() ? "" : " (e.g. " + p.example + ")"));
+    }
+  }
+  return ok_status();
+}
+
 }  // namespace
 
 ParseOutcome parse_command_line(const CommandSpec& spec, const Args& args) {
@@ -238,41 +331,8 @@ ParseOutcome parse_command_line(const CommandSpec& spec, const Args& args) {
       options_ended = true;
       continue;
     }
-    const bool looks_like_option =
-        !options_ended && a.size() > 1 && a[0] == '-' && !is_negative_number(a);
-    if (looks_like_option) {
-      std::string name = a;
-      std::optional<std::string> inline_value;
-      const OptionSpec* spec_option = nullptr;
-      if (a.rfind("--", 0) == 0) {
-        const auto eq = a.find('=');
-        if (eq != std::string::npos) {
-          inline_value = a.substr(eq + 1);
-          name = a.substr(0, eq);
-        }
-        for (const auto& o : spec.options)
-          if (o.name == name) spec_option = &o;
-      } else if (a.size() == 2) {
-        for (const auto& o : spec.options)
-          if (o.short_name == a[1]) spec_option = &o;
-      }
-      if (spec_option == nullptr) return fail(usage(unknown_option(spec, name)));
-      const OptionSpec& o = *spec_option;
-      if (!o.repeatable && parsed.has(o.name)) return fail(usage(o.name + " given more than once"));
-      std::string value;
-      if (o.value_name.empty()) {
-        if (inline_value) return fail(usage(o.name + " takes no value"));
-      } else if (inline_value) {
-        value = *inline_value;
-      } else if (i + 1 < args.size()) {
-        value = args[++i];
-      } else {
-        return fail(usage(o.name + " needs a value (" + o.value_name + ")"));
-      }
-      if (!o.value_name.empty()) {
-        if (Status s = check_value(o.name, o.rule, value); !s) return fail(s.error());
-      }
-      parsed.add(o.name, std::move(value));
+    if (!options_ended && a.size() > 1 && a[0] == '-' && !is_negative_number(a)) {
+      if (Status s = take_option(spec, args, i, parsed); !s) return fail(s.error());
       continue;
     }
     // A positional argument.
@@ -284,13 +344,7 @@ ParseOutcome parse_command_line(const CommandSpec& spec, const Args& args) {
     parsed.add(p.name, a);
     if (p.arity != PositionalSpec::Arity::kRest) ++next_positional;
   }
-  for (std::size_t k = next_positional; k < spec.positionals.size(); ++k) {
-    const PositionalSpec& p = spec.positionals[k];
-    if (p.arity == PositionalSpec::Arity::kRequired && !parsed.has(p.name)) {
-      return fail(
-          usage("missing " + p.name + (p.example.empty() ? "" : " (e.g. " + p.example + ")")));
-    }
-  }
+  if (Status s = check_required(spec, next_positional, parsed); !s) return fail(s.error());
   return {Kind::kRun, std::move(parsed), ""};
 }
 

@@ -34,6 +34,7 @@
 #include <vector>
 
 #include "cli_commands.hpp"
+#include "ranger_can/control/parameters.hpp"
 #include "ranger_can/result.hpp"
 
 namespace ranger::cli {
@@ -41,7 +42,7 @@ namespace ranger::cli {
 // What a value (of an option or a positional argument) must look like. The parser checks it, so
 // a run function reads only values its table accepted.
 struct ValueRule {
-  enum class Kind { kAny, kNonEmpty, kNumber, kInteger, kChoice, kCustom };
+  enum class Kind { kAny, kNonEmpty, kNumber, kInteger, kChoice, kCustom, kParameter };
   Kind kind = Kind::kNonEmpty;
   double min = 0.0;  // kNumber: inclusive range
   double max = 0.0;
@@ -49,6 +50,7 @@ struct ValueRule {
   std::int64_t int_max = 0;
   std::vector<std::string> choices;                 // kChoice
   std::function<Status(const std::string&)> check;  // kCustom: the error names the problem
+  const Parameter* parameter = nullptr;             // kParameter: a row of the parameter table
 };
 
 ValueRule any_text();                                      // anything, the empty string included
@@ -57,6 +59,9 @@ ValueRule number_in(double min, double max);               // a finite number in
 ValueRule integer_in(std::int64_t min, std::int64_t max);  // decimal or 0x..., inside [min, max]
 ValueRule one_of(std::vector<std::string> choices);        // exactly one of these words
 ValueRule checked_by(std::function<Status(const std::string&)> check);
+// What the node accepts for its parameter `name` (a row of ranger::node_parameters(): its type,
+// range or values), for an option that takes the same value (`sim --soc`: sim/initial_soc).
+ValueRule parameter_rule(std::string_view name);
 
 struct OptionSpec {
   std::string name;        // the long form, "--soc"

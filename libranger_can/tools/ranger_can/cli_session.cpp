@@ -10,8 +10,22 @@ namespace ranger::cli {
 
 using namespace std::chrono_literals;
 
+namespace {
+// A source whose buses are only listened to: the driver treats it as a replayed log.
+class ListenOnlySource final : public BusSource {
+ public:
+  explicit ListenOnlySource(std::shared_ptr<BusSource> source) : source_(std::move(source)) {}
+  Result<std::unique_ptr<Bus>> open() override { return source_->open(); }
+  std::string name() const override { return source_->name(); }
+  bool read_only() const override { return true; }
+
+ private:
+  std::shared_ptr<BusSource> source_;
+};
+}  // namespace
+
 Result<std::unique_ptr<DriverSession>> DriverSession::open(const std::string& spec,
-                                                           DriverConfig config) {
+                                                           DriverConfig config, bool listen_only) {
   std::unique_ptr<DriverSession> s(new DriverSession());
   auto kind = bus_kind(spec);
   if (!kind) return kind.error();
@@ -28,6 +42,7 @@ Result<std::unique_ptr<DriverSession>> DriverSession::open(const std::string& sp
   if (!source) return source.error();
   s->source_ = *source;
   if (*kind == BusKind::kSim) s->sim_ = std::static_pointer_cast<sim::SimBusSource>(s->source_);
+  if (listen_only) s->source_ = std::make_shared<ListenOnlySource>(s->source_);
   s->driver_ = std::make_unique<Driver>(std::move(config), s->source_, *s->clock_);
   return s;
 }

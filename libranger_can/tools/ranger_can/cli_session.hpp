@@ -18,8 +18,10 @@ namespace ranger::cli {
 
 class DriverSession {
  public:
-  // Opens `spec` (ranger::sim::open_bus_source) and starts a driver with `config`.
-  static Result<std::unique_ptr<DriverSession>> open(const std::string& spec, DriverConfig config);
+  // Opens `spec` (ranger::sim::open_bus_source) and starts a driver with `config`. `listen_only`:
+  // the driver sends nothing and identifies passively, as on a replayed log (`monitor`).
+  static Result<std::unique_ptr<DriverSession>> open(const std::string& spec, DriverConfig config,
+                                                     bool listen_only = false);
   ~DriverSession();
 
   // Replaces the driver (the old one stops: a zero 0x111, and standby if its config says so).

@@ -1,6 +1,5 @@
 // `ranger_can identify IFACE`: runs the driver with `--protocol auto` until the identification
 // ends (control/identification.hpp) and prints the decision with its evidence.
-#include <cstdio>
 #include <ostream>
 #include <string>
 
@@ -9,6 +8,7 @@
 #include "cli_profile.hpp"
 #include "cli_session.hpp"
 #include "cli_signals.hpp"
+#include "ranger_can/text.hpp"
 
 namespace ranger::cli {
 
@@ -16,23 +16,17 @@ namespace {
 
 using namespace std::chrono_literals;
 
-std::string seconds_text(std::chrono::nanoseconds d) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.2f s", seconds(d));
-  return buf;
-}
+using text::duration_text;
 
 // The identification as text: the decision, every setting (decided or kept), the evidence.
 void print_identification(const IdentificationStatus& s, const ProtocolProfile& profile,
                           bool simulated, std::ostream& out) {
   if (s.decided_ok()) {
-    out << "identified in " << seconds_text(s.elapsed()) << (simulated ? " (simulated time)" : "")
+    out << "identified in " << duration_text(s.elapsed()) << (simulated ? " (simulated time)" : "")
         << ": " << describe(profile) << "\n";
-    char conf[32];
-    std::snprintf(conf, sizeof conf, "%.3f", s.confidence);
-    out << "confidence: " << conf << "\n";
+    out << "confidence: " << text::fixed(s.confidence, 3) << "\n";
   } else {
-    out << "not identified after " << seconds_text(s.elapsed())
+    out << "not identified after " << duration_text(s.elapsed())
         << (simulated ? " (simulated time)" : "") << "\n";
   }
   out << "settings:\n";

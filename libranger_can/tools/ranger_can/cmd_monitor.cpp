@@ -8,7 +8,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdio>
 #include <cstdlib>
 #include <deque>
 #include <iostream>
@@ -22,10 +21,13 @@
 #include "cli_monitor_view.hpp"
 #include "cli_options.hpp"
 #include "cli_profile.hpp"
+#include "cli_session.hpp"
 #include "cli_signals.hpp"
 #include "ranger_can/clock.hpp"
+#include "ranger_can/control/diagnostics.hpp"
 #include "ranger_can/control/driver.hpp"
 #include "ranger_can/parse.hpp"
+#include "ranger_can/text.hpp"
 
 namespace ranger::cli {
 
@@ -57,8 +59,41 @@ MonitorOptions options_from(const ParsedArgs& args) {
   return o;
 }
 
-std::chrono::nanoseconds seconds(double s) {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::duration<double>(s));
+// The view as drawn: after a clear-screen on a terminal, else (text) after a blank line from the
+// second view on.
+std::string drawn(std::string view, bool clear, bool json, long views) {
+  if (clear) return "\x1b[H\x1b[2J" + view;
+  if (!json && views > 0) return "\n" + view;
+  return view;
+}
+
+// The monitor once the identification window is over: the chassis's settings read from the
+// frames heard so far (passively, as `decode` does for a log), --set over them.
+Result<ChassisMonitor> identified_monitor(const ParsedArgs& args, const Vehicle& vehicle,
+                                          const MonitorOptions& o, std::vector<CanFrame>& heard,
+                                          Timestamp now) {
+  ProtocolProfile profile = identify_log(heard, vehicle.geometry).profile;
+  if (Status st = apply_set_options(profile, args); !st) return st.error();
+  ChassisMonitor monitor(from_seconds(o.window), profile);
+  for (const CanFrame& f : heard)
+    monitor.on_frame(f, now);
+  heard.clear();
+  return monitor;
+}
+
+// A frame received (or the receive's error): to the monitor, or kept for the identification.
+void take(const Result<CanFrame>& frame, std::optional<ChassisMonitor>& monitor,
+          std::vector<CanFrame>& heard, Timestamp now) {
+  if (frame) {
+    if (monitor) {
+      monitor->on_frame(*frame, now);
+    } else {
+      heard.push_back(*frame);
+    }
+  } else if (frame.error().code != Errc::kTimeout) {
+    // The bus reports and recovers a lost interface itself; the view shows the state.
+    ::usleep(20000);
+  }
 }
 
 // IFACE once more, for the driver that reports the events: read-only (it sends nothing).
@@ -100,9 +135,8 @@ class EventLines {
       if (json_) {
         out += to_json(e, start_) + "\n";
       } else if (e.severity != Severity::kDebug) {
-        char t[24];
-        std::snprintf(t, sizeof t, "%8.3f ", ranger::seconds(e.time - start_));
-        out += t + std::string(to_string(e.severity)) + ": " + describe(e) + "\n";
+        out += text::format("%8.3f ", seconds(e.time - start_)) +
+               std::string(to_string(e.severity)) + ": " + describe(e) + "\n";
       }
     }
     if (!under_view_) return out;
@@ -140,6 +174,28 @@ DriverConfig listening_config(const Vehicle& vehicle, bool identify) {
   return c;
 }
 
+// --diagnostics: the driver listens (sends nothing) for the window, at least the identification's
+// listening time and a little, then the groups /diagnostics shows are printed.
+int diagnostics_main(const ParsedArgs& args, Io io) {
+  const MonitorOptions o = options_from(args);
+  const Result<Vehicle> vehicle = vehicle_from_args(args);
+  if (!vehicle) return usage_error(monitor_command(), io, vehicle.error().message);
+  const DriverConfig config = listening_config(*vehicle, protocol_is_auto(args));
+  StopSignals signals;
+  auto session = DriverSession::open(o.iface, config, /*listen_only=*/true);
+  if (!session) {
+    io.err << "ranger_can monitor: " << session.error().message << "\n";
+    return 1;
+  }
+  (*session)->run_for(std::max(from_seconds(o.window), config.identification.listen_time + 300ms));
+  const auto snapshot = (*session)->snapshot();
+  (*session)->stop();
+  ChassisDiagnostics diagnostics({o.iface, "", ""});
+  for (const DiagnosticGroup& group : diagnostics.report(*snapshot))
+    io.out << to_text(group);
+  return snapshot->controller.link == LinkState::kConnected ? 0 : 1;
+}
+
 int monitor_main(const ParsedArgs& args, Io io) {
   const MonitorOptions o = options_from(args);
   const Result<Vehicle> vehicle = vehicle_from_args(args);
@@ -161,67 +217,50 @@ int monitor_main(const ParsedArgs& args, Io io) {
                 std::make_shared<ListeningSource>(o.iface), clock);
   // With --protocol auto (the default) the first half second of frames (or the --once window)
   // identifies the chassis's settings passively, as `decode` does for a log; the view starts then.
-  const bool identify = protocol_is_auto(args);
   std::vector<CanFrame> heard;  // while identifying
   std::optional<ChassisMonitor> monitor;
-  if (!identify) monitor.emplace(seconds(o.window), vehicle->profile);
+  if (!protocol_is_auto(args)) monitor.emplace(from_seconds(o.window), vehicle->profile);
   const Timestamp start = clock.now();
   EventLines events(driver, start, o.json, clear);
-  const auto period = seconds(1.0 / o.rate);
-  Timestamp next_view = start + (o.once ? seconds(o.window) : std::max(period, seconds(0.5)));
+  const auto period = from_seconds(1.0 / o.rate);
+  Timestamp next_view =
+      start + (o.once ? from_seconds(o.window) : std::max(period, from_seconds(0.5)));
   long views = 0;
 
   while (!StopSignals::requested()) {
     const Timestamp now = clock.now();
     io.out << events.step(now);
     if (now >= next_view && !monitor) {
-      ProtocolProfile profile = identify_log(heard, vehicle->geometry).profile;
-      if (Status st = apply_set_options(profile, args); !st) {
-        return usage_error(monitor_command(), io, st.error().message);
-      }
-      monitor.emplace(seconds(o.window), profile);
-      for (const CanFrame& f : heard)
-        monitor->on_frame(f, now);
-      heard.clear();
+      auto m = identified_monitor(args, *vehicle, o, heard, now);
+      if (!m) return usage_error(monitor_command(), io, m.error().message);
+      monitor.emplace(std::move(*m));
     }
     if (now >= next_view) {
       const BusStatus status = (*bus)->status();
-      std::string view = o.json
-                             ? monitor->render_json(o.iface, status, now) + "\n"
-                             : monitor->render_text(o.iface, status, now, color) + events.recent();
-      if (clear) {
-        view = "\x1b[H\x1b[2J" + view;
-      } else if (!o.json && views > 0) {
-        view = "\n" + view;
-      }
-      io.out << view;
+      io.out << drawn(o.json ? monitor->render_json(o.iface, status, now) + "\n"
+                             : monitor->render_text(o.iface, status, now, color) + events.recent(),
+                      clear, o.json, views);
       io.out.flush();
       ++views;
-      if (o.once) {
-        if (!monitor->heard_chassis()) {
-          io.err << "ranger_can monitor: no RANGER feedback on " << o.iface << " within "
-                 << o.window << " s\n";
-          return 1;
-        }
-        return 0;
+      if (o.once && !monitor->heard_chassis()) {
+        io.err << "ranger_can monitor: no RANGER feedback on " << o.iface << " within " << o.window
+               << " s\n";
+        return 1;
       }
-      if (o.count && views >= *o.count) return 0;
+      if (o.once || (o.count && views >= *o.count)) return 0;
       next_view += period;
       if (next_view <= now) next_view = now + period;
     }
-    auto frame = (*bus)->receive(std::min<std::chrono::nanoseconds>(next_view - clock.now(), 50ms));
-    if (frame) {
-      if (monitor) {
-        monitor->on_frame(*frame, clock.now());
-      } else {
-        heard.push_back(*frame);
-      }
-    } else if (frame.error().code != Errc::kTimeout) {
-      // The bus reports and recovers a lost interface itself; the view shows the state.
-      ::usleep(20000);
-    }
+    const auto frame =
+        (*bus)->receive(std::min<std::chrono::nanoseconds>(next_view - clock.now(), 50ms));
+    take(frame, monitor, heard, clock.now());
   }
   return 0;
+}
+
+// --diagnostics prints the groups once; otherwise the live view.
+int monitor_or_diagnostics(const ParsedArgs& args, Io io) {
+  return args.has("--diagnostics") ? diagnostics_main(args, io) : monitor_main(args, io);
 }
 
 }  // namespace
@@ -250,6 +289,10 @@ const CommandSpec& monitor_command() {
           option("--window", "SEC", "frame-rate window and --once listening time (default 1)",
                  number_in(0.05, 3600.0)),
           flag("--json", "one JSON object per view (and per event) instead of text"),
+          flag("--diagnostics",
+               "listen through the driver (nothing sent) for --window seconds (at least 1.5), "
+               "print the diagnostic groups the ROS node's /diagnostics shows, exit (0 if the "
+               "chassis was heard, 1 if not); IFACE may also be sim[:VARIANT] or replay:FILE"),
           flag("--no-color",
                "no ANSI colours (default: colours on a terminal unless NO_COLOR is set)"),
           flag("--no-clear",
@@ -259,7 +302,7 @@ const CommandSpec& monitor_command() {
           set_option(),
       },
       "",
-      monitor_main,
+      monitor_or_diagnostics,
   };
   return spec;
 }

@@ -12,10 +12,10 @@
 
 #include "cli_commands.hpp"
 #include "cli_input.hpp"
-#include "cli_json.hpp"
 #include "cli_options.hpp"
 #include "cli_profile.hpp"
 #include "ranger_can/control/odometry.hpp"
+#include "ranger_can/json.hpp"
 #include "ranger_can/parse.hpp"
 #include "ranger_can/wire/candump_log.hpp"
 
@@ -126,12 +126,6 @@ int odom_main(const ParsedArgs& args, Io io) {
   return with_input(opt.path, "odom", io, [&](std::istream& in) { return replay(in, opt, io); });
 }
 
-Status check_source(const std::string& text) {
-  const Result<OdometrySource> s = parse_odometry_source(text);
-  if (!s) return s.error();
-  return ok_status();
-}
-
 }  // namespace
 
 const CommandSpec& odom_command() {
@@ -161,15 +155,15 @@ const CommandSpec& odom_command() {
                  "wheels (default): least-squares fit to the per-wheel angles (0x271) and speeds "
                  "(0x281), falling back to 0x221 while those are missing; motion: 0x221 speed and "
                  "steering with the 0x291 motion mode only",
-                 checked_by(check_source)),
+                 parameter_rule("odometry_source")),
           option("--wheelbase", "M",
                  "front to rear axle, m (default: the model's, else " +
                      number_text(defaults.geometry.wheelbase) + ")",
-                 number_in(1e-3, 10.0)),
+                 parameter_rule("wheelbase")),
           option("--track", "M",
                  "left to right wheel centres, m (default: the model's, else " +
                      number_text(defaults.geometry.track) + ")",
-                 number_in(1e-3, 10.0)),
+                 parameter_rule("track")),
           option("--every", "N", "print every Nth step only (default 1)",
                  integer_in(1, std::numeric_limits<std::int32_t>::max())),
           flag("--quiet", "print the final pose only"),

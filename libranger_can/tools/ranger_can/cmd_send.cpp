@@ -34,15 +34,14 @@ Error bad(const std::string& what) {
 // The modes `send mode` takes: every motion mode but park, which has a command of its own.
 std::vector<std::string> mode_names() {
   std::vector<std::string> names;
-  for (const protocol::MotionMode m : protocol::kAllMotionModes)
-    if (m != protocol::MotionMode::kPark) names.emplace_back(protocol::to_string(m));
+  for (const auto& [mode, name] : protocol::kMotionModeNames)
+    if (mode != protocol::MotionMode::kPark) names.emplace_back(name);
   return names;
 }
 
 Result<Message> parse_mode(const Words& w) {
-  for (const protocol::MotionMode m : protocol::kAllMotionModes)
-    if (m != protocol::MotionMode::kPark && w[0] == protocol::to_string(m))
-      return Message{MotionModeCommand{m}};
+  const auto mode = protocol::kMotionModeNames.parse(w[0]);
+  if (mode && *mode != protocol::MotionMode::kPark) return Message{MotionModeCommand{*mode}};
   return bad("mode: unknown motion mode '" + w[0] + "' (" + text::join(mode_names()) + ")");
 }
 
@@ -57,13 +56,10 @@ Result<Message> parse_park(const Words& w) {
 Status parse_light(const std::string& what, const std::string& word, protocol::LightMode& mode,
                    std::uint8_t& brightness) {
   brightness = 0;
-  if (word == "off")
-    mode = protocol::LightMode::kOff;
-  else if (word == "on")
-    mode = protocol::LightMode::kOn;
-  else if (word == "breathing")
-    mode = protocol::LightMode::kBreathing;
-  else if (word.rfind("custom:", 0) == 0) {
+  const auto named = protocol::kLightModeNames.parse(word);  // custom takes its brightness
+  if (named && *named != protocol::LightMode::kCustom) {
+    mode = *named;
+  } else if (word.rfind("custom:", 0) == 0) {
     auto pct = parse_integer("lights " + what + " custom:PCT", word.substr(7), 0, 100);
     if (!pct) return pct.error();
     mode = protocol::LightMode::kCustom;
@@ -93,8 +89,10 @@ Result<Message> parse_version(const Words&) {
 }
 
 Result<Message> parse_control(const Words& w) {
-  if (w[0] == "can") return Message{ControlModeCommand{protocol::ControlMode::kCan}};
-  if (w[0] == "standby") return Message{ControlModeCommand{protocol::ControlMode::kStandby}};
+  const auto mode = protocol::kControlModeNames.parse(w[0]);
+  if (mode == protocol::ControlMode::kCan || mode == protocol::ControlMode::kStandby) {
+    return Message{ControlModeCommand{*mode}};
+  }
   return bad("control: unknown control mode '" + w[0] + "' (can or standby)");
 }
 
@@ -114,20 +112,19 @@ Result<Message> parse_ultrasonic(const Words& w) {
   return bad("ultrasonic: expected 'on' or 'off', got '" + w[0] + "'");
 }
 
-constexpr double kRadPerDeg = M_PI / 180.0;  // the user's unit, not the wire's
-
 Result<Message> parse_motion(const Words& w) {
   auto v = parse_double_in("motion V", w[0], -interpretation::kMaxLinearSpeedMps,
                            interpretation::kMaxLinearSpeedMps);
   if (!v) return v.error();
-  auto steer = parse_double_in("motion STEER_DEG", w[1], -kMaxObliqueSteeringRad / kRadPerDeg,
-                               kMaxObliqueSteeringRad / kRadPerDeg);
+  // Degrees: the user's unit, not the wire's.
+  auto steer = parse_double_in("motion STEER_DEG", w[1], -rad_to_deg(kMaxObliqueSteeringRad),
+                               rad_to_deg(kMaxObliqueSteeringRad));
   if (!steer) return steer.error();
   auto spin = parse_double_in("motion SPIN", w[2], -kMaxSpinSpeedMps, kMaxSpinSpeedMps);
   if (!spin) return spin.error();
   MotionCommand m;
   m.linear_speed = *v;
-  m.steering_angle = interpretation::manual_from_rep103_command_steering(*steer * kRadPerDeg);
+  m.steering_angle = interpretation::manual_from_rep103_command_steering(deg_to_rad(*steer));
   m.spin_speed = *spin;
   return Message{m};
 }
@@ -166,7 +163,7 @@ const std::vector<SendCommand>& send_commands() {
        "0x111 once: V linear speed m/s (forward +, |V| <= " +
            number_text(interpretation::kMaxLinearSpeedMps) +
            "), STEER_DEG steering in degrees, REP-103 sign: positive = LEFT (|STEER_DEG| <= " +
-           number_text(kMaxObliqueSteeringRad / kRadPerDeg) +
+           number_text(rad_to_deg(kMaxObliqueSteeringRad)) +
            "; sent with the manual's sign), SPIN wheel speed m/s, counter-clockwise + (|SPIN| <= " +
            number_text(kMaxSpinSpeedMps) +
            "). The chassis stops again 500 ms later unless repeated.",

@@ -12,28 +12,27 @@
 #include <cerrno>
 #include <chrono>
 #include <csignal>
-#include <cstdio>
 #include <cstring>
 #include <deque>
 #include <fstream>
 #include <iostream>
 #include <optional>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include "cli_bus.hpp"
 #include "cli_commands.hpp"
 #include "cli_input.hpp"
-#include "cli_json.hpp"
 #include "cli_options.hpp"
 #include "cli_profile.hpp"
 #include "cli_signals.hpp"
 #include "ranger_can/clock.hpp"
+#include "ranger_can/json.hpp"
 #include "ranger_can/parse.hpp"
 #include "ranger_can/sim/chassis_commands.hpp"
 #include "ranger_can/sim/sim_bus_source.hpp"
 #include "ranger_can/sim/virtual_chassis_runner.hpp"
+#include "ranger_can/text.hpp"
 
 namespace ranger::cli {
 
@@ -70,9 +69,7 @@ struct SimOptions {
 
 Result<std::vector<std::int16_t>> parse_ultrasonic(const std::string& text) {
   std::vector<std::int16_t> mm;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
+  for (const std::string& item : text::split(text, ',')) {
     auto d = parse_integer("distance", item, -4, 32767);
     if (!d) return d.error();
     mm.push_back(static_cast<std::int16_t>(*d));
@@ -82,11 +79,6 @@ Result<std::vector<std::int16_t>> parse_ultrasonic(const std::string& text) {
                  "give 1 or 8 comma-separated distances, got " + std::to_string(mm.size())};
   }
   return mm;
-}
-
-std::chrono::nanoseconds duration_of(double seconds) {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-      std::chrono::duration<double>(seconds));
 }
 
 // The chassis: the model's (--model; a RANGER without it), speaking the profile of --protocol and
@@ -100,7 +92,7 @@ Result<SimOptions> options_from(const ParsedArgs& args) {
   o.config.profile = vehicle->profile;
   o.variant = args.get_or("--chassis-variant", o.variant);
   if (args.has("--mode-switch-time")) {
-    o.config.mode_switch_duration = duration_of(args.number("--mode-switch-time", 0.0));
+    o.config.mode_switch_duration = from_seconds(args.number("--mode-switch-time", 0.0));
   }
   o.config.initial_soc = args.number("--soc", o.config.initial_soc);
   o.config.drivetrain.batteries =
@@ -121,7 +113,7 @@ Result<SimOptions> options_from(const ParsedArgs& args) {
   o.stuck = args.has("--stuck-mode-switch");
   o.config.limits.acceleration = args.number("--accel", o.config.limits.acceleration);
   if (args.has("--steering-rate")) {
-    o.config.limits.steering_rate = args.number("--steering-rate", 0.0) * M_PI / 180.0;
+    o.config.limits.steering_rate = deg_to_rad(args.number("--steering-rate", 0.0));
   }
   o.config.garbage_seed = static_cast<std::uint32_t>(args.integer("--seed", o.config.garbage_seed));
   o.pose_out = args.get_or("--pose-out", "");
@@ -218,10 +210,177 @@ Result<int> open_fifo(const std::string& path, bool& created) {
 }
 
 std::string stamp_prefix(Timestamp since_boot) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "[%9.3f] ", std::chrono::duration<double>(since_boot).count());
-  return buf;
+  return text::format("[%9.3f] ", seconds(since_boot));
 }
+
+// The control FIFO, open for the run; removed at its end if the run created it.
+struct Fifo {
+  int fd = -1;
+  bool created = false;
+  std::string path;
+  Fifo() = default;
+  Fifo(const Fifo&) = delete;
+  Fifo& operator=(const Fifo&) = delete;
+  ~Fifo() {
+    if (fd >= 0) ::close(fd);
+    if (created) ::unlink(path.c_str());
+  }
+};
+
+// The run after start-up: control lines in, state changes and the pose out, until `quit`, a
+// signal, --duration or the chassis's failure.
+class SimLoop {
+ public:
+  SimLoop(const SimOptions& o, Io io, sim::VirtualChassisRunner& runner, const Clock& clock,
+          Timestamp boot, int fifo_fd, std::ofstream& pose_file)
+      : o_(o),
+        io_(io),
+        runner_(runner),
+        clock_(clock),
+        boot_(boot),
+        input_(io.in, o.read_stdin, fifo_fd),
+        pose_file_(pose_file),
+        pose_period_(from_seconds(1.0 / o.pose_rate)),
+        next_pose_(boot),
+        typing_(&io.in == &std::cin && o.read_stdin && ::isatty(STDIN_FILENO) != 0) {}
+
+  // The exit status.
+  int run() {
+    std::vector<std::string> lines;
+    while (!quit_) {
+      if (StopSignals::requested()) {
+        if (!o_.quiet) {
+          io_.out << "ranger_can sim: "
+                  << (StopSignals::signal_number() == SIGTERM ? "SIGTERM" : "SIGINT")
+                  << ", stopping\n";
+        }
+        return 0;
+      }
+      if (o_.duration && clock_.now() - boot_ >= std::chrono::duration<double>(*o_.duration)) {
+        return 0;
+      }
+      if (!runner_.running()) {
+        io_.err << "ranger_can sim: " << runner_.failure() << "\n";
+        return 1;
+      }
+      lines.clear();
+      input_.poll_lines(10ms, lines);
+      for (auto& l : lines)
+        held_.push_back(std::move(l));
+      while (!held_.empty() && clock_.now() >= hold_until_ && !quit_) {
+        const std::string line = held_.front();
+        held_.pop_front();
+        execute(line);
+      }
+      print_events();
+      if (pose_file_.is_open() && clock_.now() >= next_pose_) write_pose();
+    }
+    return 0;
+  }
+
+  void print_events() {
+    auto events = runner_.with_chassis([](sim::VirtualChassis& c) { return c.take_events(); });
+    if (o_.quiet) return;
+    out_.clear();
+    for (const auto& e : events)
+      out_ += stamp_prefix(e.time - boot_) + e.text + "\n";
+    if (!out_.empty()) {
+      io_.out << out_;
+      io_.out.flush();
+    }
+  }
+
+  // How many bad control lines went unshown; what the chassis sent and received.
+  void report_end() {
+    if (bad_lines_ > kMaxReportedLines && !typing_) {
+      io_.err << "ranger_can sim: " << bad_lines_ << " bad control line(s) (the first "
+              << kMaxReportedLines << " shown)\n";
+    }
+    if (o_.quiet) return;
+    const auto c = runner_.with_chassis([](sim::VirtualChassis& ch) { return ch.counters(); });
+    io_.out << "ranger_can sim: stopped; " << c.frames_sent << " frames sent, " << c.frames_received
+            << " received (" << c.frames_rejected << " rejected, " << c.frames_ignored
+            << " ignored)";
+    if (c.send_failures > 0) io_.out << ", " << c.send_failures << " send failures";
+    io_.out << "\n";
+    io_.out.flush();
+  }
+
+ private:
+  // Bad control lines are reported one by one to a person typing; from a pipe or a FIFO only
+  // the first kMaxReportedLines are, then counted, so no input makes sim print without bound.
+  void control_error(const std::string& message) {
+    ++bad_lines_;
+    if (typing_ || bad_lines_ <= kMaxReportedLines) {
+      io_.err << "ranger_can sim: " << message << "\n";
+    } else if (bad_lines_ == kMaxReportedLines + 1) {
+      io_.err << "ranger_can sim: more bad control lines: counted, not shown\n";
+    }
+  }
+
+  // `wait SEC`: hold the following lines.
+  void hold(const std::vector<std::string>& w) {
+    auto v = parse_double_in("wait SEC", w.size() > 1 ? w[1] : "", 0.0, 1e6);
+    if (!v || w.size() > 2) {
+      control_error(v ? "usage: wait SEC" : v.error().message);
+      return;
+    }
+    hold_until_ = clock_.now() + from_seconds(*v);
+  }
+
+  void execute(const std::string& line) {
+    const std::vector<std::string> w = text::split_words(line);
+    const std::string first = w.empty() ? "" : w[0];
+    if (first == "quit" || first == "exit") {
+      quit_ = true;
+    } else if (first == "help") {
+      io_.out << control_help();
+      io_.out.flush();
+    } else if (first == "wait") {
+      hold(w);
+    } else {
+      auto r = runner_.with_chassis(
+          [&](sim::VirtualChassis& c) { return apply_chassis_command(line, c); });
+      if (!r) {
+        control_error(r.error().message);
+      } else if (!r->empty()) {
+        io_.out << *r << "\n";
+        io_.out.flush();
+      }
+    }
+  }
+
+  void write_pose() {
+    const auto s = runner_.with_chassis([](sim::VirtualChassis& c) { return c.snapshot(); });
+    out_.clear();
+    JsonWriter w(out_);
+    w.begin_object().key("t").seconds(wall_.now()).key("sim_t").number(seconds(s.time - boot_));
+    w.key("x").number(s.pose.x).key("y").number(s.pose.y).key("yaw").number(s.pose.yaw);
+    w.key("vx").number(s.twist.vx).key("vy").number(s.twist.vy).key("wz").number(s.twist.wz);
+    w.key("distance").number(s.distance_travelled).end_object();
+    pose_file_ << out_ << "\n";
+    pose_file_.flush();
+    next_pose_ += pose_period_;
+    if (next_pose_ < clock_.now()) next_pose_ = clock_.now() + pose_period_;
+  }
+
+  const SimOptions& o_;
+  Io io_;
+  sim::VirtualChassisRunner& runner_;
+  const Clock& clock_;
+  SystemClock wall_;
+  Timestamp boot_;
+  ControlInput input_;
+  std::ofstream& pose_file_;
+  std::deque<std::string> held_;  // lines waiting behind a `wait`
+  Timestamp hold_until_{0};
+  std::chrono::nanoseconds pose_period_;
+  Timestamp next_pose_;
+  bool quit_ = false;
+  const bool typing_;
+  std::size_t bad_lines_ = 0;
+  std::string out_;
+};
 
 int sim_main(const ParsedArgs& args, Io io) {
   const Result<SimOptions> parsed = options_from(args);
@@ -237,26 +396,16 @@ int sim_main(const ParsedArgs& args, Io io) {
       return 1;
     }
   }
-  int fifo_fd = -1;
-  bool fifo_created = false;
+  Fifo fifo;
   if (!o.control_fifo.empty()) {
-    auto fd = open_fifo(o.control_fifo, fifo_created);
+    auto fd = open_fifo(o.control_fifo, fifo.created);
+    fifo.path = o.control_fifo;
     if (!fd) {
       io.err << "ranger_can sim: " << fd.error().message << "\n";
       return 1;
     }
-    fifo_fd = *fd;
+    fifo.fd = *fd;
   }
-  struct FifoCleanup {
-    int fd;
-    bool created;
-    std::string path;
-    ~FifoCleanup() {
-      if (fd >= 0) ::close(fd);
-      if (created) ::unlink(path.c_str());
-    }
-  } fifo_cleanup{fifo_fd, fifo_created, o.control_fifo};
-
   auto bus = open_interface(o.iface);
   if (!bus) {
     io.err << "ranger_can sim: " << bus.error().message << "\n";
@@ -265,7 +414,6 @@ int sim_main(const ParsedArgs& args, Io io) {
 
   StopSignals signals;
   SteadyClock clock;
-  SystemClock wall;
   sim::VirtualChassisRunner runner(**bus, o.config, clock);
   const Timestamp boot = clock.now();
   runner.with_chassis([&](sim::VirtualChassis& c) {
@@ -281,151 +429,11 @@ int sim_main(const ParsedArgs& args, Io io) {
            << "; Ctrl-C to stop; 'help' lists control commands)\n";
     io.out.flush();
   }
-
-  ControlInput input(io.in, o.read_stdin, fifo_fd);
-  std::deque<std::string> held;  // lines waiting behind a `wait`
-  Timestamp hold_until{0};
-  const auto pose_period = std::chrono::duration_cast<std::chrono::nanoseconds>(
-      std::chrono::duration<double>(1.0 / o.pose_rate));
-  Timestamp next_pose = boot;
-  bool quit = false;
-  int exit_code = 0;
-  std::string out;
-
-  auto print_events = [&] {
-    auto events = runner.with_chassis([](sim::VirtualChassis& c) { return c.take_events(); });
-    if (o.quiet) return;
-    out.clear();
-    for (const auto& e : events)
-      out += stamp_prefix(e.time - boot) + e.text + "\n";
-    if (!out.empty()) {
-      io.out << out;
-      io.out.flush();
-    }
-  };
-
-  // Bad control lines are reported one by one to a person typing; from a pipe or a FIFO only
-  // the first kMaxReportedLines are, then counted, so no input makes sim print without bound.
-  const bool typing = &io.in == &std::cin && o.read_stdin && ::isatty(STDIN_FILENO) != 0;
-  std::size_t bad_lines = 0;
-  auto control_error = [&](const std::string& message) {
-    ++bad_lines;
-    if (typing || bad_lines <= kMaxReportedLines) {
-      io.err << "ranger_can sim: " << message << "\n";
-    } else if (bad_lines == kMaxReportedLines + 1) {
-      io.err << "ranger_can sim: more bad control lines: counted, not shown\n";
-    }
-  };
-
-  auto execute = [&](const std::string& line) {
-    std::istringstream words(line);
-    std::string first;
-    words >> first;
-    if (first == "quit" || first == "exit") {
-      quit = true;
-      return;
-    }
-    if (first == "help") {
-      io.out << control_help();
-      io.out.flush();
-      return;
-    }
-    if (first == "wait") {
-      std::string sec, extra;
-      words >> sec >> extra;
-      auto v = parse_double_in("wait SEC", sec, 0.0, 1e6);
-      if (!v || !extra.empty()) {
-        control_error(v ? "usage: wait SEC" : v.error().message);
-        return;
-      }
-      hold_until = clock.now() + std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                     std::chrono::duration<double>(*v));
-      return;
-    }
-    auto r =
-        runner.with_chassis([&](sim::VirtualChassis& c) { return apply_chassis_command(line, c); });
-    if (!r) {
-      control_error(r.error().message);
-    } else if (!r->empty()) {
-      io.out << *r << "\n";
-      io.out.flush();
-    }
-  };
-
-  std::vector<std::string> lines;
-  while (!quit) {
-    if (StopSignals::requested()) {
-      if (!o.quiet) {
-        io.out << "ranger_can sim: "
-               << (StopSignals::signal_number() == SIGTERM ? "SIGTERM" : "SIGINT")
-               << ", stopping\n";
-      }
-      break;
-    }
-    const Timestamp now = clock.now();
-    if (o.duration && now - boot >= std::chrono::duration<double>(*o.duration)) break;
-    if (!runner.running()) {
-      io.err << "ranger_can sim: " << runner.failure() << "\n";
-      exit_code = 1;
-      break;
-    }
-
-    lines.clear();
-    input.poll_lines(10ms, lines);
-    for (auto& l : lines)
-      held.push_back(std::move(l));
-    while (!held.empty() && clock.now() >= hold_until && !quit) {
-      const std::string line = held.front();
-      held.pop_front();
-      execute(line);
-    }
-    print_events();
-
-    if (pose_file.is_open() && clock.now() >= next_pose) {
-      const auto s = runner.with_chassis([](sim::VirtualChassis& c) { return c.snapshot(); });
-      out.clear();
-      JsonWriter w(out);
-      w.begin_object()
-          .key("t")
-          .seconds(wall.now())
-          .key("sim_t")
-          .number(std::chrono::duration<double>(s.time - boot).count())
-          .key("x")
-          .number(s.pose.x)
-          .key("y")
-          .number(s.pose.y)
-          .key("yaw")
-          .number(s.pose.yaw)
-          .key("vx")
-          .number(s.twist.vx)
-          .key("vy")
-          .number(s.twist.vy)
-          .key("wz")
-          .number(s.twist.wz)
-          .key("distance")
-          .number(s.distance_travelled)
-          .end_object();
-      pose_file << out << "\n";
-      pose_file.flush();
-      next_pose += pose_period;
-      if (next_pose < clock.now()) next_pose = clock.now() + pose_period;
-    }
-  }
+  SimLoop loop(o, io, runner, clock, boot, fifo.fd, pose_file);
+  const int exit_code = loop.run();
   runner.stop();
-  print_events();
-  if (bad_lines > kMaxReportedLines && !typing) {
-    io.err << "ranger_can sim: " << bad_lines << " bad control line(s) (the first "
-           << kMaxReportedLines << " shown)\n";
-  }
-  if (!o.quiet) {
-    const auto c = runner.with_chassis([](sim::VirtualChassis& ch) { return ch.counters(); });
-    io.out << "ranger_can sim: stopped; " << c.frames_sent << " frames sent, " << c.frames_received
-           << " received (" << c.frames_rejected << " rejected, " << c.frames_ignored
-           << " ignored)";
-    if (c.send_failures > 0) io.out << ", " << c.send_failures << " send failures";
-    io.out << "\n";
-    io.out.flush();
-  }
+  loop.print_events();
+  loop.report_end();
   return exit_code;
 }
 
@@ -441,9 +449,7 @@ Status check_with(Result<T> (*parse)(const std::string&), const std::string& tex
 const CommandSpec& sim_command() {
   const sim::VirtualChassisConfig defaults;
   const SimOptions option_defaults;
-  const auto seconds_of = [](std::chrono::nanoseconds d) {
-    return number_text(std::chrono::duration<double>(d).count());
-  };
+  const auto seconds_of = [](std::chrono::nanoseconds d) { return number_text(seconds(d)); };
   static const CommandSpec spec{
       "sim",
       "run the virtual RANGER chassis on a CAN interface, with fault injection",
@@ -472,11 +478,11 @@ const CommandSpec& sim_command() {
           option("--mode-switch-time", "SEC",
                  "time a motion-mode switch takes once at rest (default " +
                      seconds_of(defaults.mode_switch_duration) + ")",
-                 number_in(0.0, 60.0)),
+                 parameter_rule("sim/mode_switch_duration")),
           option("--soc", "PCT",
                  "initial battery state of charge, 0-100 (default " +
                      number_text(defaults.initial_soc) + ")",
-                 number_in(0.0, 100.0)),
+                 parameter_rule("sim/initial_soc")),
           option("--batteries", "N",
                  "batteries fitted, 1-" + std::to_string(protocol::kBatteryCount) + " (default " +
                      std::to_string(defaults.drivetrain.batteries) + ")",
@@ -501,7 +507,7 @@ const CommandSpec& sim_command() {
                  number_in(0.01, 20.0)),
           option("--steering-rate", "DEG/S",
                  "steering slew rate (default " +
-                     number_text(defaults.limits.steering_rate * 180.0 / M_PI) + ")",
+                     number_text(rad_to_deg(defaults.limits.steering_rate)) + ")",
                  number_in(1.0, 3600.0)),
           option("--seed", "N",
                  "seed of the garbage-frame generator (default " +

@@ -29,7 +29,9 @@
 #include <string>
 #include <string_view>
 
+#include <ranger_can/control/diagnostics.hpp>
 #include <ranger_can/control/driver.hpp>
+#include <ranger_can/control/vocabulary.hpp>
 #include <ranger_can/sim/virtual_chassis.hpp>
 
 #include "ranger_base/parameters.hpp"
@@ -53,8 +55,8 @@ std::optional<ranger::BodyTwist> achieved_twist(const ranger::SentEvent& event);
 
 // ---- odometry, TF, joints ---------------------------------------------------------------------
 // Pose covariance = diag(pose_covariance_diagonal) + the odometry's growing x/y/yaw variance;
-// twist covariance = diag(twist_covariance_diagonal). Stamped with the odometry's own stamp (the
-// frames that produced it).
+// twist covariance = diag(twist_covariance_diagonal) (ranger::pose_covariance). Stamped with the
+// odometry's own stamp (the frames that produced it).
 nav_msgs::Odometry to_odometry(const ranger::OdometryState& odometry, const NodeParameters& params);
 geometry_msgs::TransformStamped to_transform(const nav_msgs::Odometry& odometry);
 // The time of the newest per-wheel frame behind `feedback`'s joints (zero: none yet).
@@ -65,20 +67,8 @@ nav_msgs::Odometry to_ground_truth(const ranger::sim::ChassisSnapshot& sim,
                                    const NodeParameters& params, const ros::Time& stamp);
 
 // ---- chassis state ----------------------------------------------------------------------------
-// The identification is listening: nothing is sent, and the controller hears nothing on purpose
-// (its link reads never-connected; the library refuses motion with `identifying`) until the
-// chassis has been heard.
-bool listening(const ranger::ControllerState& state);
-// Why motion is refused, by stable name (libranger_can's MotionRefusal: "estop", "identifying",
-// "implausible_feedback", ...; "" while driven).
-std::string refusal_name(const ranger::ControllerState& state);
-// Why motion is refused, and what to do about it, in words (system_state's
-// motion_inhibited_detail, diagnostics; the library's ranger::describe_refusal, which the
-// driver's refusal events carry too); "" while the chassis is driven as asked.
-std::string describe_refusal(const ranger::DriverSnapshot& snapshot);
-// The stop causes of a set by name ("emergency_stop", "remote", ...), in the library's order.
-std::vector<std::string> cause_names(ranger::StopCauses causes);
-
+// The words (why motion is refused, the stop causes by name) are the library's
+// (ranger_can/control/diagnostics.hpp: describe_refusal, refusal_name, cause_names).
 ranger_msgs::SystemState to_system_state(const ranger::DriverSnapshot& snapshot,
                                          const ros::Time& stamp);
 // ---- the vendor's additions (agx_v2) ------------------------------------------------------------
@@ -90,8 +80,8 @@ ranger::Result<ranger::LightsRequest> to_lights_request(const ranger_msgs::SetLi
 void fill_lights_response(const std::optional<ranger::LightsState>& lights,
                           ranger_msgs::SetLights::Response& out);
 
-// Sets the SystemErrors fields by meaning: each row of the fault table (protocol::kFaultTable)
-// with a bit in `layout` sets the field of its name from that bit; the others stay as they are.
+// Sets the SystemErrors fields by meaning: each fault the library's table gives for `layout`
+// (ranger::fault_flags) sets the field of its name; the others stay as they are.
 void fill_system_errors(std::uint32_t error_word, ranger::ErrorWordLayout layout,
                         ranger_msgs::SystemErrors& out);
 ranger_msgs::DriverStatus to_driver_status(std::uint8_t status);
@@ -117,10 +107,11 @@ ranger_msgs::UltrasonicState to_ultrasonic_state(const ranger::DriverSnapshot& s
 sensor_msgs::Range to_range(int sensor, std::int16_t raw, const NodeParameters& params,
                             const ros::Time& stamp);
 std::string ultrasonic_frame_id(const std::string& frame_prefix, int sensor);
-// The distance a raw ultrasonic value stands for, in m; NaN unless the library calls it "ok".
+// The distance a raw ultrasonic value stands for, in m (ranger::ultrasonic_range); NaN unless
+// the library calls it "ok".
 float ultrasonic_range_m(std::int16_t raw);
 
-// ---- named-bit tables (message field <- libranger_can bit name); tests check they are complete --
+// ---- named-bit tables (message field <- libranger_can's name); tests check they are complete ---
 using SystemErrorField = std::uint8_t ranger_msgs::SystemErrors::*;
 using DriverStatusField = std::uint8_t ranger_msgs::DriverStatus::*;
 using BmsFlagField = std::uint8_t ranger_msgs::BmsFlags::*;

@@ -53,7 +53,9 @@
 #include "ranger_can/control/rearm.hpp"
 #include "ranger_can/control/speed_limiter.hpp"
 #include "ranger_can/result.hpp"
+#include "ranger_can/text.hpp"
 #include "ranger_can/transport/bus.hpp"
+#include "ranger_can/types.hpp"
 #include "ranger_can/wire/codec.hpp"
 #include "ranger_can/wire/frame.hpp"
 #include "ranger_can/wire/profile.hpp"
@@ -97,30 +99,37 @@ enum class MotionRefusal {
   // mode and motion is refused until park is released. After the stop causes and standby.
   kParked,
 };
-std::string_view to_string(MotionRefusal r);  // "none", "link_lost", "remote", ...
-inline constexpr MotionRefusal kAllMotionRefusals[] = {
-    MotionRefusal::kNone,
-    MotionRefusal::kLinkLost,
-    MotionRefusal::kRemote,
-    MotionRefusal::kEstop,
-    MotionRefusal::kCriticalError,
-    MotionRefusal::kLowBattery,
-    MotionRefusal::kModeSwitchFailed,
-    MotionRefusal::kImplausible,
-    MotionRefusal::kRearmRequired,
-    MotionRefusal::kStandby,
-    MotionRefusal::kModeUnknown,
-    MotionRefusal::kSwitching,
-    MotionRefusal::kCmdTimeout,
-    MotionRefusal::kBelowMinimum,
-    MotionRefusal::kIdentifying,
-    MotionRefusal::kParked,
-};
+inline constexpr auto kMotionRefusalNames = text::enum_names<MotionRefusal>({
+    {MotionRefusal::kNone, "none"},
+    {MotionRefusal::kLinkLost, "link_lost"},
+    {MotionRefusal::kRemote, "remote"},
+    {MotionRefusal::kEstop, "estop"},
+    {MotionRefusal::kCriticalError, "critical_error"},
+    {MotionRefusal::kLowBattery, "low_battery"},
+    {MotionRefusal::kModeSwitchFailed, "mode_switch_failed"},
+    {MotionRefusal::kImplausible, "implausible_feedback"},
+    {MotionRefusal::kRearmRequired, "rearm_required"},
+    {MotionRefusal::kStandby, "standby"},
+    {MotionRefusal::kModeUnknown, "mode_unknown"},
+    {MotionRefusal::kSwitching, "switching"},
+    {MotionRefusal::kCmdTimeout, "cmd_timeout"},
+    {MotionRefusal::kBelowMinimum, "below_minimum"},
+    {MotionRefusal::kIdentifying, "identifying"},
+    {MotionRefusal::kParked, "parked"},
+});
+inline std::string_view to_string(MotionRefusal r) {
+  return kMotionRefusalNames.name(r);
+}
 
 enum class LinkState { kNeverConnected, kConnected, kStale };
-std::string_view to_string(LinkState s);  // "never_connected", "connected", "stale"
-inline constexpr LinkState kAllLinkStates[] = {LinkState::kNeverConnected, LinkState::kConnected,
-                                               LinkState::kStale};
+inline constexpr auto kLinkStateNames = text::enum_names<LinkState>({
+    {LinkState::kNeverConnected, "never_connected"},
+    {LinkState::kConnected, "connected"},
+    {LinkState::kStale, "stale"},
+});
+inline std::string_view to_string(LinkState s) {
+  return kLinkStateNames.name(s);
+}
 
 // The faults the controller names itself in ControllerState::faults, beside the chassis's 0x211
 // faults (the fault table's names, protocol::kFaultTable, and "reserved_bit_N").
@@ -134,17 +143,19 @@ enum class ControllerFault {
   kImplausibleFeedback,    // the feedback contradicts the protocol settings
   kUltrasonicUnconfirmed,  // the ultrasonic setting was not confirmed by 0x45A
 };
-std::string_view to_string(ControllerFault f);  // "link_lost", "emergency_stop", ...
-inline constexpr ControllerFault kAllControllerFaults[] = {
-    ControllerFault::kLinkLost,
-    ControllerFault::kEmergencyStop,
-    ControllerFault::kVehicleAbnormal,
-    ControllerFault::kVehicleStatusUnknown,
-    ControllerFault::kLowBattery,
-    ControllerFault::kModeSwitchFailed,
-    ControllerFault::kImplausibleFeedback,
-    ControllerFault::kUltrasonicUnconfirmed,
-};
+inline constexpr auto kControllerFaultNames = text::enum_names<ControllerFault>({
+    {ControllerFault::kLinkLost, "link_lost"},
+    {ControllerFault::kEmergencyStop, "emergency_stop"},
+    {ControllerFault::kVehicleAbnormal, "vehicle_abnormal"},
+    {ControllerFault::kVehicleStatusUnknown, "vehicle_status_unknown"},
+    {ControllerFault::kLowBattery, "low_battery"},
+    {ControllerFault::kModeSwitchFailed, "motion_mode_switch_failed"},
+    {ControllerFault::kImplausibleFeedback, "implausible_feedback"},
+    {ControllerFault::kUltrasonicUnconfirmed, "ultrasonic_setting_unconfirmed"},
+});
+inline std::string_view to_string(ControllerFault f) {
+  return kControllerFaultNames.name(f);
+}
 
 struct ControllerConfig {
   VehicleGeometry geometry;
@@ -170,7 +181,7 @@ struct ControllerConfig {
   double standstill_speed = 0.02;  // m/s, every wheel slower than this = standstill
   // rad: full speed while every wheel is within this of its commanded angle, zero beyond twice
   // it, linear in between (0 disables steer-first).
-  double steer_first_threshold = 10.0 * M_PI / 180.0;
+  double steer_first_threshold = deg_to_rad(10.0);
   std::chrono::nanoseconds ultrasonic_confirm_timeout = std::chrono::milliseconds(500);
   int ultrasonic_max_attempts = 3;
   double low_battery_soc = vehicle_spec::kLowBatteryCutoffSoc;  // %: the chassis cuts the drives
@@ -269,6 +280,11 @@ struct ControllerState {
   bool critical_error() const { return has(active_causes, StopCause::kCriticalError); }
   bool rearm_required() const { return latched_causes != 0; }
 };
+
+// Whether a twist can be driven in `mode` under `profile`: ackermann, oblique, spin, and side slip
+// where the profile's mode numbering has it (MINI V1, agx_v2); never park. The controller's rule
+// (ChassisController::can_drive_in), for a front end to refuse a mode by name before asking.
+bool can_drive_in(protocol::MotionMode mode, const ProtocolProfile& profile);
 
 // A frame the controller has just sent (for cmd_vel_out, latency figures and wire audits).
 struct SentFrame {

@@ -30,6 +30,7 @@
 #include "ranger_can/control/request_book.hpp"
 #include "ranger_can/control/vendor_features.hpp"
 #include "ranger_can/result.hpp"
+#include "ranger_can/text.hpp"
 #include "ranger_can/types.hpp"
 #include "ranger_can/wire/protocol.hpp"
 
@@ -37,9 +38,15 @@ namespace ranger {
 
 // How much an event matters to whoever runs the robot (ROS: DEBUG, INFO, WARN, ERROR).
 enum class Severity { kDebug, kInfo, kWarn, kError };
-std::string_view to_string(Severity s);  // "debug", "info", "warn", "error"
-inline constexpr Severity kAllSeverities[] = {Severity::kDebug, Severity::kInfo, Severity::kWarn,
-                                              Severity::kError};
+inline constexpr auto kSeverityNames = text::enum_names<Severity>({
+    {Severity::kDebug, "debug"},
+    {Severity::kInfo, "info"},
+    {Severity::kWarn, "warn"},
+    {Severity::kError, "error"},
+});
+inline std::string_view to_string(Severity s) {
+  return kSeverityNames.name(s);
+}
 
 // Every kind of event, with the payload (EventData) it carries.
 enum class EventKind {
@@ -71,36 +78,38 @@ enum class EventKind {
   kFramesPadded,          // PaddedFramesEvent: an ID arrives longer than its layout (once per ID)
   kShutdownStop,          // ShutdownEvent: the stop sent at shutdown (or why none was)
 };
-std::string_view to_string(EventKind k);  // "bus_opened", "link_silent", ...
-inline constexpr EventKind kAllEventKinds[] = {
-    EventKind::kBusOpened,
-    EventKind::kBusOpenFailed,
-    EventKind::kStillWaiting,
-    EventKind::kLinkConnected,
-    EventKind::kLinkSilent,
-    EventKind::kLinkHeardAgain,
-    EventKind::kControlModeChanged,
-    EventKind::kRefusalChanged,
-    EventKind::kRearmLatched,
-    EventKind::kRearmCleared,
-    EventKind::kIdentificationPhase,
-    EventKind::kIdentified,
-    EventKind::kIdentificationFailed,
-    EventKind::kSettingLearned,
-    EventKind::kPlausibilityWarning,
-    EventKind::kPlausibilityStop,
-    EventKind::kCommandRefused,
-    EventKind::kCommandAdjusted,
-    EventKind::kMotionModeRequested,
-    EventKind::kFaultRaised,
-    EventKind::kFaultCleared,
-    EventKind::kFirmwareVersion,
-    EventKind::kParkChanged,
-    EventKind::kLightsChanged,
-    EventKind::kRequestSettled,
-    EventKind::kFramesPadded,
-    EventKind::kShutdownStop,
-};
+inline constexpr auto kEventKindNames = text::enum_names<EventKind>({
+    {EventKind::kBusOpened, "bus_opened"},
+    {EventKind::kBusOpenFailed, "bus_open_failed"},
+    {EventKind::kStillWaiting, "still_waiting"},
+    {EventKind::kLinkConnected, "link_connected"},
+    {EventKind::kLinkSilent, "link_silent"},
+    {EventKind::kLinkHeardAgain, "link_heard_again"},
+    {EventKind::kControlModeChanged, "control_mode_changed"},
+    {EventKind::kRefusalChanged, "refusal_changed"},
+    {EventKind::kRearmLatched, "rearm_latched"},
+    {EventKind::kRearmCleared, "rearm_cleared"},
+    {EventKind::kIdentificationPhase, "identification_phase"},
+    {EventKind::kIdentified, "identified"},
+    {EventKind::kIdentificationFailed, "identification_failed"},
+    {EventKind::kSettingLearned, "setting_learned"},
+    {EventKind::kPlausibilityWarning, "plausibility_warning"},
+    {EventKind::kPlausibilityStop, "plausibility_stop"},
+    {EventKind::kCommandRefused, "command_refused"},
+    {EventKind::kCommandAdjusted, "command_adjusted"},
+    {EventKind::kMotionModeRequested, "motion_mode_requested"},
+    {EventKind::kFaultRaised, "fault_raised"},
+    {EventKind::kFaultCleared, "fault_cleared"},
+    {EventKind::kFirmwareVersion, "firmware_version"},
+    {EventKind::kParkChanged, "park_changed"},
+    {EventKind::kLightsChanged, "lights_changed"},
+    {EventKind::kRequestSettled, "request_settled"},
+    {EventKind::kFramesPadded, "frames_padded"},
+    {EventKind::kShutdownStop, "shutdown_stop"},
+});
+inline std::string_view to_string(EventKind k) {
+  return kEventKindNames.name(k);
+}
 
 // ---- the payloads ----------------------------------------------------------------------------
 

@@ -18,6 +18,7 @@
 #include "ranger_can/control/plausibility.hpp"
 #include "ranger_can/control/request_book.hpp"
 #include "ranger_can/control/vendor_features.hpp"
+#include "ranger_can/text.hpp"
 #include "ranger_can/transport/bus.hpp"
 #include "ranger_can/wire/profile.hpp"
 
@@ -28,7 +29,13 @@ enum class ProtocolChoice {
   kForced,  // controller.profile as it is (a preset, --set values, a commissioning file)
   kAuto,    // identified from the chassis before anything moves (identification.hpp)
 };
-std::string_view to_string(ProtocolChoice c);  // "forced" / "auto"
+inline constexpr auto kProtocolChoiceNames = text::enum_names<ProtocolChoice>({
+    {ProtocolChoice::kForced, "forced"},
+    {ProtocolChoice::kAuto, "auto"},
+});
+inline std::string_view to_string(ProtocolChoice c) {
+  return kProtocolChoiceNames.name(c);
+}
 
 // A consistent copy of the runtime's state, published after every iteration. (The driver
 // refills snapshots no reader holds any more: it assigns every field.)

@@ -59,6 +59,7 @@
 
 #include "ranger_can/control/geometry.hpp"
 #include "ranger_can/result.hpp"
+#include "ranger_can/text.hpp"
 #include "ranger_can/types.hpp"
 #include "ranger_can/wire/codec.hpp"
 #include "ranger_can/wire/frame.hpp"
@@ -80,11 +81,11 @@ struct IdentificationConfig {
   std::chrono::nanoseconds settle_time = std::chrono::milliseconds(300);
   // The probe's steering angle, rad (REP-103: to the left). 6 deg stays within the 40 deg
   // Ackermann range even when the chassis reads it 5.7 times larger (0.001 rad for 0.01 deg).
-  double probe_angle = 6.0 * M_PI / 180.0;
+  double probe_angle = deg_to_rad(6.0);
   bool spin_check = true;  // switch to spin mode at standstill to read the 0x271 unit and sign
   // Accepted when the best combination explains every wheel within this (rad, plus 10 % of the
   // angle) and the second best is at least `margin` times worse.
-  double angle_tolerance = 2.0 * M_PI / 180.0;
+  double angle_tolerance = deg_to_rad(2.0);
   double margin = 3.0;
 
   Status validate() const;  // durations > 0, probe angle in (1, 7] deg, tolerances > 0
@@ -99,12 +100,18 @@ enum class IdentificationPhase {
   kDecided,
   kFailed,
 };
-std::string_view to_string(IdentificationPhase p);  // "listening", ..., "decided", "failed"
-inline constexpr IdentificationPhase kAllIdentificationPhases[] = {
-    IdentificationPhase::kListening, IdentificationPhase::kAwaitingControl,
-    IdentificationPhase::kSpinCheck, IdentificationPhase::kSteerProbe,
-    IdentificationPhase::kReturning, IdentificationPhase::kDecided,
-    IdentificationPhase::kFailed};
+inline constexpr auto kIdentificationPhaseNames = text::enum_names<IdentificationPhase>({
+    {IdentificationPhase::kListening, "listening"},
+    {IdentificationPhase::kAwaitingControl, "awaiting_control"},
+    {IdentificationPhase::kSpinCheck, "spin_check"},
+    {IdentificationPhase::kSteerProbe, "steer_probe"},
+    {IdentificationPhase::kReturning, "returning"},
+    {IdentificationPhase::kDecided, "decided"},
+    {IdentificationPhase::kFailed, "failed"},
+});
+inline std::string_view to_string(IdentificationPhase p) {
+  return kIdentificationPhaseNames.name(p);
+}
 
 // One decided (or kept) setting and why.
 struct IdentifiedSetting {
@@ -187,8 +194,19 @@ class ChassisIdentifier {
     SteeringSign sign;
   };
   void start(Timestamp now);
+  // The passive evidence, frame by frame: what only agx_v2 sends and padding (every chassis
+  // frame), 0x211, 0x291, 0x361 and the rolling wheels (0x271 + 0x281).
   void observe_passive(const CanFrame& frame);
+  void observe_origin(const CanFrame& frame);
+  void observe_status(const CanFrame& frame);
+  void observe_bms(const CanFrame& frame);
+  void observe_rolling(const CanFrame& frame);
   void observe_probe(const CanFrame& frame, Timestamp now);
+  // The phases, tick by tick; why the identification timed out in the phase it is in.
+  std::string timeout_reason() const;
+  void tick_listening(Timestamp now);
+  void tick_awaiting_control(Timestamp now);
+  void tick_step(Timestamp now);
   void decide_passive(Timestamp now);
   void begin_step(IdentificationPhase phase, Timestamp now);
   bool settled(Timestamp now) const;
@@ -204,7 +222,7 @@ class ChassisIdentifier {
   void evaluate_steer(Timestamp now);
   void fail(std::string why, Timestamp now);
   void decide(Timestamp now);
-  void set(std::string_view name, std::string_view value, std::string evidence);
+  void set(ProtocolSetting setting, std::string_view value, std::string evidence);
   void note(std::string line);
   std::optional<std::array<double, 4>> wheel_angles(const CanFrame& frame, AngleUnit unit,
                                                     SteeringSign sign) const;

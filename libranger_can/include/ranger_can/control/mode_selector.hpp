@@ -36,7 +36,7 @@ struct ModeSelectorConfig {
   std::chrono::nanoseconds min_dwell = std::chrono::milliseconds(1000);
   // Oblique mode: while the direction of travel is within this band of +-90 deg, the wheels keep
   // the side of the previous oblique command (rad, 0 <= x < 90 deg; 0 disables).
-  double oblique_side_band = 5.0 * M_PI / 180.0;
+  double oblique_side_band = deg_to_rad(5.0);
 
   Status validate() const;
 };

@@ -9,6 +9,7 @@
 #include <optional>
 #include <string_view>
 
+#include "ranger_can/text.hpp"
 #include "ranger_can/types.hpp"
 #include "ranger_can/wire/protocol.hpp"
 
@@ -19,7 +20,14 @@ enum class ModeSwitchPhase {
   kStopping,              // commanding zero, waiting for standstill before sending 0x141
   kAwaitingConfirmation,  // 0x141 sent, waiting for 0x291: target mode, switching = 0
 };
-std::string_view to_string(ModeSwitchPhase p);  // "idle", "stopping", "awaiting_confirmation"
+inline constexpr auto kModeSwitchPhaseNames = text::enum_names<ModeSwitchPhase>({
+    {ModeSwitchPhase::kIdle, "idle"},
+    {ModeSwitchPhase::kStopping, "stopping"},
+    {ModeSwitchPhase::kAwaitingConfirmation, "awaiting_confirmation"},
+});
+inline std::string_view to_string(ModeSwitchPhase p) {
+  return kModeSwitchPhaseNames.name(p);
+}
 
 struct ModeSwitchConfig {
   std::chrono::nanoseconds timeout = std::chrono::milliseconds(1500);  // per 0x141 attempt

@@ -24,6 +24,7 @@
 #include "ranger_can/control/geometry.hpp"
 #include "ranger_can/control/kinematics.hpp"
 #include "ranger_can/result.hpp"
+#include "ranger_can/text.hpp"
 #include "ranger_can/types.hpp"
 #include "ranger_can/wire/codec.hpp"
 #include "ranger_can/wire/frame.hpp"
@@ -36,7 +37,13 @@ enum class OdometrySource {
   kWheels,  // per-wheel fit (0x271 + 0x281), falling back to kMotion while those are stale
   kMotion,  // 0x221 + 0x291 only
 };
-std::string_view to_string(OdometrySource s);  // "wheels" / "motion"
+inline constexpr auto kOdometrySourceNames = text::enum_names<OdometrySource>({
+    {OdometrySource::kWheels, "wheels"},
+    {OdometrySource::kMotion, "motion"},
+});
+inline std::string_view to_string(OdometrySource s) {
+  return kOdometrySourceNames.name(s);
+}
 // Parses "wheels" / "motion"; kInvalidArgument otherwise.
 Result<OdometrySource> parse_odometry_source(std::string_view text);
 

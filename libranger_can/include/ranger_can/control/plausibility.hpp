@@ -74,8 +74,8 @@ struct PlausibilityConfig {
   std::chrono::nanoseconds warn_after = std::chrono::milliseconds(1000);
   // ... and this long stops (0: warn only).
   std::chrono::nanoseconds subtle_stop_after = std::chrono::milliseconds(2000);
-  double min_steering = 3.0 * M_PI / 180.0;         // rad: smaller commanded angles are not judged
-  double min_reference_angle = 5.0 * M_PI / 180.0;  // rad: the reference needs a real turn
+  double min_steering = deg_to_rad(3.0);         // rad: smaller commanded angles are not judged
+  double min_reference_angle = deg_to_rad(5.0);  // rad: the reference needs a real turn
   double unit_ratio = 2.0;    // measured/commanded beyond this (or below 1/this): a unit mismatch
   double min_yaw_rate = 0.1;  // rad/s commanded for the yaw check
   std::chrono::nanoseconds yaw_settle = std::chrono::milliseconds(1000);

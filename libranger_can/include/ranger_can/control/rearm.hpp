@@ -15,6 +15,7 @@
 #include <string_view>
 
 #include "ranger_can/result.hpp"
+#include "ranger_can/text.hpp"
 
 namespace ranger {
 
@@ -35,7 +36,19 @@ inline StopCauses operator|(StopCauses a, StopCause b) {
 inline bool has(StopCauses set, StopCause c) {
   return (set & static_cast<std::uint32_t>(c)) != 0;
 }
-std::string_view to_string(StopCause c);  // "link_lost", "remote", "emergency_stop", ...
+// In ascending bit order.
+inline constexpr auto kStopCauseNames = text::enum_names<StopCause>({
+    {StopCause::kLinkLost, "link_lost"},
+    {StopCause::kRemote, "remote"},
+    {StopCause::kEstop, "emergency_stop"},
+    {StopCause::kCriticalError, "critical_error"},
+    {StopCause::kLowBattery, "low_battery"},
+    {StopCause::kModeSwitchFailed, "motion_mode_switch_failed"},
+    {StopCause::kImplausible, "implausible_feedback"},
+});
+inline std::string_view to_string(StopCause c) {
+  return kStopCauseNames.name(c);
+}
 // "emergency_stop,remote" (ascending bit order), "" for none.
 std::string describe(StopCauses causes);
 

@@ -21,6 +21,7 @@
 #include "ranger_can/control/feedback.hpp"
 #include "ranger_can/control/vendor_features.hpp"
 #include "ranger_can/result.hpp"
+#include "ranger_can/text.hpp"
 #include "ranger_can/types.hpp"
 #include "ranger_can/wire/profile.hpp"
 
@@ -42,8 +43,26 @@ struct RequestOutcome {
 
   bool settled() const { return state == State::kAnswered || state == State::kFailed; }
 };
-std::string_view to_string(RequestOutcome::Kind k);   // "clear_errors", "ultrasonic", "resume", ...
-std::string_view to_string(RequestOutcome::State s);  // "pending", "sent", "answered", "failed"
+inline constexpr auto kRequestKindNames = text::enum_names<RequestOutcome::Kind>({
+    {RequestOutcome::Kind::kClearErrors, "clear_errors"},
+    {RequestOutcome::Kind::kUltrasonic, "ultrasonic"},
+    {RequestOutcome::Kind::kResume, "resume"},
+    {RequestOutcome::Kind::kLights, "lights"},
+    {RequestOutcome::Kind::kPark, "park"},
+    {RequestOutcome::Kind::kFirmwareVersion, "firmware_version"},
+});
+inline constexpr auto kRequestStateNames = text::enum_names<RequestOutcome::State>({
+    {RequestOutcome::State::kPending, "pending"},
+    {RequestOutcome::State::kSent, "sent"},
+    {RequestOutcome::State::kAnswered, "answered"},
+    {RequestOutcome::State::kFailed, "failed"},
+});
+inline std::string_view to_string(RequestOutcome::Kind k) {
+  return kRequestKindNames.name(k);
+}
+inline std::string_view to_string(RequestOutcome::State s) {
+  return kRequestStateNames.name(s);
+}
 
 // The timing a settle rule judges by (the driver's configuration).
 struct RequestTiming {

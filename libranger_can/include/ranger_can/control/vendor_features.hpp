@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "ranger_can/control/feedback.hpp"
+#include "ranger_can/text.hpp"
 #include "ranger_can/types.hpp"
 #include "ranger_can/wire/codec.hpp"
 #include "ranger_can/wire/protocol.hpp"
@@ -37,7 +38,14 @@ enum class VendorFrames {
   kPresent,  // 0x231 or 0x241 received
   kAbsent,   // heard for DriverConfig::vendor_frames_wait without either
 };
-std::string_view to_string(VendorFrames v);  // "unknown", "present", "absent"
+inline constexpr auto kVendorFramesNames = text::enum_names<VendorFrames>({
+    {VendorFrames::kUnknown, "unknown"},
+    {VendorFrames::kPresent, "present"},
+    {VendorFrames::kAbsent, "absent"},
+});
+inline std::string_view to_string(VendorFrames v) {
+  return kVendorFramesNames.name(v);
+}
 
 // The remote control's switches and sticks (0x241), sticks and knob normalised to -1..1
 // (protocol::kRemoteAxisFullScale; saturated).
@@ -94,7 +102,16 @@ struct FirmwareVersion {
   State state = State::kNotAsked;
   std::string text;  // the answer's frames, in order
 };
-std::string_view to_string(FirmwareVersion::State s);  // "not_asked", "asked", ...
+inline constexpr auto kFirmwareStateNames = text::enum_names<FirmwareVersion::State>({
+    {FirmwareVersion::State::kNotAsked, "not_asked"},
+    {FirmwareVersion::State::kAsked, "asked"},
+    {FirmwareVersion::State::kAnswered, "answered"},
+    {FirmwareVersion::State::kUnanswered, "unanswered"},
+    {FirmwareVersion::State::kUnsupported, "unsupported"},
+});
+inline std::string_view to_string(FirmwareVersion::State s) {
+  return kFirmwareStateNames.name(s);
+}
 
 // A lights or version request the driver holds until it knows whether the chassis has the
 // vendor's frames.

@@ -28,6 +28,7 @@
 #include "ranger_can/control/geometry.hpp"
 #include "ranger_can/control/kinematics.hpp"  // BodyTwist, WheelState(s)
 #include "ranger_can/control/odometry.hpp"    // Pose2D
+#include "ranger_can/types.hpp"
 #include "ranger_can/wire/codec.hpp"
 #include "ranger_can/wire/interpretation.hpp"
 #include "ranger_can/wire/protocol.hpp"
@@ -42,7 +43,7 @@ struct MotionLimits {
   double acceleration = 1.0;                              // m/s^2 when speeding up
   double deceleration = 2.0;                              // m/s^2 when slowing down or stopping
   double emergency_deceleration = 6.0;                    // m/s^2 for e-stop and power cut
-  double steering_rate = 90.0 * M_PI / 180.0;             // rad/s of the body steering quantity
+  double steering_rate = deg_to_rad(90.0);                // rad/s of the body steering quantity
 };
 
 // What the chassis has been asked to do, REP-103 signs (VirtualChassis converts from the wire).

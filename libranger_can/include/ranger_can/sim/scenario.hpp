@@ -40,6 +40,7 @@
 #include "ranger_can/control/driver.hpp"
 #include "ranger_can/result.hpp"
 #include "ranger_can/sim/chassis_commands.hpp"
+#include "ranger_can/text.hpp"
 #include "ranger_can/types.hpp"
 
 namespace ranger::sim {
@@ -75,6 +76,15 @@ struct Expectation {
   // as written.
   std::string text;
 };
+
+// The comparison operators, as a script writes them.
+inline constexpr auto kOpNames = text::enum_names<Expectation::Op>({
+    {Expectation::Op::kGreater, ">"},
+    {Expectation::Op::kLess, "<"},
+    {Expectation::Op::kGreaterEqual, ">="},
+    {Expectation::Op::kLessEqual, "<="},
+    {Expectation::Op::kEqual, "=="},
+});
 
 // One script line, checked.
 struct ScenarioAction {

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "ranger_can/result.hpp"
+#include "ranger_can/text.hpp"
 #include "ranger_can/wire/frame.hpp"
 
 namespace ranger {
@@ -36,7 +37,16 @@ enum class BusState {
   kBusOff,        // controller disconnected from the bus (too many errors)
   kDown,          // interface gone or administratively down; reopening is being attempted
 };
-std::string_view to_string(BusState s);
+inline constexpr auto kBusStateNames = text::enum_names<BusState>({
+    {BusState::kActive, "active"},
+    {BusState::kErrorWarning, "error-warning"},
+    {BusState::kErrorPassive, "error-passive"},
+    {BusState::kBusOff, "bus-off"},
+    {BusState::kDown, "down"},
+});
+inline std::string_view to_string(BusState s) {
+  return kBusStateNames.name(s);
+}
 
 struct BusStatistics {
   std::uint64_t tx_frames = 0;

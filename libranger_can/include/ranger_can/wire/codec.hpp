@@ -25,6 +25,7 @@
 #include <variant>
 
 #include "ranger_can/result.hpp"
+#include "ranger_can/types.hpp"
 #include "ranger_can/wire/frame.hpp"
 #include "ranger_can/wire/profile.hpp"
 #include "ranger_can/wire/protocol.hpp"
@@ -50,10 +51,10 @@ struct MotionCommand {
 };
 // 0x111's valid ranges in SI units, for code above the codec (the linear speed's range is open
 // point 1: interpretation::kMaxLinearSpeedMps).
-inline constexpr double kMaxAckermannSteeringRad = 40.0 * M_PI / 180.0;  // +-4000 x 0.01 deg
-inline constexpr double kMaxObliqueSteeringRad = 90.0 * M_PI / 180.0;    // +-9000 x 0.01 deg
-inline constexpr double kMaxSpinSpeedMps = 1.0;                          // +-1000 mm/s
-struct MotionModeCommand {                                               // 0x141
+inline constexpr double kMaxAckermannSteeringRad = deg_to_rad(40.0);  // +-4000 x 0.01 deg
+inline constexpr double kMaxObliqueSteeringRad = deg_to_rad(90.0);    // +-9000 x 0.01 deg
+inline constexpr double kMaxSpinSpeedMps = 1.0;                       // +-1000 mm/s
+struct MotionModeCommand {                                            // 0x141
   protocol::MotionMode mode = protocol::MotionMode::kAckermann;
   // Decoding only: the wire byte, and whether the profile's numbering defines it (when not,
   // `mode` holds no enumerator and the command must not be obeyed). Encoding writes `mode`.

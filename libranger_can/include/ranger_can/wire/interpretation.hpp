@@ -16,6 +16,7 @@
 #include <optional>
 #include <vector>
 
+#include "ranger_can/types.hpp"
 #include "ranger_can/wire/profile.hpp"
 #include "ranger_can/wire/protocol.hpp"
 
@@ -27,7 +28,7 @@ namespace ranger::interpretation {
 // angle exceeds 20 degrees, without giving it: the kinematics' configurable
 // `max_speed_at_large_steering` covers it.)
 inline constexpr double kMaxLinearSpeedMps = 2.6;
-inline constexpr double kLargeSteeringThresholdRad = 20.0 * M_PI / 180.0;
+inline constexpr double kLargeSteeringThresholdRad = deg_to_rad(20.0);
 
 // 0x221 steering feedback: the manual states negative = left, positive = right. REP-103 is the
 // opposite (positive = left, towards +y). Decoded messages always use the manual's sign; the
@@ -45,7 +46,7 @@ inline constexpr double kManualWheelAngleSignVsRep103 = -1.0;
 // (oblique mode), the spin position about 58 deg. A 0x221 or 0x271 angle beyond this (after the
 // profile's unit) cannot be true under that profile; the codec refuses it (Errc::kOutOfRange,
 // naming the ID and the value), so a wrong unit shows as counted errors, never as motion.
-inline constexpr double kMaxPlausibleSteeringRad = 100.0 * M_PI / 180.0;
+inline constexpr double kMaxPlausibleSteeringRad = deg_to_rad(100.0);
 
 // Converts a steering/wheel angle between the manual's convention and REP-103's (involutions).
 // 0x221 (feedback) steering:

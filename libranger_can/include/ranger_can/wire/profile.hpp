@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "ranger_can/result.hpp"
+#include "ranger_can/text.hpp"
 
 namespace ranger {
 
@@ -72,6 +73,41 @@ enum class DriverStatusBit6 {
   kDisabled,  // 1 = driver disabled (the manual)
   kEnabled,   // 1 = driver enabled (the vendor's software)
 };
+
+// The values' names, as the settings spell them.
+inline constexpr auto kAngleUnitNames = text::enum_names<AngleUnit>({
+    {AngleUnit::kCentidegree, "centideg"},
+    {AngleUnit::kMilliradian, "millirad"},
+});
+inline constexpr auto kSteeringSignNames = text::enum_names<SteeringSign>({
+    {SteeringSign::kRightPositive, "right_positive"},
+    {SteeringSign::kLeftPositive, "left_positive"},
+});
+inline constexpr auto kSteeringReferenceNames = text::enum_names<SteeringReference>({
+    {SteeringReference::kMeanFront, "mean_front"},
+    {SteeringReference::kInnerFront, "inner_front"},
+});
+inline constexpr auto kSpinFieldNames = text::enum_names<SpinField>({
+    {SpinField::kWheelSpeed, "wheel_speed"},
+    {SpinField::kYawRate, "yaw_rate"},
+});
+inline constexpr auto kFeedbackSpeedNames = text::enum_names<FeedbackSpeed>({
+    {FeedbackSpeed::kMeanWheel, "mean_wheel"},
+    {FeedbackSpeed::kBodyCentre, "body_centre"},
+});
+inline constexpr auto kErrorWordLayoutNames = text::enum_names<ErrorWordLayout>({
+    {ErrorWordLayout::kManual32, "manual32"},
+    {ErrorWordLayout::kAgxV2_16, "agx16"},
+});
+inline constexpr auto kModeNumberingNames = text::enum_names<ModeNumbering>({
+    {ModeNumbering::kManual, "manual"},
+    {ModeNumbering::kAgxV2, "agx_v2"},
+    {ModeNumbering::kMiniV1, "mini_v1"},
+});
+inline constexpr auto kDriverStatusBit6Names = text::enum_names<DriverStatusBit6>({
+    {DriverStatusBit6::kDisabled, "disabled"},
+    {DriverStatusBit6::kEnabled, "enabled"},
+});
 
 struct ProtocolProfile {
   // The preset this profile started from ("manual", "agx_v2"), for logs; changing a field below
@@ -121,18 +157,65 @@ const ProtocolProfile& manual_profile();
 // ---- Settings by name -------------------------------------------------------------------------
 // Every field of ProtocolProfile (except `revision`) as a named setting, the one table the node's
 // parameters, the CLI's --set option, commissioning files and docs/PROTOCOL_INTERPRETATIONS.md
-// are checked against.
+// are checked against. Code names a setting by its enumerator; people by its name.
+enum class ProtocolSetting {
+  kSteeringUnit111,
+  kSteeringUnit221,
+  kSteeringUnit271,
+  kSteeringSign111,
+  kSteeringSign221,
+  kSteeringSign271,
+  kSteeringReference,
+  kSpinField,
+  kSpinSign,
+  kFeedbackSpeed,
+  kErrorWord,
+  kVehicleStatus1IsEstop,
+  kBmsVoltageScale,
+  kBmsCurrentSign,
+  kModeNumbering,
+  kDriverStatusBit6,
+  kTxDlc,
+};
+// The settings' names, in the table's order (that of profile_settings()).
+inline constexpr auto kProtocolSettingNames = text::enum_names<ProtocolSetting>({
+    {ProtocolSetting::kSteeringUnit111, "steering_unit_111"},
+    {ProtocolSetting::kSteeringUnit221, "steering_unit_221"},
+    {ProtocolSetting::kSteeringUnit271, "steering_unit_271"},
+    {ProtocolSetting::kSteeringSign111, "steering_sign_111"},
+    {ProtocolSetting::kSteeringSign221, "steering_sign_221"},
+    {ProtocolSetting::kSteeringSign271, "steering_sign_271"},
+    {ProtocolSetting::kSteeringReference, "steering_reference"},
+    {ProtocolSetting::kSpinField, "spin_field"},
+    {ProtocolSetting::kSpinSign, "spin_sign"},
+    {ProtocolSetting::kFeedbackSpeed, "feedback_speed"},
+    {ProtocolSetting::kErrorWord, "error_word"},
+    {ProtocolSetting::kVehicleStatus1IsEstop, "vehicle_status_1_is_estop"},
+    {ProtocolSetting::kBmsVoltageScale, "bms_voltage_scale"},
+    {ProtocolSetting::kBmsCurrentSign, "bms_current_sign"},
+    {ProtocolSetting::kModeNumbering, "mode_numbering"},
+    {ProtocolSetting::kDriverStatusBit6, "driver_status_bit6"},
+    {ProtocolSetting::kTxDlc, "tx_dlc"},
+});
+inline std::string_view to_string(ProtocolSetting s) {
+  return kProtocolSettingNames.name(s);
+}
+
 struct ProfileSetting {
   std::string_view name;                 // "steering_unit_111", ...
   std::string_view description;          // one line
   std::vector<std::string_view> values;  // the valid values, as text ("centideg", "millirad")
+  ProtocolSetting id;
 };
 const std::vector<ProfileSetting>& profile_settings();
+const ProfileSetting& profile_setting(ProtocolSetting id);
 // The value of setting `name` in `profile`, as text.
 Result<std::string> get_setting(const ProtocolProfile& profile, std::string_view name);
+Result<std::string> get_setting(const ProtocolProfile& profile, ProtocolSetting id);
 // Sets `name` to `value` (text, as listed in profile_settings()). Errors (kInvalidArgument) name
 // the setting and list the valid values; an unknown name lists the valid names.
 Status set_setting(ProtocolProfile& profile, std::string_view name, std::string_view value);
+Status set_setting(ProtocolProfile& profile, ProtocolSetting id, std::string_view value);
 // The same for one "NAME=VALUE" text (the CLI's --set, commissioning files).
 Status apply_setting(ProtocolProfile& profile, std::string_view assignment);
 // "agx_v2", or "agx_v2 with steering_unit_271=centideg,tx_dlc=0": the revision and every
@@ -140,13 +223,29 @@ Status apply_setting(ProtocolProfile& profile, std::string_view assignment);
 std::string describe(const ProtocolProfile& profile);
 
 // Text names of the enumerations (as used by the settings).
-std::string_view to_string(AngleUnit v);
-std::string_view to_string(SteeringSign v);
-std::string_view to_string(SteeringReference v);
-std::string_view to_string(SpinField v);
-std::string_view to_string(FeedbackSpeed v);
-std::string_view to_string(ErrorWordLayout v);
-std::string_view to_string(ModeNumbering v);
-std::string_view to_string(DriverStatusBit6 v);
+inline std::string_view to_string(AngleUnit v) {
+  return kAngleUnitNames.name(v);
+}
+inline std::string_view to_string(SteeringSign v) {
+  return kSteeringSignNames.name(v);
+}
+inline std::string_view to_string(SteeringReference v) {
+  return kSteeringReferenceNames.name(v);
+}
+inline std::string_view to_string(SpinField v) {
+  return kSpinFieldNames.name(v);
+}
+inline std::string_view to_string(FeedbackSpeed v) {
+  return kFeedbackSpeedNames.name(v);
+}
+inline std::string_view to_string(ErrorWordLayout v) {
+  return kErrorWordLayoutNames.name(v);
+}
+inline std::string_view to_string(ModeNumbering v) {
+  return kModeNumberingNames.name(v);
+}
+inline std::string_view to_string(DriverStatusBit6 v) {
+  return kDriverStatusBit6Names.name(v);
+}
 
 }  // namespace ranger

@@ -14,6 +14,7 @@
 #include <string_view>
 #include <vector>
 
+#include "ranger_can/text.hpp"
 #include "ranger_can/wire/frame.hpp"
 #include "ranger_can/wire/profile.hpp"
 
@@ -61,9 +62,14 @@ enum class Direction : std::uint8_t {
   kFromChassis,  // the chassis's feedback
   kBoth,         // 0x4A1: the host's request and the chassis's answers
 };
-std::string_view to_string(Direction d);  // "to_chassis", "from_chassis", "both"
-inline constexpr Direction kAllDirections[] = {Direction::kToChassis, Direction::kFromChassis,
-                                               Direction::kBoth};
+inline constexpr auto kDirectionNames = text::enum_names<Direction>({
+    {Direction::kToChassis, "to_chassis"},
+    {Direction::kFromChassis, "from_chassis"},
+    {Direction::kBoth, "both"},
+});
+inline std::string_view to_string(Direction d) {
+  return kDirectionNames.name(d);
+}
 
 // The revisions that define a frame (a bit set).
 inline constexpr std::uint8_t kInManual = 1u << 0;  // the manual, section 3.2 (PROTOCOL.md)
@@ -216,22 +222,51 @@ inline constexpr std::uint8_t kMaxErrorClearCode = 0x10;
 
 // Names (snake_case, stable) and every enumerator of each, in wire order: what the scenario
 // language, the CLI and the ROS node accept and print.
-std::string_view to_string(MotionMode m);
-std::string_view to_string(ControlMode m);
-std::string_view to_string(VehicleStatus s);
-std::string_view to_string(RemoteSwitch s);
-std::string_view to_string(LightMode m);
-inline constexpr MotionMode kAllMotionModes[] = {MotionMode::kAckermann, MotionMode::kOblique,
-                                                 MotionMode::kSpin, MotionMode::kPark,
-                                                 MotionMode::kSideSlip};
-inline constexpr ControlMode kAllControlModes[] = {ControlMode::kStandby, ControlMode::kCan,
-                                                   ControlMode::kUart, ControlMode::kRemote};
-inline constexpr VehicleStatus kAllVehicleStatuses[] = {
-    VehicleStatus::kNormal, VehicleStatus::kEmergencyStop, VehicleStatus::kAbnormal};
-inline constexpr RemoteSwitch kAllRemoteSwitches[] = {
-    RemoteSwitch::kUndefined, RemoteSwitch::kMiddle, RemoteSwitch::kUp, RemoteSwitch::kDown};
-inline constexpr LightMode kAllLightModes[] = {LightMode::kOff, LightMode::kOn,
-                                               LightMode::kBreathing, LightMode::kCustom};
+inline constexpr auto kMotionModeNames = text::enum_names<MotionMode>({
+    {MotionMode::kAckermann, "ackermann"},
+    {MotionMode::kOblique, "oblique"},
+    {MotionMode::kSpin, "spin"},
+    {MotionMode::kPark, "park"},
+    {MotionMode::kSideSlip, "side_slip"},
+});
+inline constexpr auto kControlModeNames = text::enum_names<ControlMode>({
+    {ControlMode::kStandby, "standby"},
+    {ControlMode::kCan, "can"},
+    {ControlMode::kUart, "uart"},
+    {ControlMode::kRemote, "remote"},
+});
+inline constexpr auto kVehicleStatusNames = text::enum_names<VehicleStatus>({
+    {VehicleStatus::kNormal, "normal"},
+    {VehicleStatus::kEmergencyStop, "emergency_stop"},
+    {VehicleStatus::kAbnormal, "abnormal"},
+});
+inline constexpr auto kRemoteSwitchNames = text::enum_names<RemoteSwitch>({
+    {RemoteSwitch::kUndefined, "undefined"},
+    {RemoteSwitch::kMiddle, "middle"},
+    {RemoteSwitch::kUp, "up"},
+    {RemoteSwitch::kDown, "down"},
+});
+inline constexpr auto kLightModeNames = text::enum_names<LightMode>({
+    {LightMode::kOff, "off"},
+    {LightMode::kOn, "on"},
+    {LightMode::kBreathing, "breathing"},
+    {LightMode::kCustom, "custom"},
+});
+inline std::string_view to_string(MotionMode m) {
+  return kMotionModeNames.name(m);
+}
+inline std::string_view to_string(ControlMode m) {
+  return kControlModeNames.name(m);
+}
+inline std::string_view to_string(VehicleStatus s) {
+  return kVehicleStatusNames.name(s);
+}
+inline std::string_view to_string(RemoteSwitch s) {
+  return kRemoteSwitchNames.name(s);
+}
+inline std::string_view to_string(LightMode m) {
+  return kLightModeNames.name(m);
+}
 // Describes what a 0x441 code clears ("all non-critical faults", "motor driver 3 communication
 // fault").
 std::string error_clear_description(std::uint8_t code);
@@ -286,24 +321,28 @@ enum class Fault {
   kSteeringServoWarning,  // motor-numbered (steering motors 5..8)
   kSteeringEncoder,
 };
-inline constexpr Fault kAllFaults[] = {
-    Fault::kBatteryUnderVoltage,
-    Fault::kBatteryWarning,
-    Fault::kUltrasonicTriggered,
-    Fault::kRemoteSignalLost,
-    Fault::kHostCommunicationLost,
-    Fault::kDriverStatusError,
-    Fault::kOverTemperature,
-    Fault::kOverCurrent,
-    Fault::kMotorCommunication,
-    Fault::kSteeringCalibration,
-    Fault::kSteeringCalibrationTimeout,
-    Fault::kSafetyEdge,
-    Fault::kSteeringServoWarning,
-    Fault::kSteeringEncoder,
-};
-inline constexpr int kFaultCount = static_cast<int>(std::size(kAllFaults));
-std::string_view to_string(Fault f);  // "battery_under_voltage", ...
+// The names of the faults by meaning (a motor-numbered fault's rows in the fault table below
+// carry the motor in their own names).
+inline constexpr auto kFaultNames = text::enum_names<Fault>({
+    {Fault::kBatteryUnderVoltage, "battery_under_voltage"},
+    {Fault::kBatteryWarning, "battery_warning"},
+    {Fault::kUltrasonicTriggered, "ultrasonic_triggered"},
+    {Fault::kRemoteSignalLost, "remote_signal_lost"},
+    {Fault::kHostCommunicationLost, "host_communication_lost"},
+    {Fault::kDriverStatusError, "driver_status_error"},
+    {Fault::kOverTemperature, "over_temperature"},
+    {Fault::kOverCurrent, "over_current"},
+    {Fault::kMotorCommunication, "motor_communication"},
+    {Fault::kSteeringCalibration, "steering_calibration"},
+    {Fault::kSteeringCalibrationTimeout, "steering_calibration_timeout"},
+    {Fault::kSafetyEdge, "safety_edge"},
+    {Fault::kSteeringServoWarning, "steering_servo_warning"},
+    {Fault::kSteeringEncoder, "steering_encoder"},
+});
+inline constexpr int kFaultCount = static_cast<int>(kFaultNames.size());
+inline std::string_view to_string(Fault f) {
+  return kFaultNames.name(f);
+}
 
 // ---- The fault table --------------------------------------------------------------------------
 // One row per fault the chassis reports in 0x211, by meaning: its bit in each error-word layout
@@ -408,6 +447,12 @@ enum class UltrasonicCode : std::int16_t {
   kAbnormalData = -3,
   kSystemException = -4,
 };
+inline constexpr auto kUltrasonicCodeNames = text::enum_names<UltrasonicCode>({
+    {UltrasonicCode::kOffline, "offline"},
+    {UltrasonicCode::kChecksumFailed, "checksum_failed"},
+    {UltrasonicCode::kAbnormalData, "abnormal_data"},
+    {UltrasonicCode::kSystemException, "system_exception"},
+});
 // "ok" for a positive raw value (a distance), "no_reading" for 0, otherwise the code's name
 // ("offline", ...) or "unknown_code".
 std::string_view ultrasonic_status_name(std::int16_t raw);

@@ -1,11 +1,12 @@
-#include "cli_json.hpp"
+#include "ranger_can/json.hpp"
+
 #include "ranger_can/text.hpp"
 
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 
-namespace ranger::cli {
+namespace ranger {
 
 void append_json_number(std::string& out, double v) {
   if (!std::isfinite(v)) {
@@ -22,6 +23,16 @@ void append_json_number(std::string& out, double v) {
     if (*p == '.' || *p == 'e') has_fraction_or_exponent = true;
   }
   if (!has_fraction_or_exponent) out += ".0";
+}
+
+void append_json_fixed(std::string& out, double v, int decimals) {
+  if (!std::isfinite(v)) {
+    out += "null";
+    return;
+  }
+  std::string s = text::fixed(v, decimals);
+  if (s[0] == '-' && s.find_first_not_of("-0.") == std::string::npos) s.erase(0, 1);  // -0.000
+  out += s;
 }
 
 void append_json_string(std::string& out, std::string_view v) {
@@ -85,6 +96,12 @@ JsonWriter& JsonWriter::number(double v) {
   return *this;
 }
 
+JsonWriter& JsonWriter::fixed(double v, int decimals) {
+  before_value();
+  append_json_fixed(out_, v, decimals);
+  return *this;
+}
+
 JsonWriter& JsonWriter::integer(std::int64_t v) {
   before_value();
   out_ += std::to_string(v);
@@ -115,10 +132,27 @@ JsonWriter& JsonWriter::null() {
   return *this;
 }
 
+JsonWriter& JsonWriter::string_or_null(const std::optional<std::string>& v) {
+  return v ? string(*v) : null();
+}
+
+JsonWriter& JsonWriter::strings(const std::vector<std::string>& v) {
+  begin_array();
+  for (const std::string& s : v)
+    string(s);
+  return end_array();
+}
+
+JsonWriter& JsonWriter::raw(std::string_view json) {
+  before_value();
+  out_ += json;
+  return *this;
+}
+
 JsonWriter& JsonWriter::seconds(Timestamp t) {
   before_value();
   append_seconds(out_, t);
   return *this;
 }
 
-}  // namespace ranger::cli
+}  // namespace ranger

@@ -1,4 +1,5 @@
-// Minimal JSON output for the ranger_can sub-commands (decode, odom, monitor print JSON lines).
+// Minimal JSON output: the ranger_can sub-commands' JSON lines (decode, odom, monitor, sim's pose)
+// and the scenario runner's samples.
 //
 // Appends to a std::string so that a line is built without per-value stream overhead and written
 // in one go. Output is always valid JSON whatever the input: control and non-ASCII bytes in
@@ -8,12 +9,14 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
-#include "ranger_can/wire/frame.hpp"
+#include "ranger_can/types.hpp"
 
-namespace ranger::cli {
+namespace ranger {
 
 class JsonWriter {
  public:
@@ -28,11 +31,17 @@ class JsonWriter {
   // Shortest text that reads back as v, always with a fraction or exponent ("0.0", "0.15",
   // "1e+20"); null if v is not finite.
   JsonWriter& number(double v);
+  // `v` with exactly `decimals` digits after the point ("%.*f"); a value that prints as zero
+  // prints without a sign ("0.000", never "-0.000"); null if v is not finite.
+  JsonWriter& fixed(double v, int decimals);
   JsonWriter& integer(std::int64_t v);
   JsonWriter& unsigned_integer(std::uint64_t v);
   JsonWriter& boolean(bool v);
   JsonWriter& string(std::string_view v);
   JsonWriter& null();
+  JsonWriter& string_or_null(const std::optional<std::string>& v);
+  JsonWriter& strings(const std::vector<std::string>& v);  // an array of strings
+  JsonWriter& raw(std::string_view json);                  // a value already written as JSON
   JsonWriter& seconds(Timestamp t);  // a timestamp as seconds with exactly 6 decimals
 
  private:
@@ -43,9 +52,10 @@ class JsonWriter {
 
 // Free helpers, usable without a writer.
 void append_json_number(std::string& out, double v);
+void append_json_fixed(std::string& out, double v, int decimals);
 void append_json_string(std::string& out, std::string_view v);
 // Seconds with 6 decimals from a nanosecond timestamp, computed in integers so that a 10-digit
 // epoch keeps its microseconds exactly ("1700000000.123456"); negative stamps keep their sign.
 void append_seconds(std::string& out, Timestamp t);
 
-}  // namespace ranger::cli
+}  // namespace ranger
