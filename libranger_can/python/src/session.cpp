@@ -27,14 +27,15 @@ const Clock& bus_clock() {
 Session::Session(Setup setup) : setup_(std::move(setup)) {}
 
 Result<std::unique_ptr<Session>> Session::open(const Setup& setup) {
-  auto source = sim::open_bus_source(setup.port, bus_clock(), setup.sim);
+  auto source = sim::open_bus_source(setup.node.port_name, bus_clock(), setup.node.sim);
   if (!source) {
-    return Error{source.error().code, "port \"" + setup.port + "\": " + source.error().message};
+    return Error{source.error().code,
+                 "port \"" + setup.node.port_name + "\": " + source.error().message};
   }
   std::unique_ptr<Session> s(new Session(setup));
   s->source_ = *source;
   s->sim_ = std::dynamic_pointer_cast<sim::SimBusSource>(s->source_);
-  s->driver_ = std::make_unique<Driver>(s->setup_.driver, s->source_, driver_clock());
+  s->driver_ = std::make_unique<Driver>(s->setup_.node.driver, s->source_, driver_clock());
   Session* self = s.get();
   s->driver_->set_step_observer(
       [self](const std::shared_ptr<const DriverSnapshot>& snap) { self->on_step(snap); });
@@ -158,6 +159,19 @@ MotionUpdate Session::wait_motion(std::chrono::nanoseconds period,
   return out;
 }
 
+std::vector<DiagnosticGroup> Session::diagnostics(const std::string& ns) {
+  const auto s = driver_->snapshot();
+  std::lock_guard<std::mutex> lock(diagnostics_mutex_);
+  if (!diagnostics_ || diagnostics_->context().ns != ns) {
+    diagnostics_.emplace(DiagnosticContext{setup_.node.port_name, setup_.node.protocol.source, ns});
+  }
+  return diagnostics_->report(*s);
+}
+
+std::string Session::hardware_id(const std::string& ns) const {
+  return ranger::hardware_id(ns, setup_.node.port_name);
+}
+
 bool Session::stop_sent() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return stop_sent_;
@@ -165,8 +179,8 @@ bool Session::stop_sent() const {
 
 Result<std::string> Session::inject(const std::string& line) {
   if (!sim_) {
-    return Error{Errc::kInvalidArgument,
-                 "inject: port " + setup_.port + " is no virtual chassis (use sim or sim:VARIANT)"};
+    return Error{Errc::kInvalidArgument, "inject: port " + setup_.node.port_name +
+                                             " is no virtual chassis (use sim or sim:VARIANT)"};
   }
   auto action = sim::parse_chassis_command(line);
   if (!action) {

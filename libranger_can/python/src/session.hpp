@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "ranger_can/clock.hpp"
+#include "ranger_can/control/diagnostics.hpp"
 #include "ranger_can/control/driver.hpp"
 #include "ranger_can/result.hpp"
 #include "ranger_can/sim/sim_bus_source.hpp"
@@ -85,6 +86,14 @@ class Session {
   // waiter only for a new estimate or a frame sent, not at each of its iterations. One caller.
   MotionUpdate wait_motion(std::chrono::nanoseconds period, std::chrono::nanoseconds timeout);
 
+  // The library's diagnostic groups (control/diagnostics.hpp) of the latest snapshot, in
+  // kDiagnosticGroups' order, as the ROS 1 node reports them: the context is the port, where the
+  // protocol settings came from and the namespace `ns`. One ranger::ChassisDiagnostics per
+  // session keeps what the groups remember between reports (frames rejected since the last).
+  std::vector<DiagnosticGroup> diagnostics(const std::string& ns);
+  // The hardware_id of every group: "ranger:<ns>:<port_name>".
+  std::string hardware_id(const std::string& ns) const;
+
  private:
   explicit Session(Setup setup);
   void on_step(const std::shared_ptr<const DriverSnapshot>& s);
@@ -108,6 +117,8 @@ class Session {
   std::uint64_t estimates_ = 0;  // how often it advanced
   std::chrono::steady_clock::time_point motion_due_{};
   Timestamp published_odometry_{0}, published_joints_{0};
+  std::mutex diagnostics_mutex_;
+  std::optional<ChassisDiagnostics> diagnostics_;  // by diagnostics_mutex_
 };
 
 }  // namespace ranger::python

@@ -268,12 +268,14 @@ def to_range(u, params) -> Range:
     return msg
 
 
-def to_diagnostics(groups, stamp, hardware_id) -> DiagnosticArray:
-    """Diagnostic groups (name, level, message, key/values) one to one onto diagnostic_msgs."""
+def to_diagnostics(groups, stamp, node_name) -> DiagnosticArray:
+    """The library's diagnostic groups (ranger_can.DiagnosticGroup: name, level, message,
+    key/values, hardware_id) one to one onto diagnostic_msgs; each status named
+    "<node_name>: <group>", as diagnostic_updater names its tasks."""
     msg = DiagnosticArray()
     msg.header.stamp = stamp
-    for g in groups:
-        msg.status.append(DiagnosticStatus(
-            level=g.level, name=g.name, message=g.message, hardware_id=hardware_id,
-            values=[KeyValue(key=k, value=str(v)) for k, v in g.values]))
+    msg.status = [DiagnosticStatus(level=bytes([g.level]), name=f"{node_name}: {g.name}",
+                                   message=g.message, hardware_id=g.hardware_id,
+                                   values=[KeyValue(key=k, value=v) for k, v in g.values])
+                  for g in groups]
     return msg

@@ -50,7 +50,7 @@ from tf2_msgs.msg import TFMessage
 import ranger_can
 from ranger_can import RangerError, RequestFailed, RequestTimeout
 
-from . import adapters, conversions, parameters
+from . import conversions, parameters
 
 MOTION_MODES = {SetMotionMode.Request.ACKERMANN: "ackermann",
                 SetMotionMode.Request.OBLIQUE: "oblique", SetMotionMode.Request.SPIN: "spin",
@@ -145,13 +145,13 @@ class RangerNode(Node):
         display = self.get_fully_qualified_name() + "."
         declared = parameters.declare_all(self, display)
         errors = list(declared.errors)
-        self.params = declared.node
-        self.port = self.params["port_name"]
         self.driver = None
         try:
-            self.driver = ranger_can.Driver(self.port, params=declared.given,
-                                            record_sent=self.params["publish_cmd"], start=False,
-                                            display_prefix=display)
+            # The library checks every value against its row (the ROS 1 node's messages) and
+            # gives the node's own values back checked (Driver.settings); publish_cmd records
+            # the frames sent for cmd_vel_out.
+            self.driver = ranger_can.Driver(parameters.default_of_port(), params=declared.given,
+                                            start=False, display_prefix=display)
         except RangerError as e:
             errors.append(str(e))
         if errors:
@@ -159,10 +159,12 @@ class RangerNode(Node):
             for name in parameters.declared_names():  # ROS 2 spells nesting with '.'
                 text = text.replace(f"{display}{name} ", f"{display}{parameters.ros2_name(name)} ")
             raise ParameterError(text)
+        self.params = dict(self.driver.settings)
+        self.params[parameters.DIAGNOSTIC_PERIOD] = declared.diagnostic_period
+        self.port = self.params["port_name"]
         self.add_on_set_parameters_callback(self._on_set_parameters)
 
-        ns = self.get_namespace()
-        self.hardware_id = f"ranger:{ns}:{self.port}"
+        self._diagnostics_ns = self.get_namespace()
         self._stop = threading.Event()
         self._stopped = False
         self._last_remote = 0
@@ -253,13 +255,13 @@ class RangerNode(Node):
     def _on_set_parameters(self, params):
         for p in params:
             name = parameters.ros1_name(p.name)
-            row = next((r for r in parameters.NODE_ROWS if r.name == name), None)
-            if row is None or row.read_only:
+            if name not in parameters.CHANGEABLE:
                 return SetParametersResult(successful=False,
                                            reason=f"{p.name} cannot change while the driver runs")
-            value, problem = parameters._check_node_value(row, p.value, "")
-            if problem:
-                return SetParametersResult(successful=False, reason=problem)
+            try:
+                value = ranger_can.check_parameter(name, p.value)  # the library's row
+            except RangerError as e:
+                return SetParametersResult(successful=False, reason=str(e))
             self.params[name] = value
         return SetParametersResult(successful=True)
 
@@ -417,7 +419,7 @@ class RangerNode(Node):
                     self._publish_states(self.driver.snapshot())
                     next_state = _advance(next_state, 1.0 / self.params["state_publish_rate"], now)
                 if now >= next_diag:
-                    self._publish_diagnostics(self.driver.snapshot())
+                    self._publish_diagnostics()
                     next_diag = _advance(next_diag, self.params["diagnostic_period"], now)
                 wait = max(0.0, min(next_state, next_diag) - time.monotonic())
                 if self._motion_heard():
@@ -498,10 +500,13 @@ class RangerNode(Node):
             {"debug": log.debug, "info": log.info, "warn": log.warn,
              "error": log.error}.get(event.severity, log.info)(event.text)
 
-    def _publish_diagnostics(self, s):
-        groups = adapters.diagnostic_groups(s, self.driver.protocol_source)
+    def _publish_diagnostics(self):
+        """The library's diagnostic groups of the latest snapshot (ranger_can's
+        Driver.diagnostics: name, level, message, key/values, hardware_id), one to one onto
+        diagnostic_msgs, named as diagnostic_updater names them ("<node>: <group>")."""
+        groups = self.driver.diagnostics(self._diagnostics_ns)
         self.diag_pub.publish(conversions.to_diagnostics(
-            groups, self.get_clock().now().to_msg(), self.hardware_id))
+            groups, self.get_clock().now().to_msg(), self.get_name()))
 
 
 def main(args=None):
