@@ -227,6 +227,59 @@ CliResult run_cli(const std::vector<std::string>& args, const std::string& input
   return r;
 }
 
+// Whether a row's lo and hi hold (numbers and number lists).
+bool has_range(const Parameter& p) {
+  return p.type == ParameterType::kInteger || p.type == ParameterType::kNumber ||
+         p.type == ParameterType::kSeconds || p.type == ParameterType::kNumberList;
+}
+
+// The library's tables as they are: the parameter rows and the diagnostic groups.
+void bind_tables(py::module_& m) {
+  // A row of the library's parameter table (frontend/node_parameters.hpp), as it is.
+  using P = Parameter;
+  py::class_<P>(m, "ParameterRow")
+      .def_readonly("name", &P::name)
+      .def_property_readonly("type", [](const P& p) { return python_type(p.type); })
+      .def_property_readonly("table_type",
+                             [](const P& p) { return std::string(to_string(p.type)); })
+      .def_readonly("unit", &P::unit)
+      .def_property_readonly("lo", [](const P& p) { return p.range.lo; })
+      .def_property_readonly("hi", [](const P& p) { return p.range.hi; })
+      .def_property_readonly("lo_open", [](const P& p) { return p.range.lo_open; })
+      .def_property_readonly("hi_open", [](const P& p) { return p.range.hi_open; })
+      .def_property_readonly("has_range", &has_range)
+      .def_property_readonly("default", [](const P& p) { return to_python(p.default_value); })
+      .def_readonly("default_note", &P::default_note)
+      .def_property_readonly("valid", [](const P& p) { return valid_text(p); })
+      .def_readonly("choices", &P::choices)
+      .def_readonly("size", &P::size)
+      .def_readonly("meaning", &P::meaning)
+      .def_property_readonly("driver_setting", [](const P& p) { return p.get != nullptr; })
+      .def_property_readonly("markdown", [](const P& p) { return markdown_row(p); })
+      .def("__repr__", [](const P& p) { return "ParameterRow(" + p.name + ")"; });
+  py::class_<DiagnosticView>(m, "DiagnosticGroup")
+      .def_property_readonly("name", [](const DiagnosticView& d) { return d.group.name; })
+      .def_property_readonly(
+          "level", [](const DiagnosticView& d) { return static_cast<int>(d.group.level); })
+      .def_property_readonly(
+          "level_name",
+          [](const DiagnosticView& d) { return std::string(to_string(d.group.level)); })
+      .def_property_readonly("message", [](const DiagnosticView& d) { return d.group.message; })
+      .def_property_readonly("values", [](const DiagnosticView& d) { return d.group.values; })
+      .def_readonly("hardware_id", &DiagnosticView::hardware_id)
+      .def("value",
+           [](const DiagnosticView& d, const std::string& key) -> std::optional<std::string> {
+             const std::string* v = d.group.value(key);
+             if (!v) return std::nullopt;
+             return *v;
+           })
+      .def("__str__", [](const DiagnosticView& d) { return to_text(d.group); })
+      .def("__repr__", [](const DiagnosticView& d) {
+        return "DiagnosticGroup(" + d.group.name + ": " + std::string(to_string(d.group.level)) +
+               ")";
+      });
+}
+
 }  // namespace
 }  // namespace ranger::python
 
@@ -411,55 +464,7 @@ PYBIND11_MODULE(_ranger_can, m) {
         return std::string("MotionUpdate(") + (u.odometry ? "odometry " : "") +
                (u.joints ? "joints " : "") + std::to_string(u.sent.size()) + " sent)";
       });
-  // A row of the library's parameter table (frontend/node_parameters.hpp), as it is.
-  using P = Parameter;
-  py::class_<P>(m, "ParameterRow")
-      .def_readonly("name", &P::name)
-      .def_property_readonly("type", [](const P& p) { return python_type(p.type); })
-      .def_property_readonly("table_type",
-                             [](const P& p) { return std::string(to_string(p.type)); })
-      .def_readonly("unit", &P::unit)
-      .def_property_readonly("lo", [](const P& p) { return p.range.lo; })
-      .def_property_readonly("hi", [](const P& p) { return p.range.hi; })
-      .def_property_readonly("lo_open", [](const P& p) { return p.range.lo_open; })
-      .def_property_readonly("hi_open", [](const P& p) { return p.range.hi_open; })
-      .def_property_readonly("has_range",
-                             [](const P& p) {
-                               return p.type == ParameterType::kInteger ||
-                                      p.type == ParameterType::kNumber ||
-                                      p.type == ParameterType::kSeconds ||
-                                      p.type == ParameterType::kNumberList;
-                             })
-      .def_property_readonly("default", [](const P& p) { return to_python(p.default_value); })
-      .def_readonly("default_note", &P::default_note)
-      .def_property_readonly("valid", [](const P& p) { return valid_text(p); })
-      .def_readonly("choices", &P::choices)
-      .def_readonly("size", &P::size)
-      .def_readonly("meaning", &P::meaning)
-      .def_property_readonly("driver_setting", [](const P& p) { return p.get != nullptr; })
-      .def_property_readonly("markdown", [](const P& p) { return markdown_row(p); })
-      .def("__repr__", [](const P& p) { return "ParameterRow(" + p.name + ")"; });
-  py::class_<DiagnosticView>(m, "DiagnosticGroup")
-      .def_property_readonly("name", [](const DiagnosticView& d) { return d.group.name; })
-      .def_property_readonly(
-          "level", [](const DiagnosticView& d) { return static_cast<int>(d.group.level); })
-      .def_property_readonly(
-          "level_name",
-          [](const DiagnosticView& d) { return std::string(to_string(d.group.level)); })
-      .def_property_readonly("message", [](const DiagnosticView& d) { return d.group.message; })
-      .def_property_readonly("values", [](const DiagnosticView& d) { return d.group.values; })
-      .def_readonly("hardware_id", &DiagnosticView::hardware_id)
-      .def("value",
-           [](const DiagnosticView& d, const std::string& key) -> std::optional<std::string> {
-             const std::string* v = d.group.value(key);
-             if (!v) return std::nullopt;
-             return *v;
-           })
-      .def("__str__", [](const DiagnosticView& d) { return to_text(d.group); })
-      .def("__repr__", [](const DiagnosticView& d) {
-        return "DiagnosticGroup(" + d.group.name + ": " + std::string(to_string(d.group.level)) +
-               ")";
-      });
+  bind_tables(m);
   py::class_<CliResult>(m, "CliResult")
       .def_readonly("exit_code", &CliResult::exit_code)
       .def_readonly("out", &CliResult::out)
