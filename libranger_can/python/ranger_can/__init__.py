@@ -27,9 +27,11 @@ from typing import Dict, List, Optional
 
 from ._errors import RangerError, RequestFailed, RequestTimeout
 from ._ranger_can import (  # noqa: F401  (re-exported)
-    Battery, CliResult, Event, FrameCount, GroundTruth, Identification, Joints, Lights, Motor, Odometry,
+    Battery, CliResult, DiagnosticGroup, Event, FrameCount, GroundTruth, Identification, Joints, Lights, Motor,
+    MotionUpdate, Odometry,
     ParameterRow, RemoteState, RequestOutcome, SentMotion, Snapshot, UltrasonicReading,
-    __version__, _cli, _Session, bms_status_bit_names, chassis_command_names,
+    __version__, _cli, _Session, bms_status_bit_names, chassis_command_names, check_parameter,
+    diagnostic_group_names,
     driver_status_bit_names, error_clear_description, error_names, event_kinds, fault_names,
     light_modes, model_names,
     motion_modes, parameters, protocol_names, refusal_names, steering_joint_names, variant_names,
@@ -37,7 +39,8 @@ from ._ranger_can import (  # noqa: F401  (re-exported)
 
 __all__ = [
     "Driver", "RangerError", "RequestFailed", "RequestTimeout", "Snapshot", "RequestOutcome",
-    "Event", "event_kinds",
+    "Event", "event_kinds", "MotionUpdate", "DiagnosticGroup", "diagnostic_group_names",
+    "check_parameter",
     "decode", "replay_odometry", "parameters", "model_names", "variant_names", "protocol_names",
     "motion_modes", "light_modes", "refusal_names", "fault_names", "steering_joint_names",
     "wheel_joint_names", "__version__",
@@ -61,7 +64,7 @@ def _close_all():
 
 class Driver:
     """The driver of one RANGER: `port` names the bus ("can0", "vcan0", "sim", "sim:VARIANT",
-    "replay:FILE"). Parameters by the ROS node's names (ranger_can.parameters() lists every
+    "replay:FILE"; a `port_name` in `params` wins). Parameters by the ROS node's names (ranger_can.parameters() lists every
     one, with its range): as keywords (`cmd_vel_timeout=1.0`) or in `params` (names with a
     slash: `params={"linear/x/has_velocity_limits": True}`). A bad value raises RangerError
     naming every bad parameter and its valid range (each name after `display_prefix`). With
@@ -132,6 +135,10 @@ class Driver:
     protocol_source = property(lambda self: self._s.protocol_source,
                                doc="where the protocol settings come from, in words")
     is_sim = property(lambda self: self._s.is_sim, doc="the in-process virtual chassis")
+    settings = property(lambda self: self._s.settings,
+                        doc="the node's own values of the parameter table, checked: port_name, "
+                            "frames, publish rates, covariance diagonals, ultrasonic ranges "
+                            "(what a ROS front end publishes with)")
     stop_sent = property(lambda self: self._s.stop_sent,
                          doc="the stop at close() was sent to the chassis")
 
@@ -183,6 +190,36 @@ class Driver:
                     + (f", identification {ident.phase}: {ident.message}" if ident else ""))
                 raise RequestTimeout(f"{self.port}: not ready within {timeout} s ({why})")
             s = self._s.wait_snapshot(s.sequence, min(left, _SLICE))
+
+    def wait_motion(self, rate: float = 50.0, timeout: float = 1.0) -> MotionUpdate:
+        """For a publisher of the motion estimate (odom, TF, joint states), paced as the ROS 1
+        node paces it: waits (GIL released) until a publication is due at `rate` (Hz) and the
+        driver has an estimate not handed out before, then returns it (update.odometry,
+        update.joints: ready tuples, None when not new). Returns early with update.sent when a
+        motion frame was sent (record_sent), and empty after `timeout` s or close(). The driver's
+        thread wakes the caller only for a new estimate or a frame sent. One caller per driver."""
+        if not rate > 0:
+            raise RangerError(f"wait_motion: rate {rate} Hz: expected > 0", "invalid_argument")
+        period = 1.0 / rate
+        deadline = time.monotonic() + timeout
+        while True:
+            left = deadline - time.monotonic()
+            update = self._s.wait_motion(period, max(0.0, min(left, _SLICE)))
+            if (update.snapshot is not None or update.sent or left <= _SLICE
+                    or self._s.stopped):
+                return update
+
+    def diagnostics(self, namespace: str = "/") -> List[DiagnosticGroup]:
+        """The library's diagnostic groups of the latest snapshot, in the order of
+        diagnostic_group_names() — CAN link, control mode, protocol settings, chassis errors,
+        battery, frame rates — each with its level, message, key/values and hardware_id
+        ("ranger:<namespace>:<port>"): what the ROS 1 node's /diagnostics shows. The frame-rate
+        group counts frames rejected since the previous call."""
+        return self._s.diagnostics(namespace)
+
+    def hardware_id(self, namespace: str = "/") -> str:
+        """"ranger:<namespace>:<port>": the hardware_id of every diagnostic group."""
+        return self._s.hardware_id(namespace)
 
     def events(self) -> List[Event]:
         """The driver's events (transitions with a severity: link, control mode, re-arm,

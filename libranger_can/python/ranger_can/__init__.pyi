@@ -6,7 +6,11 @@ from ._errors import RangerError as RangerError, RequestFailed as RequestFailed
 from ._errors import RequestTimeout as RequestTimeout
 from ._ranger_can import (Battery as Battery, Event as Event, event_kinds as event_kinds, FrameCount as FrameCount, GroundTruth as GroundTruth,
                           Identification as Identification, Joints as Joints, Lights as Lights,
-                          Motor as Motor, Odometry as Odometry, ParameterRow as ParameterRow,
+                          Motor as Motor, MotionUpdate as MotionUpdate,
+                          Odometry as Odometry, ParameterRow as ParameterRow,
+                          DiagnosticGroup as DiagnosticGroup,
+                          check_parameter as check_parameter,
+                          diagnostic_group_names as diagnostic_group_names,
                           RemoteState as RemoteState, RequestOutcome as RequestOutcome,
                           SentMotion as SentMotion, Snapshot as Snapshot,
                           UltrasonicReading as UltrasonicReading, __version__ as __version__,
@@ -30,6 +34,7 @@ class Driver:
     stop_sent: bool
     closed: bool
     events_missed: int
+    settings: Dict[str, object]
     def __init__(self, port: str = ..., *, model: Optional[str] = ...,
                  protocol: Optional[str] = ..., params: Optional[Dict[str, object]] = ...,
                  record_sent: bool = ..., start: bool = ..., display_prefix: str = ...,
@@ -44,7 +49,10 @@ class Driver:
     def wait_until(self, predicate: Callable[[Snapshot], bool],
                    timeout: float = ...) -> Snapshot: ...
     def wait_ready(self, timeout: float = ...) -> Snapshot: ...
+    def wait_motion(self, rate: float = ..., timeout: float = ...) -> MotionUpdate: ...
     def events(self) -> List[Event]: ...
+    def diagnostics(self, namespace: str = ...) -> List[DiagnosticGroup]: ...
+    def hardware_id(self, namespace: str = ...) -> str: ...
     def command(self, vx: float = ..., vy: float = ..., wz: float = ...,
                 mode: Optional[str] = ..., vz: float = ..., wx: float = ...,
                 wy: float = ...) -> None: ...

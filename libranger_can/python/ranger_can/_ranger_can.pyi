@@ -80,9 +80,28 @@ class GroundTruth:
 class SentMotion:
     vx: float; vy: float; wz: float; wall: float; shutdown: bool
 
+class MotionUpdate:
+    snapshot: Optional[Snapshot]  # None: nothing new (timeout, close, only frames sent)
+    # (sec, nanosec, x, y, qz, qw, vx, vy, wz, var_x, var_y, var_yaw); None when not new
+    odometry: Optional[Tuple[int, int, float, float, float, float, float, float, float, float,
+                             float, float]]
+    # (sec, nanosec, positions, velocities): steering joints 1-4, then wheels 1-4; None: not new
+    joints: Optional[Tuple[int, int, List[float], List[float]]]
+    sent: List[SentMotion]
+
 class ParameterRow:
-    name: str; type: str; unit: str; lo: float; hi: float; lo_open: bool; hi_open: bool
-    has_range: bool; default: str; choices: List[str]; meaning: str; group: str
+    # A row of the library's parameter table (frontend/node_parameters.hpp). type: bool, int,
+    # double, string, double_list, string_list; table_type: the library's (seconds, choice, ...).
+    name: str; type: str; table_type: str; unit: str; lo: float; hi: float; lo_open: bool
+    hi_open: bool; has_range: bool; default: object; default_note: str; valid: str
+    choices: List[str]; size: int; meaning: str; driver_setting: bool; markdown: str
+
+class DiagnosticGroup:
+    # A group of the library's diagnostics (control/diagnostics.hpp); level as
+    # diagnostic_msgs numbers it (0 OK, 1 WARN, 2 ERROR, 3 STALE).
+    name: str; level: int; level_name: str; message: str; values: List[Tuple[str, str]]
+    hardware_id: str
+    def value(self, key: str) -> Optional[str]: ...
 
 class CliResult:
     exit_code: int; out: str; err: str
@@ -123,6 +142,8 @@ class _Session:
     def __getattr__(self, name: str): ...
 
 def parameters() -> List[ParameterRow]: ...
+def check_parameter(name: str, value: object) -> object: ...
+def diagnostic_group_names() -> List[str]: ...
 def model_names() -> List[str]: ...
 def variant_names() -> List[str]: ...
 def protocol_names() -> List[str]: ...

@@ -15,6 +15,7 @@
 #include <string>
 
 #include "ranger_can/control/controller.hpp"
+#include "ranger_can/control/diagnostics.hpp"
 #include "ranger_can/control/geometry.hpp"
 #include "ranger_can/control/model.hpp"
 #include "ranger_can/control/rearm.hpp"
@@ -109,34 +110,77 @@ std::optional<std::string> name_of(const std::optional<T>& v) {
   return std::string(protocol::to_string(*v));
 }
 
-std::vector<std::string> cause_names(StopCauses causes) {
-  std::vector<std::string> out;
-  for (const auto& [cause, name] : kStopCauseNames) {
-    if (has(causes, cause)) out.emplace_back(name);
-  }
-  return out;
-}
-
-// Converts a Python parameter value (bool, int, float, str, list of numbers or strings).
-Value to_value(const std::string& name, const py::handle& h) {
+// A Python parameter value (bool, int, float, str, a list of them; a dict) as the library reads
+// parameters (ranger::ParameterValue); anything else is named in the error.
+ParameterValue to_value(const std::string& name, const py::handle& h) {
   if (py::isinstance<py::bool_>(h)) return h.cast<bool>();
-  if (py::isinstance<py::int_>(h)) return h.cast<std::int64_t>();
+  if (py::isinstance<py::int_>(h)) return ParameterValue(h.cast<long long>());
   if (py::isinstance<py::float_>(h)) return h.cast<double>();
   if (py::isinstance<py::str>(h)) return h.cast<std::string>();
+  if (py::isinstance<py::dict>(h)) return ParameterValue::dictionary();
   if (py::isinstance<py::list>(h) || py::isinstance<py::tuple>(h)) {
-    const auto seq = h.cast<py::sequence>();
-    bool all_text = true, all_numbers = true;
-    for (const auto& item : seq) {
-      all_text = all_text && py::isinstance<py::str>(item);
-      all_numbers = all_numbers && !py::isinstance<py::bool_>(item) &&
-                    (py::isinstance<py::int_>(item) || py::isinstance<py::float_>(item));
-    }
-    if (seq.size() > 0 && all_text) return h.cast<std::vector<std::string>>();
-    if (all_numbers) return h.cast<std::vector<double>>();
+    std::vector<ParameterValue> items;
+    for (const auto& item : h.cast<py::sequence>())
+      items.push_back(to_value(name, item));
+    return items;
   }
   invalid("parameter " + name + " = " + py::repr(h).cast<std::string>() +
           ": expected a bool, a number, a string or a list of them");
 }
+
+// A parameter value as Python sees it.
+py::object to_python(const ParameterValue& v) {
+  using K = ParameterValue::Kind;
+  switch (v.kind) {
+    case K::kBool:
+      return py::bool_(v.boolean);
+    case K::kInteger:
+      return py::int_(v.integer);
+    case K::kNumber:
+      return py::float_(v.number);
+    case K::kText:
+      return py::str(v.text);
+    case K::kList: {
+      py::list out;
+      for (const ParameterValue& item : v.items)
+        out.append(to_python(item));
+      return std::move(out);
+    }
+    case K::kDictionary:
+      return py::dict();
+    case K::kOther:
+      break;
+  }
+  return py::none();
+}
+
+// The node's own values of a setup (the rows without a driver setting that a front end uses), by
+// the table's names: what the ROS 2 node publishes with.
+py::dict node_values(const NodeParameters& n) {
+  py::dict d;
+  d["port_name"] = n.port_name;
+  d["odom_frame"] = n.odom_frame;
+  d["base_frame"] = n.base_frame;
+  d["frame_prefix"] = n.frame_prefix;
+  d["publish_odom_tf"] = n.publish_odom_tf;
+  d["publish_rate"] = n.publish_rate;
+  d["state_publish_rate"] = n.state_publish_rate;
+  d["publish_cmd"] = n.publish_cmd;
+  d["pose_covariance_diagonal"] =
+      std::vector<double>(n.pose_covariance_diagonal.begin(), n.pose_covariance_diagonal.end());
+  d["twist_covariance_diagonal"] =
+      std::vector<double>(n.twist_covariance_diagonal.begin(), n.twist_covariance_diagonal.end());
+  d["ultrasonic/field_of_view"] = n.ultrasonic.field_of_view;
+  d["ultrasonic/min_range"] = n.ultrasonic.min_range;
+  d["ultrasonic/max_range"] = n.ultrasonic.max_range;
+  return d;
+}
+
+// A diagnostic group as Python sees it, with the hardware_id every group of a report carries.
+struct DiagnosticView {
+  DiagnosticGroup group;
+  std::string hardware_id;
+};
 
 // The DriverSnapshot as Python sees it: properties read it on demand.
 class Snapshot {
@@ -182,6 +226,59 @@ CliResult run_cli(const std::vector<std::string>& args, const std::string& input
   r.out = out.str();
   r.err = err.str();
   return r;
+}
+
+// Whether a row's lo and hi hold (numbers and number lists).
+bool has_range(const Parameter& p) {
+  return p.type == ParameterType::kInteger || p.type == ParameterType::kNumber ||
+         p.type == ParameterType::kSeconds || p.type == ParameterType::kNumberList;
+}
+
+// The library's tables as they are: the parameter rows and the diagnostic groups.
+void bind_tables(py::module_& m) {
+  // A row of the library's parameter table (frontend/node_parameters.hpp), as it is.
+  using P = Parameter;
+  py::class_<P>(m, "ParameterRow")
+      .def_readonly("name", &P::name)
+      .def_property_readonly("type", [](const P& p) { return python_type(p.type); })
+      .def_property_readonly("table_type",
+                             [](const P& p) { return std::string(to_string(p.type)); })
+      .def_readonly("unit", &P::unit)
+      .def_property_readonly("lo", [](const P& p) { return p.range.lo; })
+      .def_property_readonly("hi", [](const P& p) { return p.range.hi; })
+      .def_property_readonly("lo_open", [](const P& p) { return p.range.lo_open; })
+      .def_property_readonly("hi_open", [](const P& p) { return p.range.hi_open; })
+      .def_property_readonly("has_range", &has_range)
+      .def_property_readonly("default", [](const P& p) { return to_python(p.default_value); })
+      .def_readonly("default_note", &P::default_note)
+      .def_property_readonly("valid", [](const P& p) { return valid_text(p); })
+      .def_readonly("choices", &P::choices)
+      .def_readonly("size", &P::size)
+      .def_readonly("meaning", &P::meaning)
+      .def_property_readonly("driver_setting", [](const P& p) { return p.get != nullptr; })
+      .def_property_readonly("markdown", [](const P& p) { return markdown_row(p); })
+      .def("__repr__", [](const P& p) { return "ParameterRow(" + p.name + ")"; });
+  py::class_<DiagnosticView>(m, "DiagnosticGroup")
+      .def_property_readonly("name", [](const DiagnosticView& d) { return d.group.name; })
+      .def_property_readonly(
+          "level", [](const DiagnosticView& d) { return static_cast<int>(d.group.level); })
+      .def_property_readonly(
+          "level_name",
+          [](const DiagnosticView& d) { return std::string(to_string(d.group.level)); })
+      .def_property_readonly("message", [](const DiagnosticView& d) { return d.group.message; })
+      .def_property_readonly("values", [](const DiagnosticView& d) { return d.group.values; })
+      .def_readonly("hardware_id", &DiagnosticView::hardware_id)
+      .def("value",
+           [](const DiagnosticView& d, const std::string& key) -> std::optional<std::string> {
+             const std::string* v = d.group.value(key);
+             if (!v) return std::nullopt;
+             return *v;
+           })
+      .def("__str__", [](const DiagnosticView& d) { return to_text(d.group); })
+      .def("__repr__", [](const DiagnosticView& d) {
+        return "DiagnosticGroup(" + d.group.name + ": " + std::string(to_string(d.group.level)) +
+               ")";
+      });
 }
 
 }  // namespace
@@ -350,20 +447,28 @@ PYBIND11_MODULE(_ranger_can, m) {
       .def_property_readonly("wz", [](const SentMotion& s) { return s.achieved.wz; })
       .def_readonly("wall", &SentMotion::wall)
       .def_readonly("shutdown", &SentMotion::shutdown);
-  py::class_<ParameterRow>(m, "ParameterRow")
-      .def_readonly("name", &ParameterRow::name)
-      .def_readonly("type", &ParameterRow::type)
-      .def_readonly("unit", &ParameterRow::unit)
-      .def_readonly("lo", &ParameterRow::lo)
-      .def_readonly("hi", &ParameterRow::hi)
-      .def_readonly("lo_open", &ParameterRow::lo_open)
-      .def_readonly("hi_open", &ParameterRow::hi_open)
-      .def_readonly("has_range", &ParameterRow::has_range)
-      .def_readonly("default", &ParameterRow::default_text)
-      .def_readonly("choices", &ParameterRow::choices)
-      .def_readonly("meaning", &ParameterRow::meaning)
-      .def_readonly("group", &ParameterRow::group)
-      .def("__repr__", [](const ParameterRow& r) { return "ParameterRow(" + r.name + ")"; });
+  py::class_<MotionUpdate>(m, "MotionUpdate")
+      .def_property_readonly("snapshot",
+                             [](const MotionUpdate& u) -> std::optional<Snapshot> {
+                               if (!u.snapshot) return std::nullopt;
+                               return Snapshot(u.snapshot);
+                             })
+      .def_property_readonly("odometry",
+                             [](const MotionUpdate& u) -> std::optional<OdometryValues> {
+                               if (!u.odometry) return std::nullopt;
+                               return odometry_values(*u.snapshot);
+                             })
+      .def_property_readonly("joints",
+                             [](const MotionUpdate& u) -> std::optional<JointValues> {
+                               if (!u.joints) return std::nullopt;
+                               return joint_values(*u.snapshot);
+                             })
+      .def_readonly("sent", &MotionUpdate::sent)
+      .def("__repr__", [](const MotionUpdate& u) {
+        return std::string("MotionUpdate(") + (u.odometry ? "odometry " : "") +
+               (u.joints ? "joints " : "") + std::to_string(u.sent.size()) + " sent)";
+      });
+  bind_tables(m);
   py::class_<CliResult>(m, "CliResult")
       .def_readonly("exit_code", &CliResult::exit_code)
       .def_readonly("out", &CliResult::out)
@@ -423,11 +528,9 @@ PYBIND11_MODULE(_ranger_can, m) {
       .def_property_readonly(
           "error_layout",
           [](const S& s) { return std::string(to_string(s.s().profile.error_word)); })
-      .def_property_readonly("error_names",
-                             [](const S& s) {
-                               return protocol::error_bit_names(s.c().error_bits,
-                                                                s.s().profile.error_word);
-                             })
+      .def_property_readonly(
+          "error_names",
+          [](const S& s) { return fault_names(s.c().error_bits, s.s().profile.error_word); })
       .def_property_readonly("battery_voltage",
                              [](const S& s) -> std::optional<double> {
                                const auto& st = s.s().feedback.system_status;
@@ -518,13 +621,14 @@ PYBIND11_MODULE(_ranger_can, m) {
   py::class_<PySession>(m, "_Session")
       .def(py::init([](const std::string& port, const py::dict& params, bool record_sent,
                        const std::string& display_prefix) {
-             std::map<std::string, Value> values;
+             std::map<std::string, ParameterValue> values;
              for (const auto& [k, v] : params) {
                const std::string name = py::str(k);
                values[name] = to_value(name, v);
              }
-             Setup setup = value_or_throw(make_setup(port, values, display_prefix));
-             setup.record_sent = record_sent;
+             Setup setup = value_or_throw(make_setup(port, std::move(values), display_prefix));
+             // publish_cmd: the frames sent are what cmd_vel_out publishes.
+             setup.record_sent = record_sent || setup.node.publish_cmd;
              return std::make_unique<PySession>(value_or_throw(Session::open(setup)));
            }),
            py::arg("port"), py::arg("params"), py::arg("record_sent") = false,
@@ -535,22 +639,28 @@ PYBIND11_MODULE(_ranger_can, m) {
       .def_property_readonly("started", [](PySession& p) { return p.s().started(); })
       .def_property_readonly("stopped", [](PySession& p) { return p.s().stopped(); })
       .def_property_readonly("stop_sent", [](PySession& p) { return p.s().stop_sent(); })
-      .def_property_readonly("port", [](const PySession& p) { return p.setup().port; })
-      .def_property_readonly("model", [](const PySession& p) { return p.setup().model; })
-      .def_property_readonly("model_display_name",
-                             [](const PySession& p) { return p.setup().model_display_name; })
-      .def_property_readonly("protocol", [](const PySession& p) { return p.setup().protocol; })
+      .def_property_readonly("port", [](const PySession& p) { return p.setup().node.port_name; })
+      .def_property_readonly("model",
+                             [](const PySession& p) { return p.setup().node.protocol.model; })
+      .def_property_readonly(
+          "model_display_name",
+          [](const PySession& p) { return p.setup().node.protocol.model_display_name; })
+      .def_property_readonly("protocol",
+                             [](const PySession& p) { return p.setup().node.protocol.protocol; })
       .def_property_readonly("protocol_source",
-                             [](const PySession& p) { return p.setup().protocol_source; })
+                             [](const PySession& p) { return p.setup().node.protocol.source; })
+      .def_property_readonly("settings",
+                             [](const PySession& p) { return node_values(p.setup().node); })
       .def_property_readonly("is_sim", [](PySession& p) { return p.s().sim() != nullptr; })
       .def_property_readonly("geometry",
                              [](const PySession& p) {
-                               const auto& g = p.setup().driver.controller.geometry;
+                               const auto& g = p.setup().node.driver.controller.geometry;
                                return py::make_tuple(g.wheelbase, g.track, g.wheel_radius);
                              })
-      .def_property_readonly(
-          "max_linear_speed",
-          [](const PySession& p) { return p.setup().driver.controller.limits.max_linear_speed; })
+      .def_property_readonly("max_linear_speed",
+                             [](const PySession& p) {
+                               return p.setup().node.driver.controller.limits.max_linear_speed;
+                             })
       .def("budget", &PySession::budget, py::arg("kind"))
       .def("snapshot", [](PySession& p) { return Snapshot(p.s().snapshot()); })
       .def(
@@ -578,7 +688,7 @@ PYBIND11_MODULE(_ranger_can, m) {
       .def(
           "set_motion_mode",
           [](PySession& p, std::optional<std::string> mode) {
-            std::optional<protocol::MotionMode> m;
+            std::optional<MotionMode> m;
             if (mode) m = parse_mode(*mode);
             // The driver refuses a mode the settings in use cannot drive, naming the ones they do.
             check(p.s().driver().set_motion_mode(m));
@@ -650,6 +760,25 @@ PYBIND11_MODULE(_ranger_can, m) {
             return py::make_tuple(out, missed);
           },
           py::arg("after"))
+      .def(
+          "wait_motion",
+          [](PySession& p, double period, double timeout) {
+            if (!(period > 0.0)) invalid("wait_motion: the period must be > 0 s");
+            py::gil_scoped_release release;
+            return p.s().wait_motion(to_ns(period), to_ns(timeout));
+          },
+          py::arg("period"), py::arg("timeout"))
+      .def(
+          "diagnostics",
+          [](PySession& p, const std::string& ns) {
+            std::vector<DiagnosticView> out;
+            const std::string id = p.s().hardware_id(ns);
+            for (DiagnosticGroup& g : p.s().diagnostics(ns))
+              out.push_back(DiagnosticView{std::move(g), id});
+            return out;
+          },
+          py::arg("namespace"))
+      .def("hardware_id", [](PySession& p, const std::string& ns) { return p.s().hardware_id(ns); })
       .def("take_sent", [](PySession& p) { return p.s().take_sent(); })
       .def(
           "wait_sent",
@@ -660,7 +789,16 @@ PYBIND11_MODULE(_ranger_can, m) {
           py::arg("timeout"));
 
   // ---- tables and names ----
-  m.def("parameters", &parameter_rows, py::return_value_policy::copy);
+  m.def("parameters", &node_parameters, py::return_value_policy::copy);
+  m.def(
+      "check_parameter",
+      [](const std::string& name, const py::handle& value) {
+        return to_python(value_or_throw(check_value(name, to_value(name, value))));
+      },
+      py::arg("name"), py::arg("value"));
+  m.def("diagnostic_group_names", [] {
+    return std::vector<std::string>(kDiagnosticGroups.begin(), kDiagnosticGroups.end());
+  });
   m.def("model_names", &model_names);
   m.def("variant_names", &sim::variant_names);
   m.def("protocol_names", [] {
@@ -705,7 +843,7 @@ PYBIND11_MODULE(_ranger_can, m) {
       [](std::uint32_t word, const std::string& layout) {
         ProtocolProfile p;
         check(set_setting(p, "error_word", layout));
-        return protocol::error_bit_names(word, p.error_word);
+        return fault_names(word, p.error_word);
       },
       py::arg("error_word"), py::arg("layout"));
   m.def(

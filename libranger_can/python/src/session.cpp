@@ -5,6 +5,8 @@
 #include "ranger_can/sim/chassis_commands.hpp"
 #include "ranger_can/text.hpp"
 
+#include "views.hpp"
+
 namespace ranger::python {
 namespace {
 
@@ -25,14 +27,15 @@ const Clock& bus_clock() {
 Session::Session(Setup setup) : setup_(std::move(setup)) {}
 
 Result<std::unique_ptr<Session>> Session::open(const Setup& setup) {
-  auto source = sim::open_bus_source(setup.port, bus_clock(), setup.sim);
+  auto source = sim::open_bus_source(setup.node.port_name, bus_clock(), setup.node.sim);
   if (!source) {
-    return Error{source.error().code, "port \"" + setup.port + "\": " + source.error().message};
+    return Error{source.error().code,
+                 "port \"" + setup.node.port_name + "\": " + source.error().message};
   }
   std::unique_ptr<Session> s(new Session(setup));
   s->source_ = *source;
   s->sim_ = std::dynamic_pointer_cast<sim::SimBusSource>(s->source_);
-  s->driver_ = std::make_unique<Driver>(s->setup_.driver, s->source_, driver_clock());
+  s->driver_ = std::make_unique<Driver>(s->setup_.node.driver, s->source_, driver_clock());
   Session* self = s.get();
   s->driver_->set_step_observer(
       [self](const std::shared_ptr<const DriverSnapshot>& snap) { self->on_step(snap); });
@@ -57,14 +60,23 @@ void Session::stop() {
   stopped_ = true;
   driver_->stop();
   changed_.notify_all();
+  motion_.notify_all();
 }
 
 void Session::on_step(const std::shared_ptr<const DriverSnapshot>& s) {
+  const Timestamp estimate = std::max(s->odometry.stamp, joints_stamp(*s));
+  bool advanced = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     sequence_ = s->sequence;
+    if (estimate > estimate_stamp_) {
+      estimate_stamp_ = estimate;
+      ++estimates_;
+      advanced = true;
+    }
   }
   changed_.notify_all();
+  if (advanced) motion_.notify_all();
 }
 
 void Session::on_sent(const SentEvent& e) {
@@ -79,6 +91,7 @@ void Session::on_sent(const SentEvent& e) {
                                e.sent.shutdown});
   }
   changed_.notify_all();
+  motion_.notify_all();
 }
 
 std::shared_ptr<const DriverSnapshot> Session::wait_snapshot(std::uint64_t sequence,
@@ -105,6 +118,60 @@ std::vector<SentMotion> Session::wait_sent(std::chrono::nanoseconds timeout) {
   return take_sent();
 }
 
+MotionUpdate Session::wait_motion(std::chrono::nanoseconds period,
+                                  std::chrono::nanoseconds timeout) {
+  using Clock = std::chrono::steady_clock;
+  const auto early = std::min<Clock::duration>(std::chrono::milliseconds(5), period / 4);
+  const auto deadline = Clock::now() + timeout;
+  MotionUpdate out;
+  std::unique_lock<std::mutex> lock(mutex_);
+  while (!stopped_) {
+    out.sent.assign(sent_.begin(), sent_.end());
+    sent_.clear();
+    const auto now = Clock::now();
+    bool waiting = false;  // due, and the latest snapshot has nothing new: the next estimate
+    if (now >= motion_due_ - early) {
+      auto s = driver_->snapshot();
+      const Timestamp joints = joints_stamp(*s);
+      out.odometry = s->motion_known && s->odometry.stamp > published_odometry_;
+      out.joints = s->motion_known && (s->joints.has_steering || s->joints.has_wheels) &&
+                   joints > published_joints_;
+      if (out.odometry || out.joints || !s->motion_known) {  // published, or nothing to wait for
+        motion_due_ += period;
+        if (motion_due_ < now) motion_due_ = now + period;
+      }
+      if (out.odometry || out.joints) {
+        published_odometry_ = std::max(published_odometry_, s->odometry.stamp);
+        published_joints_ = std::max(published_joints_, joints);
+        out.snapshot = std::move(s);
+        return out;
+      }
+      waiting = s->motion_known;
+    }
+    if (!out.sent.empty() || now >= deadline) return out;
+    const std::uint64_t estimates = estimates_;
+    motion_.wait_until(lock, waiting ? deadline : std::min(deadline, motion_due_ - early), [&] {
+      return stopped_ || !sent_.empty() || (waiting && estimates_ != estimates);
+    });
+  }
+  out.sent.assign(sent_.begin(), sent_.end());
+  sent_.clear();
+  return out;
+}
+
+std::vector<DiagnosticGroup> Session::diagnostics(const std::string& ns) {
+  const auto s = driver_->snapshot();
+  std::lock_guard<std::mutex> lock(diagnostics_mutex_);
+  if (!diagnostics_ || diagnostics_->context().ns != ns) {
+    diagnostics_.emplace(DiagnosticContext{setup_.node.port_name, setup_.node.protocol.source, ns});
+  }
+  return diagnostics_->report(*s);
+}
+
+std::string Session::hardware_id(const std::string& ns) const {
+  return ranger::hardware_id(ns, setup_.node.port_name);
+}
+
 bool Session::stop_sent() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return stop_sent_;
@@ -112,8 +179,8 @@ bool Session::stop_sent() const {
 
 Result<std::string> Session::inject(const std::string& line) {
   if (!sim_) {
-    return Error{Errc::kInvalidArgument,
-                 "inject: port " + setup_.port + " is no virtual chassis (use sim or sim:VARIANT)"};
+    return Error{Errc::kInvalidArgument, "inject: port " + setup_.node.port_name +
+                                             " is no virtual chassis (use sim or sim:VARIANT)"};
   }
   auto action = sim::parse_chassis_command(line);
   if (!action) {

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "ranger_can/clock.hpp"
+#include "ranger_can/control/diagnostics.hpp"
 #include "ranger_can/control/driver.hpp"
 #include "ranger_can/result.hpp"
 #include "ranger_can/sim/sim_bus_source.hpp"
@@ -30,6 +31,16 @@ struct SentMotion {
   BodyTwist achieved;  // the twist it realises (zero for a stop)
   double wall = 0.0;   // s since the Unix epoch, right after the send
   bool shutdown = false;
+};
+
+// What Session::wait_motion hands a front end that publishes the motion estimate (odom, TF,
+// joint states): the snapshot it was read from, which of its parts are new, and the motion
+// frames sent meanwhile.
+struct MotionUpdate {
+  std::shared_ptr<const DriverSnapshot> snapshot;  // nullptr: nothing new (timeout, stop, sent)
+  bool odometry = false;                           // snapshot->odometry is a new estimate
+  bool joints = false;                             // the joint states are new
+  std::vector<SentMotion> sent;                    // with Setup::record_sent
 };
 
 class Session {
@@ -67,6 +78,22 @@ class Session {
   // Whether the shutdown's stop was sent (seen by the observer).
   bool stop_sent() const;
 
+  // The motion publication of a front end, paced as the ROS 1 node paces it: each estimate
+  // (odometry, joint states) once, at most one publication per `period` (a fixed-rate schedule,
+  // up to min(5 ms, period / 4) early), and nothing while the chassis is not heard. Blocks until
+  // a publication is due and the driver has a new estimate, a motion frame was sent (with
+  // Setup::record_sent), the session stops, or `timeout` passes. The driver's thread wakes the
+  // waiter only for a new estimate or a frame sent, not at each of its iterations. One caller.
+  MotionUpdate wait_motion(std::chrono::nanoseconds period, std::chrono::nanoseconds timeout);
+
+  // The library's diagnostic groups (control/diagnostics.hpp) of the latest snapshot, in
+  // kDiagnosticGroups' order, as the ROS 1 node reports them: the context is the port, where the
+  // protocol settings came from and the namespace `ns`. One ranger::ChassisDiagnostics per
+  // session keeps what the groups remember between reports (frames rejected since the last).
+  std::vector<DiagnosticGroup> diagnostics(const std::string& ns);
+  // The hardware_id of every group: "ranger:<ns>:<port_name>".
+  std::string hardware_id(const std::string& ns) const;
+
  private:
   explicit Session(Setup setup);
   void on_step(const std::shared_ptr<const DriverSnapshot>& s);
@@ -80,10 +107,18 @@ class Session {
   bool stopped_ = false;
 
   mutable std::mutex mutex_;
-  std::condition_variable changed_;
-  std::uint64_t sequence_ = 0;   // of the newest snapshot, guarded by mutex_
-  std::deque<SentMotion> sent_;  // bounded, guarded by mutex_
-  bool stop_sent_ = false;       // guarded by mutex_
+  std::condition_variable changed_;  // every snapshot, every frame sent, the stop
+  std::condition_variable motion_;   // a new estimate, a frame sent, the stop
+  std::uint64_t sequence_ = 0;       // of the newest snapshot, guarded by mutex_
+  std::deque<SentMotion> sent_;      // bounded, guarded by mutex_
+  bool stop_sent_ = false;           // guarded by mutex_
+  // The estimate's progress (on the driver's thread) and wait_motion's schedule; by mutex_.
+  Timestamp estimate_stamp_{0};  // the newest odometry or joint-state stamp seen
+  std::uint64_t estimates_ = 0;  // how often it advanced
+  std::chrono::steady_clock::time_point motion_due_{};
+  Timestamp published_odometry_{0}, published_joints_{0};
+  std::mutex diagnostics_mutex_;
+  std::optional<ChassisDiagnostics> diagnostics_;  // by diagnostics_mutex_
 };
 
 }  // namespace ranger::python

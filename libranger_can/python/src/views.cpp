@@ -1,26 +1,18 @@
 #include "views.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "ranger_can/control/geometry.hpp"
+#include "ranger_can/control/vocabulary.hpp"
 #include "ranger_can/sim/virtual_chassis.hpp"
-#include "ranger_can/wire/interpretation.hpp"
 #include "ranger_can/wire/protocol.hpp"
 
 namespace ranger::python {
 namespace {
 
-// A BMS report older than this many of its periods counts as absent (an unfitted slot), as the
-// ROS 1 node reads it. (Issue 27 point 2 brings the freshness in the snapshot: then read it.)
-constexpr int kStalePeriods = 3;
-
 std::int64_t ns(Timestamp t) {
   return static_cast<std::int64_t>(t.count());
-}
-
-template <typename T>
-bool fresh(const std::optional<Stamped<T>>& v, Timestamp now, std::uint32_t id) {
-  return is_fresh(v, now, std::chrono::milliseconds(kStalePeriods * protocol::frame_period_ms(id)));
 }
 
 std::string joint_of_motor(int motor) {
@@ -70,6 +62,51 @@ OdometryView odometry_view(const DriverSnapshot& s) {
   return v;
 }
 
+Timestamp joints_stamp(const DriverSnapshot& s) {
+  Timestamp stamp{0};
+  if (s.feedback.steering_angles) stamp = std::max(stamp, s.feedback.steering_angles->stamp);
+  if (s.feedback.wheel_speeds) stamp = std::max(stamp, s.feedback.wheel_speeds->stamp);
+  return stamp;
+}
+
+namespace {
+std::pair<std::int64_t, std::uint32_t> split(Timestamp t) {
+  const std::int64_t n = ns(t);
+  const std::int64_t sec = n >= 0 ? n / 1'000'000'000 : (n - 999'999'999) / 1'000'000'000;
+  return {sec, static_cast<std::uint32_t>(n - sec * 1'000'000'000)};
+}
+}  // namespace
+
+OdometryValues odometry_values(const DriverSnapshot& s) {
+  const OdometryState& o = s.odometry;
+  const auto [sec, nanosec] = split(o.stamp);
+  return {sec,
+          nanosec,
+          o.pose.x,
+          o.pose.y,
+          std::sin(o.pose.yaw / 2.0),
+          std::cos(o.pose.yaw / 2.0),
+          o.twist.vx,
+          o.twist.vy,
+          o.twist.wz,
+          o.pose_variance[0],
+          o.pose_variance[1],
+          o.pose_variance[2]};
+}
+
+JointValues joint_values(const DriverSnapshot& s) {
+  const WheelJoints& j = s.joints;
+  const auto [sec, nanosec] = split(joints_stamp(s));
+  JointValues out{sec, nanosec, {}, {}};
+  for (std::size_t w = 0; w < static_cast<std::size_t>(kWheelCount); ++w) {
+    std::get<2>(out)[w] = j.steering_position[w];
+    std::get<3>(out)[w] = j.steering_velocity[w];
+    std::get<2>(out)[w + kWheelCount] = j.wheel_position[w];
+    std::get<3>(out)[w + kWheelCount] = j.wheel_velocity[w];
+  }
+  return out;
+}
+
 JointsView joints_view(const DriverSnapshot& s) {
   const WheelJoints& j = s.joints;
   JointsView v;
@@ -81,16 +118,13 @@ JointsView joints_view(const DriverSnapshot& s) {
   v.wheel_velocity = values(j.wheel_velocity);
   v.has_steering = j.has_steering;
   v.has_wheels = j.has_wheels;
-  Timestamp stamp{0};
-  if (s.feedback.steering_angles) stamp = std::max(stamp, s.feedback.steering_angles->stamp);
-  if (s.feedback.wheel_speeds) stamp = std::max(stamp, s.feedback.wheel_speeds->stamp);
-  v.stamp_ns = ns(stamp);
+  v.stamp_ns = ns(joints_stamp(s));
   return v;
 }
 
 std::vector<MotorView> motors_view(const DriverSnapshot& s) {
   std::vector<MotorView> out;
-  for (int motor = 1; motor <= protocol::kMotorCount; ++motor) {
+  for (int motor = 1; motor <= kMotorCount; ++motor) {
     const auto i = static_cast<std::size_t>(motor - 1);
     MotorView m;
     m.motor = motor;
@@ -116,12 +150,12 @@ std::vector<MotorView> motors_view(const DriverSnapshot& s) {
 
 std::vector<BatteryView> batteries_view(const DriverSnapshot& s) {
   std::vector<BatteryView> out;
-  for (int b = 0; b <= protocol::kBatteryCount; ++b) {
+  for (int b = 0; b <= kBatteryCount; ++b) {
     const auto i = static_cast<std::size_t>(b);
     BatteryView v;
     v.battery = b;
     const auto& data = s.feedback.bms[i];
-    v.present = fresh(data, s.now, protocol::kBmsBaseId);
+    v.present = bms_present(s.feedback, b, s.now);  // the library's freshness, as ROS 1 reads it
     if (data) {
       v.soc = data->value.soc;
       v.soh = data->value.soh;
@@ -151,8 +185,8 @@ std::vector<UltrasonicView> ultrasonic_view(const DriverSnapshot& s) {
       UltrasonicView u;
       u.sensor = group->value.first_sensor + k;
       u.raw = group->value.raw[static_cast<std::size_t>(k)];
-      u.status = std::string(protocol::ultrasonic_status_name(group->value.raw[k]));
-      if (u.status == "ok") u.range = interpretation::ultrasonic_distance_m(group->value.raw[k]);
+      u.status = std::string(ultrasonic_status(group->value.raw[k]));  // the library's words
+      if (u.status == "ok") u.range = ultrasonic_range(group->value.raw[k]);
       u.stamp_ns = ns(group->stamp);
       out.push_back(std::move(u));
     }
@@ -215,8 +249,9 @@ std::vector<FrameView> frames_view(const DriverSnapshot& s) {
 }
 
 EventView event_view(const DriverEvent& e) {
-  return EventView{e.sequence,          ns(e.time), std::string(to_string(e.kind)),
-                   std::string(to_string(e.severity)), describe(e), to_json(e)};
+  return EventView{
+      e.sequence,  ns(e.time), std::string(to_string(e.kind)), std::string(to_string(e.severity)),
+      describe(e), to_json(e)};
 }
 
 OutcomeView outcome_view(const RequestOutcome& o) {

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -115,6 +116,21 @@ struct EventView {
   std::string text;  // describe(): the line the ROS node logs
   std::string json;  // to_json()
 };
+
+// The time of the newest frame behind the joint states (steering angles, wheel speeds).
+Timestamp joints_stamp(const DriverSnapshot& s);
+
+// The motion estimate in the shape a publisher fills its messages with, in one call: the stamp
+// split into s and ns (as ROS splits it), the heading also as a unit quaternion about z.
+// (sec, nanosec, x, y, qz, qw, vx, vy, wz, var_x, var_y, var_yaw)
+using OdometryValues = std::tuple<std::int64_t, std::uint32_t, double, double, double, double,
+                                  double, double, double, double, double, double>;
+// (sec, nanosec, positions, velocities): the steering joints 1-4, then the wheels 1-4 (the order
+// of kSteeringJointNames, kWheelJointNames).
+using JointValues =
+    std::tuple<std::int64_t, std::uint32_t, std::array<double, 8>, std::array<double, 8>>;
+OdometryValues odometry_values(const DriverSnapshot& s);
+JointValues joint_values(const DriverSnapshot& s);
 
 OdometryView odometry_view(const DriverSnapshot& s);
 EventView event_view(const DriverEvent& e);

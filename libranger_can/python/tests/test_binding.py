@@ -395,3 +395,81 @@ def test_type_stubs_name_everything_the_module_offers():
     for attr in dir(ranger_can.Driver):
         if not attr.startswith("_"):
             assert re.search(rf"\b{attr}\b", init_stub), f"Driver.{attr} not in __init__.pyi"
+
+
+# ---- the library's parameter table and diagnostics, as they are --------------------------------
+
+def readme_parameter_rows():
+    """Every parameter row of ranger_base/README.md (the ROS 1 node's; its tests hold each one
+    character for character to the library's table)."""
+    with open(os.path.join(REPO, "ranger_base", "README.md"), encoding="utf-8") as f:
+        text = f.read()
+    block = text[text.index("## Parameters"):]
+    block = block[:block.find("\n## ", 1)]
+    return [line for line in block.splitlines() if line.startswith("| `")]
+
+
+def test_parameters_are_the_librarys_table_row_for_row():
+    """Fails when the binding's rows drift from the library's table: each row is the README's
+    row of the ROS 1 node (markdown_row of the same row), in the same order, nothing more."""
+    rows = ranger_can.parameters()
+    assert [r.markdown for r in rows] == readme_parameter_rows()
+    names = [r.name for r in rows]
+    assert len(set(names)) == len(names)
+    by_name = {r.name: r for r in rows}
+    # The node's own rows and the generated per-axis rows are there, with the library's values.
+    assert by_name["publish_rate"].default == 50.0 and by_name["publish_rate"].lo_open
+    assert by_name["publish_rate"].valid == "(0, 50] Hz" and not by_name["publish_rate"].driver_setting
+    assert by_name["cmd_vel_timeout"].driver_setting and by_name["cmd_vel_timeout"].type == "double"
+    assert by_name["pose_covariance_diagonal"].type == "double_list"
+    assert by_name["pose_covariance_diagonal"].size == 6
+    assert by_name["wheelbase"].default_note.startswith("the model's")
+    assert by_name["tx_dlc"].table_type == "choice" and by_name["tx_dlc"].choices == ["0", "8"]
+    for axis in ("linear/x", "linear/y", "angular/z"):
+        assert f"{axis}/max_velocity" in by_name and f"{axis}/min_acceleration" in by_name
+
+
+def test_settings_and_check_parameter_are_the_tables():
+    rows = {r.name: r for r in ranger_can.parameters()}
+    with ranger_can.Driver("sim", start=False, odom_frame="robot1/odom",
+                           params={"ultrasonic/max_range": 4.0}) as d:
+        s = d.settings
+        assert s["odom_frame"] == "robot1/odom" and s["ultrasonic/max_range"] == 4.0
+        for name in ("base_frame", "publish_rate", "state_publish_rate", "publish_odom_tf",
+                     "pose_covariance_diagonal", "ultrasonic/field_of_view"):
+            assert s[name] == rows[name].default, name
+        assert s["port_name"] == "sim"
+    assert ranger_can.check_parameter("publish_rate", 20) == 20.0
+    with pytest.raises(RangerError, match=r"parameter publish_rate = 60 is out of range: "
+                                          r"valid \(0, 50\] Hz"):
+        ranger_can.check_parameter("publish_rate", 60.0)
+    with pytest.raises(RangerError, match="parameter no_such_row unknown"):
+        ranger_can.check_parameter("no_such_row", 1)
+    with pytest.raises(RangerError, match=r"parameter ultrasonic/max_range = 0.01 is out of range"):
+        ranger_can.Driver("sim", start=False, params={"ultrasonic/max_range": 0.01})
+
+
+def test_diagnostics_are_the_librarys_groups(sim):
+    sim.wait_ready(timeout=30)
+    groups = sim.diagnostics("/robot1")
+    assert [g.name for g in groups] == ranger_can.diagnostic_group_names() == [
+        "CAN link", "Control mode", "Protocol", "Chassis errors", "Battery", "Frame rates"]
+    assert {g.hardware_id for g in groups} == {"ranger:/robot1:sim"} == {sim.hardware_id("/robot1")}
+    link, control = groups[0], groups[1]
+    assert link.level == 0 and link.level_name == "OK", str(link)
+    assert link.value("Port") == "sim" and link.value("Chassis link") == "connected"
+    assert control.value("Motion refused because") in ("none", "cmd_timeout")
+    assert str(link).startswith("CAN link: OK: ")
+    # A latched e-stop: the control group says so at a level above OK, in the library's words.
+    sim.inject("estop on")
+    sim.wait_until(lambda s: s.refusal == "estop", timeout=10)
+    control = sim.diagnostics("/robot1")[1]
+    assert control.level > 0 and control.value("Motion refused because") == "estop", str(control)
+    assert "emergency_stop" in control.value("Latched stop causes")
+    sim.inject("estop off")
+
+
+def test_battery_presence_is_the_librarys_freshness(sim):
+    sim.wait_ready(timeout=30)
+    s = sim.wait_until(lambda s: s.batteries[0].present, timeout=10)
+    assert s.batteries[0].soc > 0

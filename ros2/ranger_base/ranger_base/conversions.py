@@ -13,6 +13,7 @@ from ranger_msgs.msg import (ActuatorState, ActuatorStateArray, BmsFlags, BmsSta
                              DriverStatus, RemoteState, SystemErrors, SystemState,
                              UltrasonicReading, UltrasonicState)
 from sensor_msgs.msg import BatteryState, JointState, Range
+from tf2_msgs.msg import TFMessage
 
 NAN = float("nan")
 
@@ -44,36 +45,52 @@ def _odometry(stamp_ns, params, pose, twist) -> Odometry:
     return msg
 
 
-def to_odometry(o, params) -> Odometry:
-    """Pose covariance = diag(pose_covariance_diagonal) + the odometry's x/y/yaw variance;
-    twist covariance = diag(twist_covariance_diagonal)."""
-    msg = _odometry(o.stamp_ns, params, (o.x, o.y, o.yaw), (o.vx, o.vy, o.wz))
-    pose = _diagonal(params["pose_covariance_diagonal"])
-    pose[0] += o.pose_variance[0]
-    pose[7] += o.pose_variance[1]
-    pose[35] += o.pose_variance[2]
-    msg.pose.covariance = pose
-    msg.twist.covariance = _diagonal(params["twist_covariance_diagonal"])
-    return msg
+class MotionMessages:
+    """odom, its transform on /tf and joint_states, each allocated once and refilled from the
+    binding's ready values (ranger_can.MotionUpdate.odometry, .joints) at every estimate: only
+    the fields that change are set, and the transform shares the odometry's header and
+    orientation. Pose covariance = diag(pose_covariance_diagonal) + the odometry's x/y/yaw
+    variance; twist covariance = diag(twist_covariance_diagonal)."""
 
+    def __init__(self, params, joint_names):
+        self.odom = Odometry()
+        self.odom.header.frame_id = params["odom_frame"]
+        self.odom.child_frame_id = params["base_frame"]
+        self._pose_floor = _diagonal(params["pose_covariance_diagonal"])
+        self.odom.pose.covariance = self._pose_floor
+        self.odom.twist.covariance = _diagonal(params["twist_covariance_diagonal"])
+        transform = TransformStamped()
+        transform.header = self.odom.header
+        transform.child_frame_id = self.odom.child_frame_id
+        transform.transform.rotation = self.odom.pose.pose.orientation
+        self.tf = TFMessage(transforms=[transform])
+        self.joints = JointState(name=list(joint_names))
+        self._stamp = self.odom.header.stamp
+        self._position = self.odom.pose.pose.position
+        self._orientation = self.odom.pose.pose.orientation
+        self._translation = transform.transform.translation
+        self._linear = self.odom.twist.twist.linear
+        self._angular = self.odom.twist.twist.angular
+        self._covariance = self.odom.pose.covariance
 
-def to_transform(odom: Odometry) -> TransformStamped:
-    t = TransformStamped()
-    t.header = odom.header
-    t.child_frame_id = odom.child_frame_id
-    t.transform.translation.x = odom.pose.pose.position.x
-    t.transform.translation.y = odom.pose.pose.position.y
-    t.transform.rotation = odom.pose.pose.orientation
-    return t
+    def fill_odometry(self, values):
+        """values: (sec, nanosec, x, y, qz, qw, vx, vy, wz, var_x, var_y, var_yaw)."""
+        sec, nanosec, x, y, qz, qw, vx, vy, wz, var_x, var_y, var_yaw = values
+        self._stamp.sec, self._stamp.nanosec = sec, nanosec
+        self._position.x = self._translation.x = x
+        self._position.y = self._translation.y = y
+        self._orientation.z, self._orientation.w = qz, qw
+        self._linear.x, self._linear.y, self._angular.z = vx, vy, wz
+        floor, cov = self._pose_floor, self._covariance
+        cov[0], cov[7], cov[35] = floor[0] + var_x, floor[7] + var_y, floor[35] + var_yaw
 
-
-def to_joint_state(j) -> JointState:
-    msg = JointState()
-    msg.header.stamp = to_time(j.stamp_ns)
-    msg.name = list(j.steering_names) + list(j.wheel_names)
-    msg.position = list(j.steering_position) + list(j.wheel_position)
-    msg.velocity = list(j.steering_velocity) + list(j.wheel_velocity)
-    return msg
+    def fill_joints(self, values):
+        """values: (sec, nanosec, positions, velocities) in the order of the names."""
+        sec, nanosec, position, velocity = values
+        stamp = self.joints.header.stamp
+        stamp.sec, stamp.nanosec = sec, nanosec
+        self.joints.position = position
+        self.joints.velocity = velocity
 
 
 def to_ground_truth(g, params) -> Odometry:
@@ -262,12 +279,14 @@ def to_range(u, params) -> Range:
     return msg
 
 
-def to_diagnostics(groups, stamp, hardware_id) -> DiagnosticArray:
-    """Diagnostic groups (name, level, message, key/values) one to one onto diagnostic_msgs."""
+def to_diagnostics(groups, stamp, node_name) -> DiagnosticArray:
+    """The library's diagnostic groups (ranger_can.DiagnosticGroup: name, level, message,
+    key/values, hardware_id) one to one onto diagnostic_msgs; each status named
+    "<node_name>: <group>", as diagnostic_updater names its tasks."""
     msg = DiagnosticArray()
     msg.header.stamp = stamp
-    for g in groups:
-        msg.status.append(DiagnosticStatus(
-            level=g.level, name=g.name, message=g.message, hardware_id=hardware_id,
-            values=[KeyValue(key=k, value=str(v)) for k, v in g.values]))
+    msg.status = [DiagnosticStatus(level=bytes([g.level]), name=f"{node_name}: {g.name}",
+                                   message=g.message, hardware_id=g.hardware_id,
+                                   values=[KeyValue(key=k, value=v) for k, v in g.values])
+                  for g in groups]
     return msg

@@ -3,18 +3,22 @@ over the Python binding of libranger_can (import ranger_can).
 
 The driver (the bus, the 20 ms keep-alive, the 500 ms command timeout, the re-arm, the
 identification, the odometry) runs in C++ on a thread of the library's own; this node maps:
-  * cmd_vel -> Driver.command (the driver's mailbox: never waits for the bus);
-  * the driver's snapshots -> odom, /tf, joint_states at publish_rate (each estimate once,
-    stamped with its frames' time, only while the chassis is heard), the states at
+  * cmd_vel -> Driver.command (the driver's mailbox: never waits for the bus), on a thread of the
+    node's own that waits for cmd_vel alone (not the executor, whose every wake-up rebuilds its
+    wait set in Python: that costs more than the driver itself and delays the command);
+  * the driver's estimates -> odom, /tf, joint_states at publish_rate (each estimate once,
+    stamped with its frames' time, only while the chassis is heard; Driver.wait_motion paces
+    them in C++ and hands over ready values for messages allocated once), the states at
     state_publish_rate, /diagnostics at 1 Hz, cmd_vel_out for every motion frame sent — on a
-    thread of the node's own, which waits for snapshots with the GIL released;
-  * the services -> the driver's requests, answered when the chassis answers (they wait on a
-    callback group of their own, so cmd_vel is never queued behind them);
+    thread of the node's own, which waits with the GIL released;
+  * the services -> the driver's requests, answered when the chassis answers (the executor's
+    threads: cmd_vel is never queued behind them);
   * sim/inject -> the virtual chassis's control language (port sim[:VARIANT]).
 All names are relative (push the node into a namespace for several robots); /tf and
 /diagnostics are global by their conventions.
 """
 
+import ctypes
 import signal
 import sys
 import threading
@@ -25,12 +29,14 @@ from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import Twist, TwistStamped
 from nav_msgs.msg import Odometry
 from rcl_interfaces.msg import SetParametersResult
-from rclpy.callback_groups import MutuallyExclusiveCallbackGroup
+from rclpy.callback_groups import CallbackGroup, MutuallyExclusiveCallbackGroup
 try:
     from rclpy.event_handler import PublisherEventCallbacks, SubscriptionEventCallbacks
 except ImportError:  # Humble: the same classes under their older module name
     from rclpy.qos_event import PublisherEventCallbacks, SubscriptionEventCallbacks
 from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+from rclpy.guard_condition import GuardCondition
+from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 from ranger_msgs.msg import (ActuatorStateArray, BmsStateArray, RemoteState, SystemState,
@@ -44,7 +50,7 @@ from tf2_msgs.msg import TFMessage
 import ranger_can
 from ranger_can import RangerError, RequestFailed, RequestTimeout
 
-from . import adapters, conversions, parameters
+from . import conversions, parameters
 
 MOTION_MODES = {SetMotionMode.Request.ACKERMANN: "ackermann",
                 SetMotionMode.Request.OBLIQUE: "oblique", SetMotionMode.Request.SPIN: "spin",
@@ -62,8 +68,76 @@ def _advance(due, period, now):
     return due if due >= now else now + period
 
 
+def name_os_thread(name):
+    """Names the calling thread as the OS shows it (top -H, /proc/PID/task/TID/comm; Python's
+    thread names stay inside Python), as the ROS 1 node names its threads."""
+    try:
+        ctypes.CDLL(None).prctl(15, name.encode()[:15], 0, 0, 0)  # PR_SET_NAME
+    except (OSError, AttributeError):
+        pass
+
+
 class ParameterError(Exception):
     """Start-up refused: every bad parameter, one per line."""
+
+
+class OwnThreadGroup(CallbackGroup):
+    """The callback group of what a thread of the node's own serves (cmd_vel): no executor ever
+    takes it up, so it stays out of the executor's wait set."""
+
+    def can_execute(self, entity):
+        return False
+
+    def beginning_execution(self, entity):
+        return False
+
+    def ending_execution(self, entity):
+        pass
+
+
+class SubscriptionThread:
+    """Serves one subscription on a thread of its own: waits on a wait set holding only that
+    subscription (and a guard condition to end it) with the GIL released, takes each message and
+    calls the callback (as rclpy.wait_for_message waits). No executor wakes for it."""
+
+    def __init__(self, node, subscription, name):
+        self._sub = subscription
+        self._context = node.context
+        self._wake = GuardCondition(None, None, context=node.context)
+        self._stop = threading.Event()
+        self._logger = node.get_logger()
+        self._thread = threading.Thread(target=self._run, name=name, daemon=True)
+
+    def start(self):
+        self._thread.start()
+
+    def stop(self):
+        """Ends the thread (the callback does not run afterwards); idempotent."""
+        self._stop.set()
+        if self._thread.is_alive():
+            self._wake.trigger()
+            self._thread.join()
+        self._wake.destroy()
+
+    def _run(self):
+        name_os_thread(self._thread.name)
+        sub, handle = self._sub, self._sub.handle
+        wait_set = _rclpy.WaitSet(1, 1, 0, 0, 0, 0, self._context.handle)
+        while not self._stop.is_set():
+            try:
+                wait_set.clear_entities()
+                wait_set.add_subscription(handle)
+                wait_set.add_guard_condition(self._wake.handle)
+                wait_set.wait(1_000_000_000)
+                if self._stop.is_set():
+                    break
+                while (taken := handle.take_message(sub.msg_type, sub.raw)) is not None:
+                    sub.callback(taken[0])
+            except Exception as e:  # noqa: BLE001 (nothing may end the thread but stop())
+                if not self._context.ok():
+                    break
+                self._logger.error(f"{sub.topic_name}: {e}", throttle_duration_sec=5.0)
+                self._stop.wait(0.05)
 
 
 class RangerNode(Node):
@@ -72,13 +146,13 @@ class RangerNode(Node):
         display = self.get_fully_qualified_name() + "."
         declared = parameters.declare_all(self, display)
         errors = list(declared.errors)
-        self.params = declared.node
-        self.port = self.params["port_name"]
         self.driver = None
         try:
-            self.driver = ranger_can.Driver(self.port, params=declared.given,
-                                            record_sent=self.params["publish_cmd"], start=False,
-                                            display_prefix=display)
+            # The library checks every value against its row (the ROS 1 node's messages) and
+            # gives the node's own values back checked (Driver.settings); publish_cmd records
+            # the frames sent for cmd_vel_out.
+            self.driver = ranger_can.Driver(parameters.default_of_port(), params=declared.given,
+                                            start=False, display_prefix=display)
         except RangerError as e:
             errors.append(str(e))
         if errors:
@@ -86,13 +160,15 @@ class RangerNode(Node):
             for name in parameters.declared_names():  # ROS 2 spells nesting with '.'
                 text = text.replace(f"{display}{name} ", f"{display}{parameters.ros2_name(name)} ")
             raise ParameterError(text)
+        self.params = dict(self.driver.settings)
+        self.params[parameters.DIAGNOSTIC_PERIOD] = declared.diagnostic_period
+        self.port = self.params["port_name"]
         self.add_on_set_parameters_callback(self._on_set_parameters)
 
-        ns = self.get_namespace()
-        self.hardware_id = f"ranger:{ns}:{self.port}"
+        self._diagnostics_ns = self.get_namespace()
         self._stop = threading.Event()
         self._stopped = False
-        self._last_odom = self._last_joints = self._last_remote = 0
+        self._last_remote = 0
         self._last_ultrasonic = {}
 
         q = 10
@@ -114,12 +190,15 @@ class RangerNode(Node):
                        if self.params["publish_odom_tf"] else None)
         self.diag_pub = self._publisher(DiagnosticArray, "/diagnostics", q)
 
-        # cmd_vel on a group of its own: never queued behind a service waiting for the chassis.
-        self._cmd_group = MutuallyExclusiveCallbackGroup()
+        # cmd_vel on a thread of its own: never queued behind a service waiting for the chassis,
+        # never behind the executor's wait-set rebuild.
         self._service_group = MutuallyExclusiveCallbackGroup()
         self.cmd_sub = self.create_subscription(
-            Twist, "cmd_vel", self._on_cmd_vel, 1, callback_group=self._cmd_group,
+            Twist, "cmd_vel", self._on_cmd_vel, 1, callback_group=OwnThreadGroup(),
             event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False))
+        self._cmd_thread = SubscriptionThread(self, self.cmd_sub, "ranger_cmd_vel")
+        self.motion_messages = conversions.MotionMessages(
+            self.params, ranger_can.steering_joint_names() + ranger_can.wheel_joint_names())
         self.inject_sub = (self.create_subscription(String, "sim/inject", self._on_inject, 10,
                                                     callback_group=self._service_group)
                            if self.driver.is_sim else None)
@@ -150,6 +229,7 @@ class RangerNode(Node):
     def start(self):
         self.driver.start()
         self._thread.start()
+        self._cmd_thread.start()
         kind = ("the in-process virtual chassis" if self.driver.is_sim else
                 "a replayed log: nothing is sent" if self.port.startswith("replay:") else
                 "SocketCAN")
@@ -165,6 +245,7 @@ class RangerNode(Node):
         if self._stopped:
             return
         self._stopped = True
+        self._cmd_thread.stop()
         if self.cmd_sub is not None:
             self.destroy_subscription(self.cmd_sub)
             self.cmd_sub = None
@@ -177,13 +258,13 @@ class RangerNode(Node):
     def _on_set_parameters(self, params):
         for p in params:
             name = parameters.ros1_name(p.name)
-            row = next((r for r in parameters.NODE_ROWS if r.name == name), None)
-            if row is None or row.read_only:
+            if name not in parameters.CHANGEABLE:
                 return SetParametersResult(successful=False,
                                            reason=f"{p.name} cannot change while the driver runs")
-            value, problem = parameters._check_node_value(row, p.value, "")
-            if problem:
-                return SetParametersResult(successful=False, reason=problem)
+            try:
+                value = ranger_can.check_parameter(name, p.value)  # the library's row
+            except RangerError as e:
+                return SetParametersResult(successful=False, reason=str(e))
             self.params[name] = value
         return SetParametersResult(successful=True)
 
@@ -351,73 +432,62 @@ class RangerNode(Node):
         return pub is not None and pub.get_subscription_count() > 0
 
     def _publication_loop(self):
-        """Wakes when a publication is due (or, with cmd_vel_out, when a frame was sent), not at
-        every driver iteration: motion waits for the driver's next snapshot only when it is due
-        and the latest one had no new estimate."""
-        next_motion = next_state = next_diag = time.monotonic()
-        waiting = False  # motion is due, the latest snapshot had nothing new
-        sent = []
+        """Wakes when the driver has a new estimate and the motion publication is due (paced in
+        C++: Driver.wait_motion), when a motion frame was sent (cmd_vel_out), or when the
+        states or diagnostics are due; not at every driver iteration."""
+        name_os_thread("ranger_publish")
+        next_state = next_diag = time.monotonic()
         while not self._stop.is_set():
             try:
-                self._publish_sent(sent)
                 now = time.monotonic()
-                s = self.driver.snapshot()
-                if now >= next_motion:
-                    waiting = not self._publish_motion(s)
-                    if not waiting:
-                        next_motion = _advance(next_motion, 1.0 / self.params["publish_rate"], now)
                 if now >= next_state:
-                    self._publish_states(s)
+                    self._publish_states(self.driver.snapshot())
                     next_state = _advance(next_state, 1.0 / self.params["state_publish_rate"], now)
                 if now >= next_diag:
-                    self._publish_diagnostics(s)
+                    self._publish_diagnostics()
                     next_diag = _advance(next_diag, self.params["diagnostic_period"], now)
-                due = min(next_state, next_diag) if waiting else min(next_motion, next_state,
-                                                                       next_diag)
-                wait = max(0.0, min(due - time.monotonic(), 1.0))
-                if waiting:
-                    self.driver.wait_snapshot(s.sequence, min(wait, 0.05))
-                    sent = self.driver.sent() if self.cmd_out_pub else []
+                wait = max(0.0, min(next_state, next_diag) - time.monotonic())
+                if self._motion_heard():
+                    update = self.driver.wait_motion(self.params["publish_rate"], wait)
+                    self._publish_motion(update)
+                    self._publish_sent(update.sent)
                 elif self.cmd_out_pub is not None:
-                    sent = self.driver.wait_sent(wait)
+                    self._publish_sent(self.driver.wait_sent(wait))
                 else:
                     self._stop.wait(wait)
             except Exception as e:  # noqa: BLE001 (nothing may end the publication thread)
                 self.get_logger().error(f"publishing failed: {e}", throttle_duration_sec=5.0)
-                sent = []
                 self._stop.wait(0.05)
-        # What was taken but not published yet, and the shutdown's stop.
-        self._publish_sent(sent + (self.driver.sent() if self.cmd_out_pub else []))
+        # What was sent but not published yet, and the shutdown's stop.
+        self._publish_sent(self.driver.sent() if self.cmd_out_pub else [])
 
     def _publish_sent(self, sent):
         for m in sent:
             self.cmd_out_pub.publish(conversions.to_twist_stamped(m, self.params["base_frame"]))
 
-    def _publish_motion(self, s) -> bool:
-        """odom, /tf, joint_states: each estimate once; False when nothing new was there."""
-        if not s.motion_known:
-            return True
-        published = False
-        o = s.odometry
-        if o.stamp_ns > self._last_odom:
-            self._last_odom = o.stamp_ns
-            if self._heard(self.odom_pub) or self._heard(self.tf_pub):
-                odom = conversions.to_odometry(o, self.params)
-                if self._heard(self.tf_pub):
-                    self.tf_pub.publish(TFMessage(transforms=[conversions.to_transform(odom)]))
-                if self._heard(self.odom_pub):
-                    self.odom_pub.publish(odom)
-            published = True
-        j = s.joints
-        if (j.has_steering or j.has_wheels) and j.stamp_ns > self._last_joints:
-            self._last_joints = j.stamp_ns
-            if self._heard(self.joint_pub):
-                self.joint_pub.publish(conversions.to_joint_state(j))
-            published = True
-        if published and self._heard(self.truth_pub):
+    def _motion_heard(self):
+        return (self._heard(self.odom_pub) or self._heard(self.tf_pub)
+                or self._heard(self.joint_pub) or self._heard(self.truth_pub))
+
+    def _publish_motion(self, update):
+        """odom, /tf, joint_states from the estimate's ready values (each estimate once)."""
+        if update.snapshot is None:
+            return
+        m = self.motion_messages
+        odometry = update.odometry
+        if odometry is not None and (self._heard(self.odom_pub) or self._heard(self.tf_pub)):
+            m.fill_odometry(odometry)
+            if self._heard(self.tf_pub):
+                self.tf_pub.publish(m.tf)
+            if self._heard(self.odom_pub):
+                self.odom_pub.publish(m.odom)
+        joints = update.joints
+        if joints is not None and self._heard(self.joint_pub):
+            m.fill_joints(joints)
+            self.joint_pub.publish(m.joints)
+        if self._heard(self.truth_pub):
             truth = self.driver.ground_truth()
             self.truth_pub.publish(conversions.to_ground_truth(truth, self.params))
-        return published
 
     def _publish_states(self, s):
         stamp = self.get_clock().now().to_msg()
@@ -455,10 +525,13 @@ class RangerNode(Node):
             {"debug": log.debug, "info": log.info, "warn": log.warn,
              "error": log.error}.get(event.severity, log.info)(event.text)
 
-    def _publish_diagnostics(self, s):
-        groups = adapters.diagnostic_groups(s, self.driver.protocol_source)
+    def _publish_diagnostics(self):
+        """The library's diagnostic groups of the latest snapshot (ranger_can's
+        Driver.diagnostics: name, level, message, key/values, hardware_id), one to one onto
+        diagnostic_msgs, named as diagnostic_updater names them ("<node>: <group>")."""
+        groups = self.driver.diagnostics(self._diagnostics_ns)
         self.diag_pub.publish(conversions.to_diagnostics(
-            groups, self.get_clock().now().to_msg(), self.hardware_id))
+            groups, self.get_clock().now().to_msg(), self.get_name()))
 
 
 def main(args=None):

@@ -12,6 +12,8 @@ import time
 
 import pytest
 import rclpy
+
+import ranger_can
 from ranger_msgs.msg import SystemState
 from ranger_msgs.srv import SetDriveMode, SetLights
 from std_srvs.srv import SetBool, Trigger
@@ -249,3 +251,39 @@ def test_drive_mode_on_the_mini_v3_and_refused_by_name_elsewhere(robots, client)
     assert not refused.success and "unsupported by protocol manual" in refused.message
     assert refused.drive_mode == SystemState.DRIVE_MODE_NONE
     assert other.state().drive_mode_name == ""
+
+
+def test_diagnostics_are_the_librarys_groups_one_to_one(robots):
+    """/diagnostics carries the library's groups (ranger_can's Driver.diagnostics, the ROS 1
+    node's groups): the same names in the same order (as diagnostic_updater names them), the
+    hardware_id ranger:<namespace>:<port>, the same keys, the level and message as they are."""
+    from diagnostic_msgs.msg import DiagnosticArray
+    r = robots("sim")
+    r.client.listen("/diagnostics", DiagnosticArray, keep=True)
+    r.wait_ready()
+    hardware_id = f"ranger:{r.ns}:sim"
+
+    def latest():
+        for m in reversed(list(r.client.history.get("/diagnostics", []))):
+            mine = [s for s in m.status if s.hardware_id == hardware_id]
+            if mine:
+                return mine
+        return None
+
+    def decided():
+        values = {kv.key: kv.value for kv in latest()[2].values}
+        link = {kv.key: kv.value for kv in latest()[0].values}
+        return values.get("Identification") == "decided" and link["Chassis link"] == "connected"
+    r.client.wait_for(decided, 30, "diagnostics of an identified chassis")
+    node_groups = latest()
+    with ranger_can.Driver("sim") as d:
+        d.wait_ready(timeout=30)
+        library = d.diagnostics(r.ns)
+    assert [s.name for s in node_groups] == [f"ranger_base_node: {g.name}" for g in library]
+    assert [g.name for g in library] == ranger_can.diagnostic_group_names()
+    for status, group in zip(node_groups, library):
+        if group.name in ("CAN link", "Control mode", "Chassis errors"):
+            assert [kv.key for kv in status.values] == [k for k, _ in group.values], group.name
+    link = node_groups[0]
+    assert link.level == b"\x00", link
+    assert {kv.key: kv.value for kv in link.values}["Port"] == "sim"
