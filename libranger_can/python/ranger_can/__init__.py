@@ -33,7 +33,8 @@ from ._ranger_can import (  # noqa: F401  (re-exported)
     __version__, _cli, _Session, bms_status_bit_names, chassis_command_names, check_parameter,
     diagnostic_group_names,
     driver_status_bit_names, error_clear_description, error_names, event_kinds, fault_names,
-    light_modes, model_names,
+    light_modes, model_names, motion_mode_pinned, resume_answered, resume_refused_offline,
+    unknown_motion_mode_number,
     motion_modes, parameters, protocol_names, refusal_names, steering_joint_names, variant_names,
     wheel_joint_names)
 

@@ -20,6 +20,7 @@
 #include "ranger_can/control/model.hpp"
 #include "ranger_can/control/rearm.hpp"
 #include "ranger_can/control/vocabulary.hpp"
+#include "ranger_can/frontend/answers.hpp"
 #include "ranger_can/sim/chassis_commands.hpp"
 #include "ranger_can/sim/sim_bus_source.hpp"
 #include "ranger_can/text.hpp"
@@ -838,6 +839,33 @@ PYBIND11_MODULE(_ranger_can, m) {
   m.def("wheel_joint_names",
         [] { return std::vector<std::string>(kWheelJointNames.begin(), kWheelJointNames.end()); });
   m.def("error_clear_description", &protocol::error_clear_description);
+  // The front ends' words (frontend/answers.hpp), as the ROS 1 node answers with them.
+  m.def(
+      "unknown_motion_mode_number",
+      [](int number, const Snapshot& s) {
+        return unknown_motion_mode_number(number, s.s().profile);
+      },
+      py::arg("number"), py::arg("snapshot"));
+  m.def(
+      "motion_mode_pinned",
+      [](std::optional<std::string> mode) {
+        return motion_mode_pinned(mode ? std::optional<MotionMode>(parse_mode(*mode))
+                                       : std::nullopt);
+      },
+      py::arg("mode"));
+  m.def(
+      "resume_refused_offline",
+      [](const Snapshot& s, const std::string& port) -> std::optional<std::string> {
+        const auto refused = resume_refused_offline(s.s(), port);
+        if (!refused) return std::nullopt;
+        return refused->message;
+      },
+      py::arg("snapshot"), py::arg("port"));
+  m.def("resume_answered", [] {  // what resume answers once the driver re-armed
+    RequestOutcome answered;
+    answered.state = RequestOutcome::State::kAnswered;
+    return resume_answer(answered).message;
+  });
   m.def(
       "error_names",
       [](std::uint32_t word, const std::string& layout) {

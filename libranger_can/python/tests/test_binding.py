@@ -233,6 +233,19 @@ def test_drive_mode_and_wheel_odometers_on_the_mini_v3():
         d.command(vx=0.0)
 
 
+def test_the_front_ends_words_are_the_librarys(sim):
+    """The answers the ROS 1 node gives (frontend/answers.hpp), for the ROS 2 node to give too."""
+    s = sim.snapshot()
+    assert ranger_can.unknown_motion_mode_number(7, s) == (
+        "mode 7 unknown: under protocol manual use 0 (ackermann), 1 (oblique), 2 (spin) or "
+        "255 (automatic)")
+    assert ranger_can.motion_mode_pinned("spin") == (
+        "motion mode pinned to spin (the switch happens at standstill)")
+    assert ranger_can.motion_mode_pinned(None) == "automatic motion-mode selection"
+    assert ranger_can.resume_refused_offline(s, "sim") is None
+    assert ranger_can.resume_answered() == "re-armed: cmd_vel drives the chassis again"
+
+
 def test_vendor_features_refused_by_name_on_the_manuals_chassis(sim):
     with pytest.raises(RequestFailed, match="unsupported by protocol"):
         sim.set_lights(front="on", rear="on")

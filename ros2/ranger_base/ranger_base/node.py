@@ -37,6 +37,7 @@ except ImportError:  # Humble: the same classes under their older module name
 from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
 from rclpy.guard_condition import GuardCondition
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
+from rclpy.duration import Duration
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 from ranger_msgs.msg import (ActuatorStateArray, BmsStateArray, RemoteState, SystemState,
@@ -254,6 +255,8 @@ class RangerNode(Node):
         self._stop.set()
         if self._thread.is_alive():
             self._thread.join()
+        if self.cmd_out_pub is not None:  # the stop reaches the subscribers before ROS goes
+            self.cmd_out_pub.wait_for_all_acked(Duration(seconds=1.0))
 
     def _on_set_parameters(self, params):
         for p in params:
@@ -306,15 +309,14 @@ class RangerNode(Node):
         (self.get_logger().info if ok else self.get_logger().warn)(f"{what}: {message}")
 
     def _on_resume(self, request, response):
-        s = self.driver.snapshot()
-        if not s.bus_open:
+        refused = ranger_can.resume_refused_offline(self.driver.snapshot(), self.port)
+        if refused is not None:
             response.success = False
-            response.message = f"resume refused: not connected to {self.port}" + (
-                f": {s.bus_error}" if s.bus_error else "")
+            response.message = refused
         else:
             ok, message, _ = self._answer("resume", self.driver.resume)
             response.success = ok
-            response.message = "re-armed: cmd_vel drives the chassis again" if ok else message
+            response.message = ranger_can.resume_answered() if ok else message
         self._log_answer("resume", response.success, response.message)
         return response
 
@@ -355,12 +357,9 @@ class RangerNode(Node):
 
     def _on_set_motion_mode(self, request, response):
         if request.mode not in MOTION_MODES:
-            s = self.driver.snapshot()  # the valid values: the ones valid on this chassis
-            valid = [f"{n} ({m})" for n, m in MOTION_MODES.items() if m in s.drivable_modes]
-            response.success = False
-            response.message = (f"mode {request.mode} unknown: under protocol "
-                                f"{s.profile_revision} use {', '.join(valid)} or "
-                                f"{SetMotionMode.Request.AUTOMATIC} (automatic)")
+            response.success = False  # the valid values: the ones valid on this chassis
+            response.message = ranger_can.unknown_motion_mode_number(request.mode,
+                                                                     self.driver.snapshot())
             self._log_answer("set_motion_mode", False, response.message)
             return response
         mode = MOTION_MODES[request.mode]
@@ -372,8 +371,7 @@ class RangerNode(Node):
             self._log_answer("set_motion_mode", False, response.message)
             return response
         response.success = True
-        response.message = (f"motion mode pinned to {mode} (the switch happens at standstill)"
-                            if mode else "automatic motion-mode selection")
+        response.message = ranger_can.motion_mode_pinned(mode)
         self._log_answer("set_motion_mode", True, response.message)
         return response
 
