@@ -133,17 +133,30 @@ def node_ros2():
     same load: `port_name:=sim`, subscribers on `odom`, `/tf`, `joint_states`, `cmd_vel` at
     20 Hz; latency as above (ros2/ranger_base/ranger_base/measure_performance.py)."""
     doc = json.loads(read("node_ros2.json"))
-    load, lat = doc["load"], doc["latency"]
-    ros1 = json.loads(read("node.json"))["load"]["driver_cpu_percent"] if read("node.json") \
-        else None
-    ratio = load["driver_percent"] / ros1 if ros1 else None
-    row("Driver CPU (node minus chassis thread)", f"{load['driver_percent']} % of one core"
-        + (f" ({ratio:.1f}x the ROS 1 node's)" if ratio else ""), "node_ros2",
-        "≤ 2x the ROS 1 node's", ratio is not None and ratio <= 2.0)
-    row("RSS", f"{load['rss_mb']} MB", "node_ros2")
+    load, lat, floor = doc["load"], doc["latency_cmd_vel_to_0x111"], doc["rclpy_floor"]
+    ros1 = json.loads(read("node.json"))["load"] if read("node.json") else {}
+    cpu, ros1_cpu = load["driver_cpu_percent"], ros1.get("driver_cpu_percent")
+    ratio = cpu / ros1_cpu if cpu is not None and ros1_cpu else None
+    row("Driver CPU (node minus chassis thread)", "chassis thread not found" if cpu is None else
+        f"{cpu} % of one core" + (f" ({ratio:.1f}x the ROS 1 node's {ros1_cpu} %)" if ratio
+                                  else ""), "node_ros2", "≤ 2x the ROS 1 node's",
+        ratio is not None and ratio <= 2.0)
+    row("rclpy floor: the same topics and rates, no driver", f"{floor['cpu_percent']} %",
+        "node_ros2")
+    if cpu is not None:
+        above = round(cpu - floor["cpu_percent"], 2)
+        row("Driver CPU above the rclpy floor", f"{above} %" + (
+            f" (the ROS 1 node above roscpp's: {ros1['driver_over_floor_percent']} %)"
+            if "driver_over_floor_percent" in ros1 else ""), "node_ros2")
+    row("Per thread, % (name)", ", ".join(f"{t['name']}: {t['cpu_percent']}"
+                                         for t in load["threads"] if t["cpu_percent"]),
+        "node_ros2")
+    rss = load["rss_kib_median"] * 1.024e-3
+    row("RSS", f"{rss:.1f} MB (median)", "node_ros2")
     for p, limit in (("p50", None), ("p90", None), ("p99", 2.0)):
-        row(f"cmd_vel -> 0x111 latency {p}", f"{lat[p + '_ms']} ms", "node_ros2",
-            f"≤ {limit:g} ms" if limit else "", limit and lat[p + "_ms"] <= limit)
+        row(f"cmd_vel -> 0x111 latency {p}", f"{lat[p + '_ms']} ms" + (
+            f" (max {lat['max_ms']}, {lat['samples']} samples)" if p == "p99" else ""),
+            "node_ros2", f"≤ {limit:g} ms" if limit else "", limit and lat[p + "_ms"] <= limit)
 
 
 def keepalive():
