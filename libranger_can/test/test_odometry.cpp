@@ -332,6 +332,24 @@ TEST(OdometryTime, TheChassissOwnOdometerBridgesAGapAlongTheMotionBeforeIt) {
   EXPECT_EQ(odom.state().last_gap_odometer_distance, 0.0);
 }
 
+// Odometer frames missing while the motion frames keep coming: the pose already holds the
+// distance, nothing is added twice.
+TEST(OdometryTime, AnOdometerGapWithoutAMotionGapAddsNothing) {
+  Odometry odom;
+  Chassis chassis;
+  OdometerFeedback odometer;
+  odometer.left_distance = odometer.right_distance = 1.0;
+  Timestamp t = chassis.drive(odom, {0.5, 0, 0}, Timestamp{5s}, 1s);
+  odom.on_message(odometer, t);
+  t = chassis.drive(odom, {0.5, 0, 0}, t + 20ms, 2s);  // 2 s of motion frames, no 0x311
+  const double x = odom.state().pose.x;
+  odometer.left_distance = odometer.right_distance = 2.0;
+  EXPECT_FALSE(odom.on_message(odometer, t));
+  EXPECT_DOUBLE_EQ(odom.state().pose.x, x);
+  EXPECT_EQ(odom.state().gaps, 0u);
+  EXPECT_EQ(odom.state().last_gap_odometer_distance, 0.0);
+}
+
 TEST(OdometryRobustness, AbsurdSteeringOnTheWireNeverPoisonsThePose) {
   // 0x221 steering of 120 deg in Ackermann mode is outside the protocol but encodable.
   Odometry odom(OdometryConfig{{}, OdometrySource::kMotion});

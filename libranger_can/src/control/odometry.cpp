@@ -199,10 +199,14 @@ bool Odometry::on_odometer(const OdometerFeedback& m, Timestamp stamp) {
   if (!before || before->rear != now.rear || stamp - before->stamp <= config_.max_step) {
     return false;
   }
-  // A gap in the odometer's frames: what its wheels rolled in it, along the motion before it
-  // (the motion gap is found on the motion frames, which come first, or is still to come).
+  // A gap in the odometer's frames. Only where the motion frames were silent too (their gap found
+  // since the odometer's last reading, or still to come) is what its wheels rolled in it added,
+  // along the motion before it: with motion frames coming, the pose already holds it.
+  const bool motion_gap_found = state_.last_gap_end > before->stamp;
+  const bool motion_gap_to_come = stamp - state_.stamp > config_.max_step;
+  if (!motion_gap_found && !motion_gap_to_come) return false;
   const double d = (std::fabs(now.left - before->left) + std::fabs(now.right - before->right)) / 2;
-  const BodyTwist motion = state_.last_gap_end > before->stamp ? gap_twist_ : previous_twist_;
+  const BodyTwist motion = motion_gap_found ? gap_twist_ : previous_twist_;
   const double speed = std::hypot(motion.vx, motion.vy);
   const double spin_radius = std::hypot(config_.geometry.wheelbase, config_.geometry.track) / 2;
   // The time at the motion before the gap that rolls the wheels by d.
