@@ -28,7 +28,7 @@ from typing import Dict, List, Optional
 from ._errors import RangerError, RequestFailed, RequestTimeout
 from ._ranger_can import (  # noqa: F401  (re-exported)
     Battery, CliResult, DiagnosticGroup, Event, FrameCount, GroundTruth, Identification, Joints, Lights, Motor,
-    MotionUpdate, Odometry,
+    MotionUpdate, MotionWireEncoder, Odometry,
     ParameterRow, RemoteState, RequestOutcome, SentMotion, Snapshot, UltrasonicReading,
     __version__, _cli, _Session, bms_status_bit_names, chassis_command_names, check_parameter,
     diagnostic_group_names,
@@ -40,7 +40,8 @@ from ._ranger_can import (  # noqa: F401  (re-exported)
 
 __all__ = [
     "Driver", "RangerError", "RequestFailed", "RequestTimeout", "Snapshot", "RequestOutcome",
-    "Event", "event_kinds", "MotionUpdate", "DiagnosticGroup", "diagnostic_group_names",
+    "Event", "event_kinds", "MotionUpdate", "MotionWireEncoder", "DiagnosticGroup",
+    "diagnostic_group_names",
     "check_parameter",
     "decode", "replay_odometry", "parameters", "model_names", "variant_names", "protocol_names",
     "motion_modes", "light_modes", "refusal_names", "fault_names", "steering_joint_names",
@@ -198,7 +199,8 @@ class Driver:
         driver has an estimate not handed out before, then returns it (update.odometry,
         update.joints: ready tuples, None when not new). Returns early with update.sent when a
         motion frame was sent (record_sent), and empty after `timeout` s or close(). The driver's
-        thread wakes the caller only for a new estimate or a frame sent. One caller per driver."""
+        thread wakes the caller only for a frame sent or, once the publication is due, for a new
+        estimate. One caller per driver."""
         if not rate > 0:
             raise RangerError(f"wait_motion: rate {rate} Hz: expected > 0", "invalid_argument")
         period = 1.0 / rate
@@ -206,7 +208,7 @@ class Driver:
         while True:
             left = deadline - time.monotonic()
             update = self._s.wait_motion(period, max(0.0, min(left, _SLICE)))
-            if (update.snapshot is not None or update.sent or left <= _SLICE
+            if (update.new_estimate or update.sent or left <= _SLICE
                     or self._s.stopped):
                 return update
 

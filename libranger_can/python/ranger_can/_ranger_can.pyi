@@ -87,7 +87,25 @@ class MotionUpdate:
                              float, float]]
     # (sec, nanosec, positions, velocities): steering joints 1-4, then wheels 1-4; None: not new
     joints: Optional[Tuple[int, int, List[float], List[float]]]
+    new_estimate: bool  # odometry or joints is new (snapshot is not None)
     sent: List[SentMotion]
+
+class MotionWireEncoder:
+    # The motion estimate as serialised ROS 2 messages (CDR little endian, as rclpy's
+    # serialize_message gives them): what Publisher.publish takes as bytes. joint_names: the 8
+    # joints in MotionUpdate.joints' order; the diagonals: 6 values each.
+    def __init__(self, odom_frame: str, base_frame: str, joint_names: List[str],
+                 pose_covariance_diagonal: List[float],
+                 twist_covariance_diagonal: List[float]) -> None: ...
+    def odometry(self, values: Tuple[int, int, float, float, float, float, float, float, float,
+                                     float, float, float]) -> bytes: ...  # nav_msgs/Odometry
+    def transform(self, values: Tuple[int, int, float, float, float, float, float, float, float,
+                                      float, float, float]) -> bytes: ...  # tf2_msgs/TFMessage
+    def joint_state(self, values: Tuple[int, int, List[float], List[float]]
+                    ) -> bytes: ...  # sensor_msgs/JointState
+    # (odom, tf, joint_states) of an update: the bytes of each new part, else None
+    def encode(self, update: MotionUpdate
+               ) -> Tuple[Optional[bytes], Optional[bytes], Optional[bytes]]: ...
 
 class ParameterRow:
     # A row of the library's parameter table (frontend/node_parameters.hpp). type: bool, int,

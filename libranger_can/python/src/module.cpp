@@ -29,6 +29,7 @@
 
 #include "cli_commands.hpp"
 #include "options.hpp"
+#include "ros2_wire.hpp"
 #include "session.hpp"
 #include "views.hpp"
 
@@ -282,6 +283,53 @@ void bind_tables(py::module_& m) {
       });
 }
 
+// The motion estimate as serialised ROS 2 messages (ros2_wire.hpp): what the ROS 2 node publishes
+// as bytes.
+void bind_wire(py::module_& m) {
+  using E = MotionWireEncoder;
+  py::class_<E>(m, "MotionWireEncoder")
+      .def(py::init([](std::string odom_frame, std::string base_frame,
+                       std::vector<std::string> joint_names, std::vector<double> pose_diagonal,
+                       std::vector<double> twist_diagonal) {
+             if (joint_names.size() != 2 * static_cast<std::size_t>(kWheelCount)) {
+               invalid("MotionWireEncoder: joint_names must name the " +
+                       std::to_string(2 * kWheelCount) +
+                       " joints (steering 1-4, then wheels 1-4), not " +
+                       std::to_string(joint_names.size()));
+             }
+             MotionWireSetup setup{
+                 std::move(odom_frame), std::move(base_frame), std::move(joint_names), {}, {}};
+             for (auto [given, into] :
+                  {std::pair{&pose_diagonal, &setup.pose_covariance_diagonal},
+                   std::pair{&twist_diagonal, &setup.twist_covariance_diagonal}}) {
+               if (given->size() != into->size()) {
+                 invalid("MotionWireEncoder: a covariance diagonal has 6 values, not " +
+                         std::to_string(given->size()));
+               }
+               std::copy(given->begin(), given->end(), into->begin());
+             }
+             return E(std::move(setup));
+           }),
+           py::arg("odom_frame"), py::arg("base_frame"), py::arg("joint_names"),
+           py::arg("pose_covariance_diagonal"), py::arg("twist_covariance_diagonal"))
+      .def("odometry", [](const E& e, const OdometryValues& v) { return py::bytes(e.odometry(v)); })
+      .def("transform",
+           [](const E& e, const OdometryValues& v) { return py::bytes(e.transform(v)); })
+      .def("joint_state",
+           [](const E& e, const JointValues& v) { return py::bytes(e.joint_state(v)); })
+      // (odom, tf, joint_states) of an update: bytes where its part is new, else None.
+      .def("encode", [](const E& e, const MotionUpdate& u) {
+        py::object odom = py::none(), tf = py::none(), joints = py::none();
+        if (u.snapshot && u.odometry) {
+          const OdometryValues v = odometry_values(*u.snapshot);
+          odom = py::bytes(e.odometry(v));
+          tf = py::bytes(e.transform(v));
+        }
+        if (u.snapshot && u.joints) joints = py::bytes(e.joint_state(joint_values(*u.snapshot)));
+        return py::make_tuple(odom, tf, joints);
+      });
+}
+
 }  // namespace
 }  // namespace ranger::python
 
@@ -464,12 +512,16 @@ PYBIND11_MODULE(_ranger_can, m) {
                                if (!u.joints) return std::nullopt;
                                return joint_values(*u.snapshot);
                              })
+      .def_property_readonly(
+          "new_estimate",
+          [](const MotionUpdate& u) { return u.snapshot != nullptr && (u.odometry || u.joints); })
       .def_readonly("sent", &MotionUpdate::sent)
       .def("__repr__", [](const MotionUpdate& u) {
         return std::string("MotionUpdate(") + (u.odometry ? "odometry " : "") +
                (u.joints ? "joints " : "") + std::to_string(u.sent.size()) + " sent)";
       });
   bind_tables(m);
+  bind_wire(m);
   py::class_<CliResult>(m, "CliResult")
       .def_readonly("exit_code", &CliResult::exit_code)
       .def_readonly("out", &CliResult::out)

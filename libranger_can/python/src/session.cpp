@@ -65,18 +65,18 @@ void Session::stop() {
 
 void Session::on_step(const std::shared_ptr<const DriverSnapshot>& s) {
   const Timestamp estimate = std::max(s->odometry.stamp, joints_stamp(*s));
-  bool advanced = false;
+  bool wake = false;  // a new estimate, and wait_motion waits for one (not merely for its time)
   {
     std::lock_guard<std::mutex> lock(mutex_);
     sequence_ = s->sequence;
     if (estimate > estimate_stamp_) {
       estimate_stamp_ = estimate;
       ++estimates_;
-      advanced = true;
+      wake = estimate_awaited_;
     }
   }
   changed_.notify_all();
-  if (advanced) motion_.notify_all();
+  if (wake) motion_.notify_all();
 }
 
 void Session::on_sent(const SentEvent& e) {
@@ -150,9 +150,11 @@ MotionUpdate Session::wait_motion(std::chrono::nanoseconds period,
     }
     if (!out.sent.empty() || now >= deadline) return out;
     const std::uint64_t estimates = estimates_;
+    estimate_awaited_ = waiting;
     motion_.wait_until(lock, waiting ? deadline : std::min(deadline, motion_due_ - early), [&] {
       return stopped_ || !sent_.empty() || (waiting && estimates_ != estimates);
     });
+    estimate_awaited_ = false;
   }
   out.sent.assign(sent_.begin(), sent_.end());
   sent_.clear();

@@ -83,7 +83,8 @@ class Session {
   // up to min(5 ms, period / 4) early), and nothing while the chassis is not heard. Blocks until
   // a publication is due and the driver has a new estimate, a motion frame was sent (with
   // Setup::record_sent), the session stops, or `timeout` passes. The driver's thread wakes the
-  // waiter only for a new estimate or a frame sent, not at each of its iterations. One caller.
+  // waiter only for a frame sent or for a new estimate it waits for (due, nothing new yet), not
+  // at each of its iterations nor for estimates before the publication is due. One caller.
   MotionUpdate wait_motion(std::chrono::nanoseconds period, std::chrono::nanoseconds timeout);
 
   // The library's diagnostic groups (control/diagnostics.hpp) of the latest snapshot, in
@@ -113,8 +114,9 @@ class Session {
   std::deque<SentMotion> sent_;      // bounded, guarded by mutex_
   bool stop_sent_ = false;           // guarded by mutex_
   // The estimate's progress (on the driver's thread) and wait_motion's schedule; by mutex_.
-  Timestamp estimate_stamp_{0};  // the newest odometry or joint-state stamp seen
-  std::uint64_t estimates_ = 0;  // how often it advanced
+  Timestamp estimate_stamp_{0};    // the newest odometry or joint-state stamp seen
+  std::uint64_t estimates_ = 0;    // how often it advanced
+  bool estimate_awaited_ = false;  // wait_motion waits for the next estimate: wake it for one
   std::chrono::steady_clock::time_point motion_due_{};
   Timestamp published_odometry_{0}, published_joints_{0};
   std::mutex diagnostics_mutex_;

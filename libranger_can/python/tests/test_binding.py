@@ -486,3 +486,39 @@ def test_battery_presence_is_the_librarys_freshness(sim):
     sim.wait_ready(timeout=30)
     s = sim.wait_until(lambda s: s.batteries[0].present, timeout=10)
     assert s.batteries[0].soc > 0
+
+
+def test_motion_wire_encoder_writes_cdr_little_endian(sim):
+    """MotionWireEncoder's layout read with struct (the ROS 2 tests hold it to the rmw's own
+    serialisation): the encapsulation header, fields aligned to their size from its end."""
+    import struct
+    joints = ranger_can.steering_joint_names() + ranger_can.wheel_joint_names()
+    enc = ranger_can.MotionWireEncoder("odom", "base_link", joints, [0.5] * 6, [0.25] * 6)
+    odometry = (1_795_000_000, 42, 1.5, -2.0, 0.6, 0.8, 0.3, -0.1, 0.2, 0.01, 0.02, 0.03)
+    odom = enc.odometry(odometry)
+    assert odom[:4] == b"\x00\x01\x00\x00" and len(odom) == 724
+    body = odom[4:]
+    assert struct.unpack_from("<iI", body, 0) == (1_795_000_000, 42)
+    assert struct.unpack_from("<I", body, 8) == (5,) and body[12:17] == b"odom\0"
+    assert struct.unpack_from("<I", body, 20) == (10,) and body[24:34] == b"base_link\0"
+    assert struct.unpack_from("<7d", body, 40) == (1.5, -2.0, 0.0, 0.0, 0.0, 0.6, 0.8)
+    pose_cov = struct.unpack_from("<36d", body, 96)
+    assert (pose_cov[0], pose_cov[7], pose_cov[14], pose_cov[35]) == pytest.approx(
+        (0.51, 0.52, 0.5, 0.53))
+    assert pose_cov[1] == 0.0
+    assert struct.unpack_from("<6d", body, 384) == (0.3, -0.1, 0.0, 0.0, 0.0, 0.2)
+    assert struct.unpack_from("<36d", body, 432)[21] == 0.25
+    tf = enc.transform(odometry)
+    assert struct.unpack_from("<I", tf, 4) == (1,) and len(tf) == 100
+    assert struct.unpack_from("<7d", tf, 44) == (1.5, -2.0, 0.0, 0.0, 0.0, 0.6, 0.8)
+    state = enc.joint_state((7, 8, [float(i) for i in range(8)], [-1.0] * 8))
+    assert struct.unpack_from("<iII", state, 4) == (7, 8, 1)
+    assert struct.unpack_from("<I", state, 20) == (8,)  # the names
+    assert struct.unpack_from("<8dI", state, len(state) - 68) == (-1.0,) * 8 + (0,)
+    # An update hands all three, each only when its part is new.
+    sim.wait_ready(timeout=30)
+    update = sim.wait_motion(50.0, 2.0)
+    odom, tf, state = enc.encode(update)
+    assert update.new_estimate and odom is not None and tf is not None
+    with pytest.raises(RangerError, match="joint_names must name the 8 joints"):
+        ranger_can.MotionWireEncoder("odom", "base_link", joints[:7], [0.0] * 6, [0.0] * 6)

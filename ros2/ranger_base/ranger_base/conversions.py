@@ -9,11 +9,14 @@ from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import Quaternion, TransformStamped, TwistStamped
 from nav_msgs.msg import Odometry
+from rclpy.serialization import deserialize_message
 from ranger_msgs.msg import (ActuatorState, ActuatorStateArray, BmsFlags, BmsState, BmsStateArray,
                              DriverStatus, RemoteState, SystemErrors, SystemState,
                              UltrasonicReading, UltrasonicState)
 from sensor_msgs.msg import BatteryState, JointState, Range
 from tf2_msgs.msg import TFMessage
+
+import ranger_can
 
 NAN = float("nan")
 
@@ -91,6 +94,44 @@ class MotionMessages:
         stamp.sec, stamp.nanosec = sec, nanosec
         self.joints.position = position
         self.joints.velocity = velocity
+
+
+# Samples the encoder's bytes are compared on: odometry (sec, nanosec, x, y, qz, qw, vx, vy, wz,
+# var_x, var_y, var_yaw) and joints (sec, nanosec, positions, velocities), negative values and
+# stamps of every width among them.
+_WIRE_SAMPLES = (
+    ((1_795_000_000, 123_456_789, 12.5, -3.25, -0.6, 0.8, 0.5, -0.125, 0.75, 1e-4, 2.5e-4, 3e-5),
+     (1_795_000_000, 5, [0.1, -0.2, 0.3, -0.4, 10.0, -20.0, 30.5, 1e6],
+      [0.0, 1.0, -1.0, 0.5, 2.0, -2.0, 3.0, -3.0])),
+    ((0, 0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), (0, 0, [0.0] * 8, [0.0] * 8)),
+)
+
+
+def motion_encoder(params, joint_names):
+    """The binding's encoder of odom, /tf and joint_states (ranger_can.MotionWireEncoder: the
+    messages serialised in C++, what Publisher.publish takes as bytes), if this ROS 2's rmw reads
+    its bytes as exactly the messages MotionMessages makes of the same values (checked on samples
+    with the rmw's own deserialisation: a distribution or rmw that reads them otherwise is caught
+    here); else None, and the node publishes the messages themselves. Second: the topic whose
+    bytes were misread, for the log."""
+    encoder = ranger_can.MotionWireEncoder(
+        params["odom_frame"], params["base_frame"], list(joint_names),
+        list(params["pose_covariance_diagonal"]), list(params["twist_covariance_diagonal"]))
+    reference = MotionMessages(params, joint_names)
+    for odometry, joints in _WIRE_SAMPLES:
+        reference.fill_odometry(odometry)
+        reference.fill_joints(joints)
+        for name, ours, theirs in (
+                ("odom", encoder.odometry(odometry), reference.odom),
+                ("/tf", encoder.transform(odometry), reference.tf),
+                ("joint_states", encoder.joint_state(joints), reference.joints)):
+            try:
+                read = deserialize_message(ours, type(theirs))
+            except Exception:  # noqa: BLE001 (any failure to read is a mismatch)
+                return None, name
+            if read != theirs:
+                return None, name
+    return encoder, None
 
 
 def to_ground_truth(g, params) -> Odometry:

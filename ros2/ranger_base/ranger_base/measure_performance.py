@@ -237,7 +237,8 @@ def measure_latency(node, samples, params):
 
 def run_floor(ns):
     """rclpy_floor: odom, /tf and joint_states at 50 Hz and cmd_vel taken, with the node's own
-    message code (conversions.MotionMessages) and threads (a publication thread waking every
+    message code (the binding's serialised bytes, conversions.motion_encoder, where the node uses
+    them, else conversions.MotionMessages) and threads (a publication thread waking every
     20 ms, cmd_vel on a thread of its own), no driver: what rclpy and DDS cost for the traffic."""
     from nav_msgs.msg import Odometry
     from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
@@ -254,10 +255,11 @@ def run_floor(ns):
     sub = node.create_subscription(Twist, "cmd_vel", lambda _: None, 1,
                                    callback_group=OwnThreadGroup())
     commands = SubscriptionThread(node, sub, "ranger_cmd_vel")
-    messages = conversions.MotionMessages(
-        {"odom_frame": "odom", "base_frame": "base_link",
-         "pose_covariance_diagonal": [1e-4] * 6, "twist_covariance_diagonal": [1e-3] * 6},
-        [f"joint_{i}" for i in range(8)])
+    params = {"odom_frame": "odom", "base_frame": "base_link",
+              "pose_covariance_diagonal": [1e-4] * 6, "twist_covariance_diagonal": [1e-3] * 6}
+    names = [f"joint_{i}" for i in range(8)]
+    messages = conversions.MotionMessages(params, names)
+    encoder, _ = conversions.motion_encoder(params, names)  # as the node sends them
     stop = threading.Event()
 
     def publish():
@@ -267,9 +269,15 @@ def run_floor(ns):
             due += 0.02
             now = time.time_ns()
             sec, nanosec = divmod(now, 1_000_000_000)
-            messages.fill_odometry((sec, nanosec, 1.0, 2.0, 0.0, 1.0, 0.4, 0.0, 0.2,
-                                    1e-6, 1e-6, 1e-6))
-            messages.fill_joints((sec, nanosec, [0.1] * 8, [0.2] * 8))
+            odometry = (sec, nanosec, 1.0, 2.0, 0.0, 1.0, 0.4, 0.0, 0.2, 1e-6, 1e-6, 1e-6)
+            joints = (sec, nanosec, [0.1] * 8, [0.2] * 8)
+            if encoder is not None:
+                tf_pub.publish(encoder.transform(odometry))
+                odom_pub.publish(encoder.odometry(odometry))
+                joint_pub.publish(encoder.joint_state(joints))
+                continue
+            messages.fill_odometry(odometry)
+            messages.fill_joints(joints)
             tf_pub.publish(messages.tf)
             odom_pub.publish(messages.odom)
             joint_pub.publish(messages.joints)

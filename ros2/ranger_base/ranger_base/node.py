@@ -19,6 +19,7 @@ All names are relative (push the node into a namespace for several robots); /tf 
 """
 
 import ctypes
+import os
 import signal
 import sys
 import threading
@@ -61,6 +62,11 @@ DRIVE_MODES = {SetDriveMode.Request.CURRENT: "current", SetDriveMode.Request.VOL
 LIGHT_MODES = {SetLights.Request.OFF: "off", SetLights.Request.ON: "on",
                SetLights.Request.BREATHING: "breathing", SetLights.Request.CUSTOM: "custom"}
 LIGHT_CODES = {v: k for k, v in LIGHT_MODES.items()}
+
+
+# s: how long the motion publication trusts its last look at who subscribes (a new subscriber
+# gets odom, /tf, joint_states at most this late).
+AUDIENCE_PERIOD = 0.1
 
 
 def _advance(due, period, now):
@@ -171,6 +177,7 @@ class RangerNode(Node):
         self._stopped = False
         self._last_remote = 0
         self._last_ultrasonic = {}
+        self._motion_audience = (False, False, False, False)
 
         q = 10
         self.odom_pub = self._publisher(Odometry, "odom", q)
@@ -198,8 +205,16 @@ class RangerNode(Node):
             Twist, "cmd_vel", self._on_cmd_vel, 1, callback_group=OwnThreadGroup(),
             event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False))
         self._cmd_thread = SubscriptionThread(self, self.cmd_sub, "ranger_cmd_vel")
-        self.motion_messages = conversions.MotionMessages(
-            self.params, ranger_can.steering_joint_names() + ranger_can.wheel_joint_names())
+        joint_names = ranger_can.steering_joint_names() + ranger_can.wheel_joint_names()
+        self.motion_messages = conversions.MotionMessages(self.params, joint_names)
+        # odom, /tf and joint_states serialised in C++ where this rmw reads the bytes as the
+        # messages themselves.
+        self.motion_wire, mismatch = conversions.motion_encoder(self.params, joint_names)
+        if mismatch:
+            self.get_logger().warn(
+                f"{mismatch}: this rmw ({os.environ.get('RMW_IMPLEMENTATION', 'the default')}) "
+                "does not read the binding's serialised messages as they were meant; odom, /tf "
+                "and joint_states are published as messages (more CPU)")
         self.inject_sub = (self.create_subscription(String, "sim/inject", self._on_inject, 10,
                                                     callback_group=self._service_group)
                            if self.driver.is_sim else None)
@@ -434,7 +449,7 @@ class RangerNode(Node):
         C++: Driver.wait_motion), when a motion frame was sent (cmd_vel_out), or when the
         states or diagnostics are due; not at every driver iteration."""
         name_os_thread("ranger_publish")
-        next_state = next_diag = time.monotonic()
+        next_state = next_diag = next_audience = time.monotonic()
         while not self._stop.is_set():
             try:
                 now = time.monotonic()
@@ -444,8 +459,11 @@ class RangerNode(Node):
                 if now >= next_diag:
                     self._publish_diagnostics()
                     next_diag = _advance(next_diag, self.params["diagnostic_period"], now)
-                wait = max(0.0, min(next_state, next_diag) - time.monotonic())
-                if self._motion_heard():
+                if now >= next_audience:
+                    self._motion_audience = self._ask_motion_audience()
+                    next_audience = now + AUDIENCE_PERIOD
+                wait = max(0.0, min(next_state, next_diag, next_audience) - time.monotonic())
+                if any(self._motion_audience):
                     update = self.driver.wait_motion(self.params["publish_rate"], wait)
                     self._publish_motion(update)
                     self._publish_sent(update.sent)
@@ -463,29 +481,46 @@ class RangerNode(Node):
         for m in sent:
             self.cmd_out_pub.publish(conversions.to_twist_stamped(m, self.params["base_frame"]))
 
-    def _motion_heard(self):
-        return (self._heard(self.odom_pub) or self._heard(self.tf_pub)
-                or self._heard(self.joint_pub) or self._heard(self.truth_pub))
+    def _ask_motion_audience(self):
+        """Whether odom, /tf, joint_states, sim/ground_truth have subscribers: each question is
+        a call into the rmw, so it is asked every AUDIENCE_PERIOD, not at every publication."""
+        return (self._heard(self.odom_pub), self._heard(self.tf_pub),
+                self._heard(self.joint_pub), self._heard(self.truth_pub))
 
     def _publish_motion(self, update):
-        """odom, /tf, joint_states from the estimate's ready values (each estimate once)."""
-        if update.snapshot is None:
+        """odom, /tf, joint_states from the estimate's ready values (each estimate once): the
+        bytes of the binding's encoder where it matched the rmw, else messages."""
+        if not update.new_estimate:
             return
-        m = self.motion_messages
-        odometry = update.odometry
-        if odometry is not None and (self._heard(self.odom_pub) or self._heard(self.tf_pub)):
-            m.fill_odometry(odometry)
-            if self._heard(self.tf_pub):
-                self.tf_pub.publish(m.tf)
-            if self._heard(self.odom_pub):
-                self.odom_pub.publish(m.odom)
-        joints = update.joints
-        if joints is not None and self._heard(self.joint_pub):
-            m.fill_joints(joints)
-            self.joint_pub.publish(m.joints)
-        if self._heard(self.truth_pub):
+        odom_heard, tf_heard, joints_heard, truth_heard = self._motion_audience
+        if self.motion_wire is not None:
+            odom, tf, joints = self.motion_wire.encode(update)
+            if odom is not None:
+                if tf_heard:
+                    self.tf_pub.publish(tf)
+                if odom_heard:
+                    self.odom_pub.publish(odom)
+            if joints is not None and joints_heard:
+                self.joint_pub.publish(joints)
+        else:
+            self._publish_motion_messages(update, odom_heard, tf_heard, joints_heard)
+        if truth_heard:
             truth = self.driver.ground_truth()
             self.truth_pub.publish(conversions.to_ground_truth(truth, self.params))
+
+    def _publish_motion_messages(self, update, odom_heard, tf_heard, joints_heard):
+        m = self.motion_messages
+        odometry = update.odometry
+        if odometry is not None and (odom_heard or tf_heard):
+            m.fill_odometry(odometry)
+            if tf_heard:
+                self.tf_pub.publish(m.tf)
+            if odom_heard:
+                self.odom_pub.publish(m.odom)
+        joints = update.joints
+        if joints is not None and joints_heard:
+            m.fill_joints(joints)
+            self.joint_pub.publish(m.joints)
 
     def _publish_states(self, s):
         stamp = self.get_clock().now().to_msg()

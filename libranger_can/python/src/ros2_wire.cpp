@@ -1,0 +1,123 @@
+#include "ros2_wire.hpp"
+
+#include <algorithm>
+#include <cstring>
+#include <utility>
+
+namespace ranger::python {
+namespace {
+
+static_assert(sizeof(double) == 8, "CDR's float64 is an IEEE 754 double");
+
+// A CDR little-endian writer (see ros2_wire.hpp): the encapsulation header, then aligned fields.
+class CdrWriter {
+ public:
+  explicit CdrWriter(std::size_t reserve) {
+    out_.reserve(reserve);
+    out_.append("\x00\x01\x00\x00", 4);  // CDR_LE, options 0
+  }
+  void u32(std::uint32_t v) { put(v); }
+  void i32(std::int32_t v) { put(v); }
+  void f64(double v) { put(v); }
+  void string(const std::string& s) {
+    u32(static_cast<std::uint32_t>(s.size() + 1));
+    out_.append(s);
+    out_.push_back('\0');
+  }
+  void stamp(std::int64_t sec, std::uint32_t nanosec) {  // builtin_interfaces/Time
+    i32(static_cast<std::int32_t>(sec));
+    u32(nanosec);
+  }
+  void header(std::int64_t sec, std::uint32_t nanosec, const std::string& frame_id) {
+    stamp(sec, nanosec);
+    string(frame_id);
+  }
+  std::string take() { return std::move(out_); }
+
+ private:
+  template <class T>
+  void put(T v) {  // little endian only: the hosts we build for (static_assert below)
+    const std::size_t body = out_.size() - 4;
+    out_.append((sizeof(T) - body % sizeof(T)) % sizeof(T), '\0');
+    char bytes[sizeof(T)];
+    std::memcpy(bytes, &v, sizeof(T));
+    out_.append(bytes, sizeof(T));
+  }
+  std::string out_;
+};
+
+static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "the encoder writes host order as CDR_LE");
+
+// geometry_msgs/Pose's orientation of a yaw: (0, 0, qz, qw).
+void orientation(CdrWriter& w, double qz, double qw) {
+  w.f64(0.0);
+  w.f64(0.0);
+  w.f64(qz);
+  w.f64(qw);
+}
+
+void covariance(CdrWriter& w, const std::array<double, 6>& diagonal,
+                const std::array<double, 6>& added) {
+  for (std::size_t i = 0; i < 36; ++i) {
+    const std::size_t axis = i / 6;
+    w.f64(i % 7 == 0 ? diagonal[axis] + added[axis] : 0.0);
+  }
+}
+
+}  // namespace
+
+MotionWireEncoder::MotionWireEncoder(MotionWireSetup setup) : setup_(std::move(setup)) {}
+
+std::string MotionWireEncoder::odometry(const OdometryValues& v) const {
+  const auto& [sec, nanosec, x, y, qz, qw, vx, vy, wz, var_x, var_y, var_yaw] = v;
+  CdrWriter w(720 + setup_.odom_frame.size() + setup_.base_frame.size());
+  w.header(sec, nanosec, setup_.odom_frame);
+  w.string(setup_.base_frame);
+  // pose: PoseWithCovariance
+  w.f64(x);
+  w.f64(y);
+  w.f64(0.0);
+  orientation(w, qz, qw);
+  covariance(w, setup_.pose_covariance_diagonal, {var_x, var_y, 0.0, 0.0, 0.0, var_yaw});
+  // twist: TwistWithCovariance
+  for (double c : {vx, vy, 0.0, 0.0, 0.0, wz})
+    w.f64(c);
+  covariance(w, setup_.twist_covariance_diagonal, {});
+  return w.take();
+}
+
+std::string MotionWireEncoder::transform(const OdometryValues& v) const {
+  const auto& [sec, nanosec, x, y, qz, qw, vx, vy, wz, var_x, var_y, var_yaw] = v;
+  CdrWriter w(96 + setup_.odom_frame.size() + setup_.base_frame.size());
+  w.u32(1);  // transforms: one TransformStamped
+  w.header(sec, nanosec, setup_.odom_frame);
+  w.string(setup_.base_frame);
+  w.f64(x);
+  w.f64(y);
+  w.f64(0.0);
+  orientation(w, qz, qw);
+  return w.take();
+}
+
+std::string MotionWireEncoder::joint_state(const JointValues& v) const {
+  const auto& [sec, nanosec, position, velocity] = v;
+  std::size_t names = 0;
+  for (const std::string& n : setup_.joint_names)
+    names += n.size() + 8;
+  CdrWriter w(48 + names + 16 * position.size());
+  w.header(sec, nanosec, "");
+  w.u32(static_cast<std::uint32_t>(setup_.joint_names.size()));
+  for (const std::string& n : setup_.joint_names)
+    w.string(n);
+  const std::size_t count = std::min(setup_.joint_names.size(), position.size());
+  w.u32(static_cast<std::uint32_t>(count));
+  for (std::size_t i = 0; i < count; ++i)
+    w.f64(position[i]);
+  w.u32(static_cast<std::uint32_t>(count));
+  for (std::size_t i = 0; i < count; ++i)
+    w.f64(velocity[i]);
+  w.u32(0);  // effort
+  return w.take();
+}
+
+}  // namespace ranger::python

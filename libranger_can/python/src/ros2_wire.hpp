@@ -1,0 +1,54 @@
+// The motion estimate as ROS 2 messages on the wire: nav_msgs/Odometry, tf2_msgs/TFMessage (the
+// odometry's one transform) and sensor_msgs/JointState in their serialised form, the bytes rclpy's
+// Publisher.publish takes instead of a message. The ROS 2 node publishes those 50 times a second;
+// building them here skips rclpy's per-message conversion from Python objects and the rmw's
+// serialisation, the bulk of its publication cost.
+//
+// The encoding is OMG CDR as the ROS 2 rmw implementations write it (rmw_fastrtps, rmw_cyclonedds):
+// a 4-byte encapsulation header (CDR little endian, plain, no options), then the fields in message
+// order, each primitive aligned to its size (8 at most) from the end of the header, a string as
+// its length with the terminating NUL (uint32) and its bytes, a sequence as its length (uint32)
+// and its elements. Nothing here is trusted blindly: the node compares these bytes with rclpy's
+// own serialisation of the same message at start-up and publishes messages when they differ
+// (ranger_base/conversions.py, motion_encoder).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "views.hpp"
+
+namespace ranger::python {
+
+// What the three messages carry beside the estimate, fixed for a node's life: the frames (odom's
+// header and child frame, the transform's), the joint names in JointValues' order and the
+// covariances' diagonals (pose: the floor the odometry's variance adds to; twist: as given).
+struct MotionWireSetup {
+  std::string odom_frame;
+  std::string base_frame;
+  std::vector<std::string> joint_names;
+  std::array<double, 6> pose_covariance_diagonal{};
+  std::array<double, 6> twist_covariance_diagonal{};
+};
+
+// The encoder of one node: each call returns one message's serialised bytes. Pose covariance =
+// diag(pose_covariance_diagonal) + the odometry's x/y/yaw variance at (0,0), (1,1), (5,5); twist
+// covariance = diag(twist_covariance_diagonal); JointState: names, positions, velocities, no
+// efforts (as the ROS 1 node publishes).
+class MotionWireEncoder {
+ public:
+  explicit MotionWireEncoder(MotionWireSetup setup);
+
+  std::string odometry(const OdometryValues& v) const;
+  std::string transform(const OdometryValues& v) const;
+  std::string joint_state(const JointValues& v) const;
+
+  const MotionWireSetup& setup() const { return setup_; }
+
+ private:
+  MotionWireSetup setup_;
+};
+
+}  // namespace ranger::python
