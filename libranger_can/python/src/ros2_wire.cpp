@@ -48,12 +48,11 @@ class CdrWriter {
 
 static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "the encoder writes host order as CDR_LE");
 
-// geometry_msgs/Pose's orientation of a yaw: (0, 0, qz, qw).
-void orientation(CdrWriter& w, double qz, double qw) {
-  w.f64(0.0);
-  w.f64(0.0);
-  w.f64(qz);
-  w.f64(qw);
+// A planar pose: geometry_msgs/Pose (position, orientation) or Transform (translation, rotation),
+// which lie alike on the wire: (x, y, 0) and the yaw's quaternion (0, 0, qz, qw).
+void planar_pose(CdrWriter& w, double x, double y, double qz, double qw) {
+  for (double c : {x, y, 0.0, 0.0, 0.0, qz, qw})
+    w.f64(c);
 }
 
 void covariance(CdrWriter& w, const std::array<double, 6>& diagonal,
@@ -73,11 +72,7 @@ std::string MotionWireEncoder::odometry(const OdometryValues& v) const {
   CdrWriter w(720 + setup_.odom_frame.size() + setup_.base_frame.size());
   w.header(sec, nanosec, setup_.odom_frame);
   w.string(setup_.base_frame);
-  // pose: PoseWithCovariance
-  w.f64(x);
-  w.f64(y);
-  w.f64(0.0);
-  orientation(w, qz, qw);
+  planar_pose(w, x, y, qz, qw);  // pose: PoseWithCovariance
   covariance(w, setup_.pose_covariance_diagonal, {var_x, var_y, 0.0, 0.0, 0.0, var_yaw});
   // twist: TwistWithCovariance
   for (double c : {vx, vy, 0.0, 0.0, 0.0, wz})
@@ -92,10 +87,7 @@ std::string MotionWireEncoder::transform(const OdometryValues& v) const {
   w.u32(1);  // transforms: one TransformStamped
   w.header(sec, nanosec, setup_.odom_frame);
   w.string(setup_.base_frame);
-  w.f64(x);
-  w.f64(y);
-  w.f64(0.0);
-  orientation(w, qz, qw);
+  planar_pose(w, x, y, qz, qw);
   return w.take();
 }
 
