@@ -34,6 +34,7 @@ from ._ranger_can import (  # noqa: F401  (re-exported)
     diagnostic_group_names,
     driver_status_bit_names, error_clear_description, error_names, event_kinds, fault_names,
     light_modes, model_names, motion_mode_pinned, resume_answered, resume_refused_offline,
+    clear_errors_answer,
     unknown_motion_mode_number,
     motion_modes, parameters, protocol_names, refusal_names, steering_joint_names, variant_names,
     wheel_joint_names)

@@ -23,6 +23,7 @@ from ._ranger_can import (Battery as Battery, Event as Event, event_kinds as eve
                           light_modes as light_modes, model_names as model_names,
                           motion_mode_pinned as motion_mode_pinned,
                           resume_answered as resume_answered,
+                          clear_errors_answer as clear_errors_answer,
                           resume_refused_offline as resume_refused_offline,
                           unknown_motion_mode_number as unknown_motion_mode_number,
                           motion_modes as motion_modes, parameters as parameters,

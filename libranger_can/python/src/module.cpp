@@ -913,6 +913,16 @@ PYBIND11_MODULE(_ranger_can, m) {
         return refused->message;
       },
       py::arg("snapshot"), py::arg("port"));
+  m.def(
+      "clear_errors_answer",
+      [](int code, const OutcomeView& outcome, const Snapshot& s) {
+        if (code < 0 || code > 255)
+          invalid("clear_errors: code " + std::to_string(code) + " out of range [0, 255]");
+        const ServiceAnswer a = clear_errors_answer(static_cast<std::uint8_t>(code),
+                                                    outcome.outcome, s.s().profile.error_word);
+        return py::make_tuple(a.success, a.message);
+      },
+      py::arg("code"), py::arg("outcome"), py::arg("snapshot"));
   m.def("resume_answered", [] {  // what resume answers once the driver re-armed
     RequestOutcome answered;
     answered.state = RequestOutcome::State::kAnswered;

@@ -257,7 +257,8 @@ EventView event_view(const DriverEvent& e) {
 OutcomeView outcome_view(const RequestOutcome& o) {
   return OutcomeView{o.id,      std::string(to_string(o.kind)),
                      o.what,    std::string(to_string(o.state)),
-                     o.message, o.error_word};
+                     o.message, o.error_word,
+                     o};
 }
 
 GroundTruthView ground_truth_view(const sim::ChassisSnapshot& c) {

@@ -96,6 +96,7 @@ struct OutcomeView {
   std::uint64_t id = 0;
   std::string kind, what, state, message;
   std::optional<std::uint32_t> error_word;
+  RequestOutcome outcome;  // as the driver gave it, for the library's answer texts
   bool done() const { return state == "answered" || state == "failed"; }
 };
 

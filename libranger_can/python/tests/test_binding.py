@@ -244,6 +244,12 @@ def test_the_front_ends_words_are_the_librarys(sim):
     assert ranger_can.motion_mode_pinned(None) == "automatic motion-mode selection"
     assert ranger_can.resume_refused_offline(s, "sim") is None
     assert ranger_can.resume_answered() == "re-armed: cmd_vel drives the chassis again"
+    sim.wait_ready(timeout=30)
+    ok, text = ranger_can.clear_errors_answer(0, sim.clear_errors(0), sim.snapshot())
+    assert ok and text.startswith("clear_errors code 0 (")
+    assert text.endswith(": the chassis answered with error word 0x00000000 (no errors)")
+    with pytest.raises(RangerError, match=r"code 256 out of range \[0, 255\]"):
+        ranger_can.clear_errors_answer(256, sim.clear_errors(0), sim.snapshot())
 
 
 def test_vendor_features_refused_by_name_on_the_manuals_chassis(sim):

@@ -336,22 +336,15 @@ class RangerNode(Node):
         return response
 
     def _on_clear_errors(self, request, response):
-        asked = (f"clear_errors code {request.code} "
-                 f"({ranger_can.error_clear_description(request.code)})")
-        ok, message, outcome = self._answer(
+        _, message, outcome = self._answer(
             "clear_errors", lambda: self.driver.clear_errors(request.code))
         s = self.driver.snapshot()
-        if ok and outcome.error_word is not None:
-            response.success = True
-            response.error_word = outcome.error_word
-            names = ranger_can.error_names(outcome.error_word, s.error_layout)
-            response.message = (f"{asked}: the chassis answered with error word "
-                                f"{outcome.error_word:#010x}"
-                                + (f" ({', '.join(names)})" if names else " (no errors)"))
-        else:
-            response.success = False
-            response.error_word = s.error_word
-            response.message = message if outcome is None else f"{asked}: {message}"
+        if outcome is None:  # not posted (the bus is not open)
+            response.success, response.message = False, message
+        else:  # the library's words, as the ROS 1 node answers
+            response.success, response.message = ranger_can.clear_errors_answer(
+                request.code, outcome, s)
+        response.error_word = outcome.error_word if response.success else s.error_word
         self._log_answer("clear_errors", response.success, response.message)
         return response
 

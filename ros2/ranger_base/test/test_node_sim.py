@@ -15,7 +15,7 @@ import rclpy
 
 import ranger_can
 from ranger_msgs.msg import SystemState
-from ranger_msgs.srv import SetDriveMode, SetLights
+from ranger_msgs.srv import ClearErrors, SetDriveMode, SetLights
 from std_srvs.srv import SetBool, Trigger
 
 from support import Client, Robot, node_executable, ros_args, yaw
@@ -153,6 +153,19 @@ def test_remote_control_takes_over_until_resume(robots, client):
     assert client.call(Trigger, f"{r.ns}/resume", Trigger.Request()).success
     r.client.wait_for(lambda: r.truth().twist.twist.linear.x > 0.2, 30, "driving",
                       pace=lambda: r.send(vx=0.3))
+
+
+def test_clear_errors_answers_with_the_chassis_error_word(robots, client):
+    """The library's answer (frontend/answers.hpp, as the ROS 1 node gives it): the error word
+    the chassis answered with, its faults by name."""
+    r = robots("sim")
+    r.wait_ready()
+    answer = client.call(ClearErrors, f"{r.ns}/clear_errors", ClearErrors.Request(code=0))
+    assert answer.success, answer.message
+    assert answer.message.startswith(
+        f"clear_errors code 0 ({ranger_can.error_clear_description(0)}): the chassis answered "
+        f"with error word {answer.error_word:#010x}"), answer.message
+    assert answer.message.endswith("(no errors)") == (answer.error_word == 0)
 
 
 def test_park_and_lights_on_agx_v2(robots, client):
