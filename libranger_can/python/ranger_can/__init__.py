@@ -137,6 +137,10 @@ class Driver:
     protocol = property(lambda self: self._s.protocol, doc="auto, manual or agx_v2")
     protocol_source = property(lambda self: self._s.protocol_source,
                                doc="where the protocol settings come from, in words")
+    startup_lines = property(
+        lambda self: self._s.startup_lines,
+        doc="the start-up log's (severity, text) lines about the model and where the protocol "
+            "settings come from, in the library's words (the ROS 1 node logs the same)")
     is_sim = property(lambda self: self._s.is_sim, doc="the in-process virtual chassis")
     settings = property(lambda self: self._s.settings,
                         doc="the node's own values of the parameter table, checked: port_name, "

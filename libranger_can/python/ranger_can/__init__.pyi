@@ -1,6 +1,6 @@
 # Type stubs of the ranger_can package (libranger_can/python/ranger_can/__init__.py).
 from dataclasses import dataclass
-from typing import Callable, Dict, List, Optional
+from typing import Callable, Dict, List, Optional, Tuple
 
 from ._errors import RangerError as RangerError, RequestFailed as RequestFailed
 from ._errors import RequestTimeout as RequestTimeout
@@ -36,6 +36,7 @@ class Driver:
     model: str
     protocol: str
     protocol_source: str
+    startup_lines: List[Tuple[str, str]]  # (severity, text): the model and the protocol settings
     is_sim: bool
     stop_sent: bool
     closed: bool

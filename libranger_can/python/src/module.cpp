@@ -702,6 +702,14 @@ PYBIND11_MODULE(_ranger_can, m) {
                              [](const PySession& p) { return p.setup().node.protocol.protocol; })
       .def_property_readonly("protocol_source",
                              [](const PySession& p) { return p.setup().node.protocol.source; })
+      .def_property_readonly(
+          "startup_lines",
+          [](const PySession& p) {
+            py::list out;
+            for (const LogLine& l : describe_protocol_setup(p.setup().node))
+              out.append(py::make_tuple(std::string(to_string(l.severity)), l.text));
+            return out;
+          })
       .def_property_readonly("settings",
                              [](const PySession& p) { return node_values(p.setup().node); })
       .def_property_readonly("is_sim", [](PySession& p) { return p.s().sim() != nullptr; })

@@ -244,6 +244,16 @@ def test_the_front_ends_words_are_the_librarys(sim):
     assert ranger_can.motion_mode_pinned(None) == "automatic motion-mode selection"
     assert ranger_can.resume_refused_offline(s, "sim") is None
     assert ranger_can.resume_answered() == "re-armed: cmd_vel drives the chassis again"
+    lines = sim.startup_lines
+    assert lines[0][0] == "info" and lines[0][1].startswith("model ranger (")
+    assert any(text.startswith("protocol ") for _, text in lines[1:]), lines
+    forced = ranger_can.Driver("sim", params={"protocol": "auto", "spin_sign": "cw"},
+                               start=False)
+    try:
+        assert any(severity == "warn" and "identification is off" in text
+                   for severity, text in forced.startup_lines), forced.startup_lines
+    finally:
+        forced.close()
     sim.wait_ready(timeout=30)
     ok, text = ranger_can.clear_errors_answer(0, sim.clear_errors(0), sim.snapshot())
     assert ok and text.startswith("clear_errors code 0 (")

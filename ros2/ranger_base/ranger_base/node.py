@@ -253,8 +253,8 @@ class RangerNode(Node):
             f"ranger_base_node on {self.port} ({kind}), publishing odom at "
             f"{self.params['publish_rate']:.1f} Hz ({self.params['odom_frame']} -> "
             f"{self.params['base_frame']}{', TF on' if self.tf_pub else ', TF off'})")
-        self.get_logger().info(f"model {self.driver.model}; protocol settings: "
-                               f"{self.driver.protocol_source}")
+        for severity, text in self.driver.startup_lines:  # the library's words, as ROS 1's
+            self._log_at(severity, text)
 
     def shutdown(self):
         """Stops the chassis first (the driver's zero motion command), then publication."""
@@ -546,10 +546,14 @@ class RangerNode(Node):
     def _log_events(self):
         """The driver's events, each at its severity (the library decides what is a transition
         and words it; the ROS 1 node logs the same)."""
-        log = self.get_logger()
         for event in self.driver.events():
-            {"debug": log.debug, "info": log.info, "warn": log.warn,
-             "error": log.error}.get(event.severity, log.info)(event.text)
+            self._log_at(event.severity, event.text)
+
+    def _log_at(self, severity, text):
+        """A line of the library's at its severity (debug, info, warn, error)."""
+        log = self.get_logger()
+        {"debug": log.debug, "info": log.info, "warn": log.warn,
+         "error": log.error}.get(severity, log.info)(text)
 
     def _publish_diagnostics(self):
         """The library's diagnostic groups of the latest snapshot (ranger_can's
