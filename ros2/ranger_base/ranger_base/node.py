@@ -64,6 +64,9 @@ LIGHT_MODES = {SetLights.Request.OFF: "off", SetLights.Request.ON: "on",
 LIGHT_CODES = {v: k for k, v in LIGHT_MODES.items()}
 
 
+# s: Python's thread switch interval in the node (sys.setswitchinterval; main() says why).
+GIL_SWITCH_INTERVAL = 0.0005
+
 # s: how long the motion publication trusts its last look at who subscribes (a new subscriber
 # gets odom, /tf, joint_states at most this late).
 AUDIENCE_PERIOD = 0.1
@@ -568,6 +571,10 @@ def main(args=None):
     # SIGINT and SIGTERM are the node's to handle: the chassis is stopped (and the stop published
     # on cmd_vel_out) while ROS is still up, then ROS goes down.
     rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+    # A thread waiting for the GIL (cmd_vel's, woken by a command) makes the holder let go after
+    # this long, not after Python's default 5 ms: a command never waits behind the publication
+    # thread turning a diagnostics report into messages.
+    sys.setswitchinterval(GIL_SWITCH_INTERVAL)
     try:
         node = RangerNode()
     except ParameterError as e:
