@@ -4,13 +4,14 @@
 // building them here skips rclpy's per-message conversion from Python objects and the rmw's
 // serialisation, the bulk of its publication cost.
 //
-// The encoding is OMG CDR as the ROS 2 rmw implementations write it (rmw_fastrtps, rmw_cyclonedds):
-// a 4-byte encapsulation header (CDR little endian, plain, no options), then the fields in message
-// order, each primitive aligned to its size (8 at most) from the end of the header, a string as
-// its length with the terminating NUL (uint32) and its bytes, a sequence as its length (uint32)
-// and its elements. Nothing here is trusted blindly: the node compares these bytes with rclpy's
-// own serialisation of the same message at start-up and publishes messages when they differ
-// (ranger_base/conversions.py, motion_encoder).
+// The encoding is OMG CDR (XCDR1, plain) as rmw_fastrtps writes it (checked against it here): a
+// 4-byte encapsulation header (CDR little endian, no options), then the fields in message order,
+// each primitive aligned to its size (8 at most) from the end of the header, a string as its
+// length with the terminating NUL (uint32) and its bytes, a sequence as its length (uint32) and
+// its elements; padding is written as zeros. Nothing here is trusted blindly: at start-up the node
+// reads sample bytes back with the rmw's own deserialisation and publishes messages unless they
+// read as exactly the messages it would have published (ros2/ranger_base conversions.py,
+// motion_encoder).
 #pragma once
 
 #include <array>
@@ -44,8 +45,6 @@ class MotionWireEncoder {
   std::string odometry(const OdometryValues& v) const;
   std::string transform(const OdometryValues& v) const;
   std::string joint_state(const JointValues& v) const;
-
-  const MotionWireSetup& setup() const { return setup_; }
 
  private:
   MotionWireSetup setup_;
