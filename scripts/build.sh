@@ -4,11 +4,16 @@
 # Usage: scripts/build.sh [lib|ros|all]    (default all; in the ROS workspace the library's own
 # tests are off: they are built in build/lib)
 # Environment: RANGER_BUILD_TYPE (default RelWithDebInfo), RANGER_JOBS (default nproc).
+# RelWithDebInfo here is -O2 with line tables only (-g1): backtraces, sanitizers and perf keep file
+# and line, and the build takes about a third less time than with full debug information (-g: every
+# type and variable; test_codec.cpp compiles in 15 s against 22 s). For a debugger session:
+# RANGER_BUILD_TYPE=Debug. RANGER_RELWITHDEBINFO_FLAGS replaces the flags.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 what=${1:-all}
 build_type=${RANGER_BUILD_TYPE:-RelWithDebInfo}
 jobs=${RANGER_JOBS:-$(nproc)}
+relwithdebinfo=-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=${RANGER_RELWITHDEBINFO_FLAGS:--O2 -g1 -DNDEBUG}
 generator=()
 command -v ninja >/dev/null && generator=(-G Ninja)
 
@@ -20,7 +25,7 @@ case "$what" in lib | ros | all) ;; *) echo "build.sh: unknown target '$what'" >
 if [ "$what" != ros ]; then
   echo "== build: libranger_can + tests (build/lib)"
   [ -f build/lib/CMakeCache.txt ] || cmake -S . -B build/lib "${generator[@]}" \
-    -DCMAKE_BUILD_TYPE="$build_type" >/dev/null
+    -DCMAKE_BUILD_TYPE="$build_type" "$relwithdebinfo" >/dev/null
   cmake --build build/lib -j "$jobs"
 fi
 [ "$what" = lib ] && exit 0
@@ -32,7 +37,7 @@ if [ -f /opt/ros/noetic/setup.bash ]; then set +u; source /opt/ros/noetic/setup.
 colcon --log-base build/log build --base-paths . --build-base build/ws --install-base install \
   --event-handlers console_cohesion- summary+ \
   --parallel-workers "$jobs" \
-  --cmake-args -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE="$build_type"
+  --cmake-args -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE="$build_type" "$relwithdebinfo"
 # The install space holds the packages' manifests too: a catkin tool run in a workspace around
 # this checkout must not find them there (colcon leaves COLCON_IGNORE in it itself).
 touch install/CATKIN_IGNORE

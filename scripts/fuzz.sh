@@ -8,7 +8,8 @@
 #   SECONDS  total time budget, split evenly across the targets (default 60: 15 s each for four
 #            targets, the CI setting). Each target gets at least 5 s.
 #   TARGET   run only these targets (e.g. fuzz_decode); default: all.
-# Environment: RANGER_JOBS (build parallelism, default 2), RANGER_FUZZ_ARGS (extra libFuzzer
+# Environment: RANGER_BUILD_ONLY=1 builds the targets and runs none, RANGER_JOBS (build
+#   parallelism, default 2), RANGER_FUZZ_ARGS (extra libFuzzer
 #   flags, e.g. "-jobs=2 -workers=2"). Running longer: see docs/HARDENING.md.
 #
 # New inputs that reach new coverage are kept in build/fuzz/corpus/<target>/ (not committed, so
@@ -55,6 +56,7 @@ CC=clang CXX=clang++ cmake -S libranger_can -B "$build" "${generator[@]}" \
 cmake --build "$build" -j "$jobs" --target "${targets[@]}" ||
   { echo "fuzz.sh: build failed" >&2; exit 1; }
 echo "== fuzz: built in $((SECONDS - start)) s"
+[ "${RANGER_BUILD_ONLY:-0}" = 1 ] && exit 0
 
 per_target=$((total / ${#targets[@]}))
 [ "$per_target" -ge 5 ] || per_target=5

@@ -10,7 +10,9 @@
 #   4. `pip install ./libranger_can` into a fresh venv and the README's Python example with it
 # Usage: scripts/test_ros2.sh [RESULTS_DIR]   (JUnit reports go there; default build/test-results)
 # Environment: RANGER_ROS2_VENV (default .venv-ros2), RANGER_ROS2_DOMAIN_ID (default 87),
-# RANGER_JOBS, RANGER_ROS2_SKIP_PIP=1 to leave out step 4.
+# RANGER_JOBS, RANGER_ROS2_SKIP_PIP=1 to leave out step 4, RANGER_BUILD_ONLY=1 to make the venvs and
+# build (steps 1 and the install of 4) and run nothing (scripts/test.sh builds ahead this way, in
+# the background while other stages test; the next run without it uses that install once).
 set -uo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
@@ -32,8 +34,26 @@ failed=0
   cd "$ws"
   colcon --log-base log build --paths src/ranger_ros/ros2/* \
     --event-handlers console_cohesion- summary+ --parallel-workers "$jobs" \
-    --cmake-args -DCMAKE_BUILD_TYPE=RelWithDebInfo -DBUILD_TESTING=OFF
+    --cmake-args -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -g1 -DNDEBUG" \
+    -DBUILD_TESTING=OFF
 ) || { echo "test_ros2: the colcon build failed" >&2; exit 1; }
+
+fresh=$root/build/pip_venv
+# pip install ./libranger_can into a fresh venv. A build-only run leaves the marker; the next run
+# tests that install instead of making it again.
+pip_install() {
+  rm -rf "$fresh"
+  /usr/bin/python3 -m venv "$fresh"
+  "$fresh/bin/pip" install -q --disable-pip-version-check ./libranger_can pytest
+}
+if [ "${RANGER_BUILD_ONLY:-0}" = 1 ]; then
+  if [ "${RANGER_ROS2_SKIP_PIP:-0}" != 1 ]; then
+    pip_install || { echo "test_ros2: pip install ./libranger_can failed" >&2; exit 1; }
+    touch "$fresh/.built-ahead"
+  fi
+  echo "test_ros2: built"
+  exit 0
+fi
 
 /usr/bin/python3 ros2/ranger_msgs/sync_interfaces.py --check || failed=1
 
@@ -54,10 +74,11 @@ failed=0
 if [ "${RANGER_ROS2_SKIP_PIP:-0}" != 1 ]; then
   (
     set -e
-    fresh=$root/build/pip_venv
-    rm -rf "$fresh"
-    /usr/bin/python3 -m venv "$fresh"
-    "$fresh/bin/pip" install -q --disable-pip-version-check ./libranger_can pytest
+    if [ -f "$fresh/.built-ahead" ]; then
+      rm "$fresh/.built-ahead"
+    else
+      pip_install
+    fi
     cd /tmp  # not the source tree: the installed package is what is imported
     RANGER_PIP_PYTHON=$fresh/bin/python "$fresh/bin/python" -m pytest -p no:cacheprovider -q \
       "$root/libranger_can/python/tests/test_binding.py" -k "readme or parameters" \
