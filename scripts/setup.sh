@@ -33,7 +33,7 @@ noetic_pkgs=(ros-noetic-ros-base ros-noetic-rostest ros-noetic-tf2-ros ros-noeti
   ros-noetic-nodelet ros-noetic-pluginlib
   liburdfdom-tools libeigen3-dev python3-colcon-common-extensions python3-matplotlib)
 test_pkgs=(can-utils iproute2 kmod qemu-system-x86 linux-image-amd64 busybox-static cpio gzip
-  xvfb xauth imagemagick clang libclang-rt-14-dev valgrind clang-format)
+  xvfb xauth imagemagick clang libclang-rt-14-dev valgrind clang-format ccache)
 # The workspace builds (scripts/test_workspaces.sh): catkin build and catkin_lint (catkin_make
 # and catkin_make_isolated come with catkin; CMake 3.16 from PyPI into a venv).
 if [ -d /opt/ros/noetic ]; then

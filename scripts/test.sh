@@ -19,14 +19,15 @@
 #             binding's and the ROS 2 node's tests on this host only, pip install ./libranger_can
 #
 # RANGER_STAGES="unit ros" runs a subset (default: all of the above, in the order
-# unit vcan ros_vcan ros workspaces sanitize fuzz ros2).
+# unit vcan ros_vcan ros ros2 workspaces sanitize fuzz).
 #
-# Building ahead: sanitize, fuzz and ros2 spend most of their time compiling, while ros mostly waits
-# on nodes and clocks. Once no stage that runs the qemu VM (vcan, ros_vcan) is left, the builds of
-# those three stages start in the background at the lowest CPU and I/O priority (nice 19, ionice
-# idle), so that they take only what the running stage leaves; the first of the three waits for
-# them, then finds its builds done (log: build/build-ahead.log). RANGER_BUILD_AHEAD=0 builds each
-# in its own stage instead.
+# Two lanes. ros and ros2 mostly wait on nodes, clocks and DDS; workspaces, sanitize and fuzz
+# mostly compile. Once no stage that runs the qemu VM (vcan, ros_vcan) is left, the stages among
+# workspaces, sanitize and fuzz run one after the other in the background at a lower CPU and I/O
+# priority (nice 10: about a tenth of the CPU against a busy foreground, never starved; ionice
+# best-effort 7), so that they take mostly what the stage in the foreground leaves; their output
+# is printed when they are done, each stage's as a whole, and they count as any other stage.
+# RANGER_LANES=1 runs every stage in the foreground, in turn.
 #
 # The builds are RelWithDebInfo with line tables only (scripts/build.sh); the workspaces stage
 # builds without optimisation (scripts/test_workspaces.sh); ASan+UBSan at -O0, TSan at -O1
@@ -35,7 +36,7 @@ set -uo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
 results=$root/build/test-results
-stages=${RANGER_STAGES:-unit vcan ros_vcan ros workspaces sanitize fuzz ros2}
+stages=${RANGER_STAGES:-unit vcan ros_vcan ros ros2 workspaces sanitize fuzz}
 failed=()
 passed=()
 
@@ -84,48 +85,16 @@ stage_sanitize() { scripts/test_sanitizers.sh; }
 stage_fuzz() { scripts/fuzz.sh "${RANGER_FUZZ_SECONDS:-60}"; }
 stage_ros2() { scripts/test_ros2.sh "$results"; }
 
-# ---- building ahead ----
-ahead_pid=
-ahead_log=$root/build/build-ahead.log
-build_ahead() {  # the builds of the stages among sanitize, fuzz, ros2 that are to run
-  local wanted=() s
-  for s in $stages; do
-    case $s in sanitize | fuzz | ros2) wanted+=("$s") ;; esac
-  done
-  [ ${#wanted[@]} -gt 0 ] && [ "${RANGER_BUILD_AHEAD:-1}" != 0 ] || return 0
-  echo "== building ahead in the background (nice 19): ${wanted[*]} (log: build/build-ahead.log)"
-  set -m  # a process group of its own, which the trap below can stop whole
-  (
-    renice -n 19 -p "$BASHPID" >/dev/null
-    ionice -c 3 -p "$BASHPID" 2>/dev/null
-    export RANGER_BUILD_ONLY=1
-    for s in "${wanted[@]}"; do
-      start=$SECONDS
-      case $s in
-        sanitize) scripts/test_sanitizers.sh ;;
-        fuzz) scripts/fuzz.sh ;;
-        ros2) scripts/test_ros2.sh "$results" ;;
-      esac
-      echo "== build ahead: $s: exit status $? ($((SECONDS - start)) s)"
-    done
-  ) </dev/null >"$ahead_log" 2>&1 &
-  ahead_pid=$!
-  set +m
+# ---- the background lane ----
+background=(workspaces sanitize fuzz)
+lane_pid=
+lane_dir=$root/build/lane
+in_background() {  # stage
+  local b
+  [ "${RANGER_LANES:-2}" != 1 ] || return 1
+  for b in "${background[@]}"; do [ "$b" = "$1" ] && return 0; done
+  return 1
 }
-stop_ahead() { [ -z "$ahead_pid" ] || kill -TERM -- "-$ahead_pid" 2>/dev/null; }
-trap stop_ahead EXIT
-trap 'stop_ahead; exit 130' INT TERM
-wait_ahead() {
-  [ -n "$ahead_pid" ] || return 0
-  local start=$SECONDS
-  echo "== waiting for the builds ahead"
-  wait "$ahead_pid"
-  ahead_pid=
-  echo "== builds ahead done (waited $((SECONDS - start)) s):"
-  grep -E "^== build ahead:" "$ahead_log"
-  # A build that failed ahead is built again by its stage, which then shows the error.
-}
-# The background builds start before the first stage after which no VM stage is left.
 vm_left() {  # stages...: is vcan or ros_vcan among them?
   local s
   for s in "$@"; do
@@ -133,20 +102,57 @@ vm_left() {  # stages...: is vcan or ros_vcan among them?
   done
   return 1
 }
+start_lane() {  # stages...: run them in turn in the background, each into lane/<stage>.log
+  [ $# -gt 0 ] || return 0
+  echo "== background lane (nice 10): $* (logs: build/lane/)"
+  set -m  # a process group of its own, which the trap below can stop whole
+  (
+    renice -n 10 -p "$BASHPID" >/dev/null
+    ionice -c 2 -n 7 -p "$BASHPID" 2>/dev/null
+    for s in "$@"; do
+      start=$SECONDS
+      if "stage_$s" >"$lane_dir/$s.log" 2>&1; then rc=0; else rc=$?; fi
+      echo "$rc $((SECONDS - start))" >"$lane_dir/$s.status"
+    done
+  ) </dev/null &
+  lane_pid=$!
+  set +m
+}
+stop_lane() { [ -z "$lane_pid" ] || kill -TERM -- "-$lane_pid" 2>/dev/null; }
+trap stop_lane EXIT
+trap 'stop_lane; exit 130' INT TERM
+finish_lane() {  # stages...: wait for the lane, then print and count each stage
+  [ -n "$lane_pid" ] || return 0
+  local start=$SECONDS s rc seconds
+  echo
+  echo "== waiting for the background lane"
+  wait "$lane_pid"
+  lane_pid=
+  echo "== background lane done (waited $((SECONDS - start)) s)"
+  for s in "$@"; do
+    echo
+    echo "==================== stage: $s (background lane) ===================="
+    cat "$lane_dir/$s.log" 2>/dev/null
+    if read -r rc seconds 2>/dev/null <"$lane_dir/$s.status" && [ "$rc" = 0 ]; then
+      passed+=("$s")
+      echo "== stage $s: ok ($seconds s, in the background)"
+    else
+      failed+=("$s")
+      echo "== stage $s: FAILED (${seconds:-?} s, in the background)"
+    fi
+  done
+}
 
 echo "== setup"
 scripts/setup.sh test || { echo "setup failed: cannot install the system packages" >&2; exit 1; }
-rm -rf "$results" "$ahead_log" && mkdir -p "$results"
+rm -rf "$results" "$lane_dir" && mkdir -p "$results" "$lane_dir"
 echo "== build"
 scripts/build.sh all || { echo "build failed" >&2; exit 1; }
 
 read -r -a stage_list <<<"$stages"
+lane=()
 for i in "${!stage_list[@]}"; do
   s=${stage_list[$i]}
-  if [ -z "$ahead_pid" ] && [ ! -f "$ahead_log" ] && ! vm_left "${stage_list[@]:$i}"; then
-    build_ahead
-  fi
-  case $s in sanitize | fuzz | ros2) wait_ahead ;; esac
   if [ "$(type -t "stage_$s")" != function ]; then
     echo "unknown stage '$s'" >&2
     failed+=("$s")
@@ -156,10 +162,17 @@ for i in "${!stage_list[@]}"; do
     sanitize) [ -x scripts/test_sanitizers.sh ] || { echo "(no sanitizer script yet)"; continue; } ;;
     fuzz) [ -x scripts/fuzz.sh ] || { echo "(no fuzz script yet)"; continue; } ;;
   esac
+  if [ -z "$lane_pid" ] && [ ${#lane[@]} -eq 0 ] && ! vm_left "${stage_list[@]:$i}"; then
+    # From here on no VM stage is left: the background lane takes its stages from the rest.
+    for rest in "${stage_list[@]:$i}"; do
+      if in_background "$rest"; then lane+=("$rest"); fi
+    done
+    start_lane "${lane[@]}"
+  fi
+  in_background "$s" && [ -n "$lane_pid" ] && continue
   run_stage "$s" "stage_$s"
 done
-
-wait_ahead
+finish_lane "${lane[@]}"
 
 echo
 echo "==================== summary ===================="

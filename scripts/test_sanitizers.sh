@@ -10,8 +10,7 @@
 #            then ranger_base's gtests and rostests (the node itself runs instrumented).
 #
 # Usage: scripts/test_sanitizers.sh [address|thread|ros]...     (default: all three)
-# Environment: RANGER_BUILD_ONLY=1 builds and runs nothing (scripts/test.sh builds ahead this way,
-#   in the background while other stages test), RANGER_JOBS (default 2), CXX (default: the system compiler), RANGER_RESULTS
+# Environment: RANGER_JOBS (default 2), CXX (default: the system compiler), RANGER_RESULTS
 #   (directory for the JUnit reports asan.xml, tsan.xml, asan-ros/; default build/test-results).
 #   RANGER_SANITIZE_VCAN=1 also runs the `vcan` suites of the ASan build, natively or in the qemu
 #   VM (scripts/run_vcan_tests.sh; it adds several minutes).
@@ -38,9 +37,9 @@ mkdir -p build "$results" && touch build/COLCON_IGNORE
 # Asserts stay on (no NDEBUG); stack traces are exact. ASan+UBSan builds at -O0: GCC compiles
 # UBSan's checks at -O1 about four times slower (test_codec.cpp: 66 s against 16 s), while the tests
 # run only about twice as long; ThreadSanitizer builds at -O1, where it compiles quickly and its
-# runs stay bearable.
+# runs stay bearable, with line tables only (-g1: reports keep file and line; 12 s against 17 s).
 asan_common_flags="-O0 -g -fno-omit-frame-pointer"
-tsan_common_flags="-O1 -g -fno-omit-frame-pointer"
+tsan_common_flags="-O1 -g1 -fno-omit-frame-pointer"
 asan_flags="-fsanitize=address,undefined -fno-sanitize-recover=all"
 tsan_flags="-fsanitize=thread"
 
@@ -81,7 +80,6 @@ run_cmake_build() {  # name dir RANGER_SANITIZE common_flags flags [ctest -E reg
     return 1
   fi
   echo "== $name: built in $((SECONDS - start)) s"
-  [ "${RANGER_BUILD_ONLY:-0}" = 1 ] && return 0
 
   start=$SECONDS
   (
@@ -121,7 +119,6 @@ run_ros_build() {
       -DCATKIN_ENABLE_TESTING=ON
   ) || { echo "== asan-ros: BUILD FAILED"; return 1; }
   echo "== asan-ros: built in $((SECONDS - start)) s"
-  [ "${RANGER_BUILD_ONLY:-0}" = 1 ] && return 0
 
   start=$SECONDS
   (
@@ -170,7 +167,6 @@ for kind in "${kinds[@]}"; do
       ;;
   esac
   if "${run[@]}"; then
-    if [ "${RANGER_BUILD_ONLY:-0}" = 1 ]; then echo "== $name: built"; continue; fi
     echo "== $name: ok, no sanitizer reports"
   else
     echo "== $name: FAILED"
@@ -182,8 +178,4 @@ if [ ${#failed[@]} -gt 0 ]; then
   echo "test_sanitizers.sh: failed: ${failed[*]}"
   exit 1
 fi
-if [ "${RANGER_BUILD_ONLY:-0}" = 1 ]; then
-  echo "test_sanitizers.sh: built (${kinds[*]})"
-else
-  echo "test_sanitizers.sh: all clean (${kinds[*]})"
-fi
+echo "test_sanitizers.sh: all clean (${kinds[*]})"

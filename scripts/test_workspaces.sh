@@ -8,12 +8,13 @@
 #
 #   lint                  catkin_lint -W1 over the repository: no error, no warning; the catkin
 #                         tools find each package once (not again in build/ or install/)
-#   catkin_make           `catkin_make` in build/workspaces/catkin_make, then the driver from its
+#   catkin_make           `catkin_make` in a fresh build/workspaces/ws, then the driver from its
 #                         devel space: `source devel/setup.bash; roslaunch ranger_bringup
 #                         ranger_minimal.launch sim:=true` until it reaches CAN command mode
-#   catkin_make_isolated  `catkin_make_isolated` in build/workspaces/catkin_make_isolated
-#   catkin_build          `catkin build` (catkin_tools) in build/workspaces/catkin_build
-#   colcon                `colcon build` in build/workspaces/colcon
+#   catkin_make_isolated  `catkin_make_isolated` in a fresh build/workspaces/ws
+#   catkin_build          `catkin build` (catkin_tools) in a fresh build/workspaces/ws
+#   colcon                `colcon build` in a fresh build/workspaces/ws
+#                         (each build's output: build/workspaces/<step>.log)
 #   cmake316              CMake 3.16 (pip, in a venv cached under build/cmake-3.16): the top-level
 #                         build configured (library, tool, unit tests, system suites) and the tool
 #                         and two test executables built and run; RANGER_CMAKE316_FULL=1 builds and
@@ -37,12 +38,22 @@ jobs=${RANGER_JOBS:-$(nproc)}
 steps=${*:-lint catkin_make catkin_build colcon cmake316}
 build_type=${RANGER_WORKSPACE_BUILD_TYPE-Debug}
 if [ -n "$build_type" ]; then export CMAKE_BUILD_TYPE=$build_type; else unset CMAKE_BUILD_TYPE; fi
+# ccache (where installed; RANGER_WORKSPACE_CCACHE=0 turns it off) through CMake's
+# CMAKE_CXX_COMPILER_LAUNCHER environment variable, with a cache of this run's own (emptied first:
+# the first tool compiles everything): the later tools find the library's objects in it. The
+# directory is not hashed (the build directories differ by tool; only debug information names it).
+if [ "${RANGER_WORKSPACE_CCACHE:-1}" != 0 ] && command -v ccache >/dev/null; then
+  export CMAKE_CXX_COMPILER_LAUNCHER=ccache CCACHE_DIR=$work/ccache CCACHE_NOHASHDIR=true
+  rm -rf "$CCACHE_DIR"
+fi
 export PATH=/usr/bin:$PATH  # the ROS tools need Debian's python3, not a pyenv one
 if [ -f /opt/ros/noetic/setup.bash ]; then set +u; source /opt/ros/noetic/setup.bash; set -u; fi
 mkdir -p "$work" && touch "$root/build/COLCON_IGNORE" "$root/build/CATKIN_IGNORE"
 failed=()
 
-# A fresh workspace WS with the repository in WS/src/ranger_ros.
+# A fresh workspace WS with the repository in WS/src/ranger_ros. Every tool gets a fresh one at
+# the same path (build/workspaces/ws), so that with ccache (below) the library's files, compiled
+# alike by each tool, are compiled once.
 fresh_workspace() {
   local ws=$1
   rm -rf "$ws" && mkdir -p "$ws/src/ranger_ros"
@@ -141,30 +152,32 @@ launcher_args=()
 # CMake >= 3.20 (Noetic's catkin on Ubuntu 20.04 does not), so catkin with CMake 3.16 is a
 # combination no user has.
 step_catkin_make() {
-  local ws=$work/catkin_make
+  local ws=$work/ws
   fresh_workspace "$ws"
-  (cd "$ws" && checked_build "$ws/build.log" catkin_make -j"$jobs") || return 1
+  (cd "$ws" && checked_build "$work/catkin_make.log" catkin_make -j"$jobs") || return 1
   run_driver "$ws/devel/setup.bash"
 }
 
 step_catkin_make_isolated() {
-  local ws=$work/catkin_make_isolated
+  local ws=$work/ws
   fresh_workspace "$ws"
-  (cd "$ws" && checked_build "$ws/build.log" catkin_make_isolated -j"$jobs")
+  (cd "$ws" && checked_build "$work/catkin_make_isolated.log" catkin_make_isolated -j"$jobs")
 }
 
 step_catkin_build() {
-  local ws=$work/catkin_build
+  local ws=$work/ws
   fresh_workspace "$ws"
   (cd "$ws" && catkin init >/dev/null &&
-    checked_build "$ws/build.log" catkin build --no-status --no-notify -j"$jobs" -p 1)
+    checked_build "$work/catkin_build.log" catkin build --no-status --no-notify -j"$jobs" -p 1)
 }
 
 step_colcon() {
-  local ws=$work/colcon
+  local ws=$work/ws
   fresh_workspace "$ws"
-  (cd "$ws" && checked_build "$ws/build.log" colcon build --event-handlers console_direct+ \
-    --executor sequential)
+  # colcon runs make with -j<cores> -l<cores> unless MAKEFLAGS is set: the load limit would make
+  # it build one file at a time while CI's background lane (scripts/test.sh) is busy.
+  (cd "$ws" && MAKEFLAGS=-j$jobs checked_build "$work/colcon.log" colcon build \
+    --event-handlers console_direct+ --executor sequential)
 }
 
 step_cmake316() {
