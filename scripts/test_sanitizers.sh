@@ -3,8 +3,8 @@
 #
 #   address  libranger_can, its tool, its unit tests and the system suites in tests/ with
 #            AddressSanitizer + UndefinedBehaviorSanitizer (build/asan); every CTest case that
-#            needs no kernel CAN support (label != vcan).
-#   thread   the same with ThreadSanitizer (build/tsan), but for the lock-step suites (no thread).
+#            needs no kernel CAN support (label != vcan) but the lock-step suites (see below).
+#   thread   the same with ThreadSanitizer (build/tsan).
 #   ros      the ROS packages up to ranger_base (libranger_can, ranger_msgs, ranger_base) with
 #            ASan + UBSan in a colcon workspace of their own (build/asan-ws, build/asan-install),
 #            then ranger_base's gtests and rostests (the node itself runs instrumented).
@@ -149,14 +149,16 @@ run_ros_build() {
 failed=()
 for kind in "${kinds[@]}"; do
   case $kind in
+    # The lock-step suites (LockStep/...: the chassis and the driver stepped in turn under a
+    # ManualClock on the test's one thread, for minutes of simulated driving) are left to the plain
+    # build (the unit stage): they start no thread, so ThreadSanitizer has nothing to watch in
+    # them, and they drive the code that every other suite runs under ASan, for longer; in either
+    # build they take half of the run time.
     address)
       name=asan
-      run=(run_cmake_build asan build/asan address "$asan_common_flags" "$asan_flags")
+      run=(run_cmake_build asan build/asan address "$asan_common_flags" "$asan_flags" '^LockStep/')
       ;;
     thread)
-      # The lock-step suites (LockStep/...: chassis and driver stepped in turn under a ManualClock
-      # on the test's one thread) start no thread, so ThreadSanitizer has nothing to watch in them;
-      # they are half of its run time. ASan and the plain build run them.
       name=tsan
       run=(run_cmake_build tsan build/tsan thread "$tsan_common_flags" "$tsan_flags" '^LockStep/')
       ;;
