@@ -119,7 +119,18 @@ def test_rviz_draws_the_moving_robot(master):
 
         assert wait_for(moved, timeout=60, interval=0.05), driver.log_text()[-3000:]
         # rviz needs a moment to start and render with software GL; keep driving meanwhile.
+        # Mesa's software GL (llvmpipe) has been seen to crash inside libLLVM while rviz starts on
+        # a busy machine (SIGSEGV, once in many runs): rviz is started once more then, and the test
+        # says so; a second death fails it.
+        restarted = []
+
         def drawn():
+            nonlocal rviz
+            if not rviz.alive() and not restarted:
+                restarted.append(rviz.log_text()[-1500:])
+                print("rviz died; starting it once more. Its log:\n" + restarted[0])
+                rviz.stop()
+                rviz = Launch(master, "display.launch", log_name="rviz-again", env=env)
             cmd_vel.publish(arc)
             xvfb.screenshot(shot)
             return body_pixels(read_rgb(shot)) > 0.002 * WIDTH * HEIGHT
