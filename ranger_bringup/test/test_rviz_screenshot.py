@@ -133,7 +133,9 @@ def test_rviz_draws_the_moving_robot(master):
                 rviz = Launch(master, "display.launch", log_name="rviz-again", env=env)
             cmd_vel.publish(arc)
             xvfb.screenshot(shot)
-            return body_pixels(read_rgb(shot)) > 0.002 * WIDTH * HEIGHT
+            rgb = read_rgb(shot)
+            # The trail too: a restarted rviz draws it from its start on.
+            return body_pixels(rgb) > 0.002 * WIDTH * HEIGHT and trail_pixels(rgb) > 50
 
         ok = wait_for(drawn, timeout=90, interval=0.5)
         cmd_vel.publish(Twist())
