@@ -130,8 +130,11 @@ def node():
 def node_ros2():
     """ROS 2 node
     ros2/ranger_base's ranger_base_node (rclpy over the ranger_can binding) in the same run, the
-    same load: `port_name:=sim`, subscribers on `odom`, `/tf`, `joint_states`, `cmd_vel` at
-    20 Hz; latency as above (ros2/ranger_base/ranger_base/measure_performance.py)."""
+    same load: `port_name:=sim`, subscribers on `odom`, `/tf`, `joint_states` (raw: bytes, no
+    Python message, as the ROS 1 measurement's `rospy.AnyMsg`), `cmd_vel` at 20 Hz; latency as
+    above, from the twist's bytes handed to the publisher (serialised beforehand) to the 0x111's
+    send stamp (ros2/ranger_base/ranger_base/measure_performance.py). The node takes `cmd_vel`'s
+    bytes and reads them in C++ (`ranger_can.read_twist`)."""
     doc = json.loads(read("node_ros2.json"))
     load, lat, floor = doc["load"], doc["latency_cmd_vel_to_0x111"], doc["rclpy_floor"]
     ros1 = json.loads(read("node.json"))["load"] if read("node.json") else {}

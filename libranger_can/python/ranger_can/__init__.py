@@ -28,7 +28,7 @@ from typing import Dict, List, Optional
 from ._errors import RangerError, RequestFailed, RequestTimeout
 from ._ranger_can import (  # noqa: F401  (re-exported)
     Battery, CliResult, DiagnosticGroup, Event, FrameCount, GroundTruth, Identification, Joints, Lights, Motor,
-    MotionUpdate, MotionWireEncoder, Odometry,
+    MotionUpdate, MotionWireEncoder, Odometry, read_twist,
     ParameterRow, RemoteState, RequestOutcome, SentMotion, Snapshot, UltrasonicReading,
     __version__, _cli, _Session, bms_status_bit_names, chassis_command_names, check_parameter,
     diagnostic_group_names,
@@ -41,7 +41,7 @@ from ._ranger_can import (  # noqa: F401  (re-exported)
 
 __all__ = [
     "Driver", "RangerError", "RequestFailed", "RequestTimeout", "Snapshot", "RequestOutcome",
-    "Event", "event_kinds", "MotionUpdate", "MotionWireEncoder", "DiagnosticGroup",
+    "Event", "event_kinds", "MotionUpdate", "MotionWireEncoder", "read_twist", "DiagnosticGroup",
     "diagnostic_group_names",
     "check_parameter",
     "decode", "replay_odometry", "parameters", "model_names", "variant_names", "protocol_names",

@@ -7,7 +7,7 @@ from ._errors import RequestTimeout as RequestTimeout
 from ._ranger_can import (Battery as Battery, Event as Event, event_kinds as event_kinds, FrameCount as FrameCount, GroundTruth as GroundTruth,
                           Identification as Identification, Joints as Joints, Lights as Lights,
                           Motor as Motor, MotionUpdate as MotionUpdate,
-                          MotionWireEncoder as MotionWireEncoder,
+                          MotionWireEncoder as MotionWireEncoder, read_twist as read_twist,
                           Odometry as Odometry, ParameterRow as ParameterRow,
                           DiagnosticGroup as DiagnosticGroup,
                           check_parameter as check_parameter,

@@ -107,6 +107,10 @@ class MotionWireEncoder:
     def encode(self, update: MotionUpdate
                ) -> Tuple[Optional[bytes], Optional[bytes], Optional[bytes]]: ...
 
+# geometry_msgs/Twist's serialised bytes (CDR or XCDR2, either byte order) -> (linear x, y, z,
+# angular x, y, z); None for what it does not read (the rmw's deserialize_message reads those).
+def read_twist(data: bytes) -> Optional[Tuple[float, float, float, float, float, float]]: ...
+
 class ParameterRow:
     # A row of the library's parameter table (frontend/node_parameters.hpp). type: bool, int,
     # double, string, double_list, string_list; table_type: the library's (seconds, choice, ...).

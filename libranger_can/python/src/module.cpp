@@ -328,6 +328,16 @@ void bind_wire(py::module_& m) {
         if (u.snapshot && u.joints) joints = py::bytes(e.joint_state(joint_values(*u.snapshot)));
         return py::make_tuple(odom, tf, joints);
       });
+  // cmd_vel's bytes -> (linear x, y, z, angular x, y, z), or None where the rmw must read them.
+  m.def(
+      "read_twist",
+      [](py::bytes data) -> py::object {
+        const auto twist = read_twist(std::string_view(data));
+        if (!twist) return py::none();
+        const auto& t = *twist;
+        return py::make_tuple(t[0], t[1], t[2], t[3], t[4], t[5]);
+      },
+      py::arg("data"));
 }
 
 }  // namespace

@@ -63,7 +63,44 @@ void covariance(CdrWriter& w, const std::array<double, 6>& diagonal,
   }
 }
 
+// The encapsulation identifiers (the first two bytes, big endian) whose body read_twist reads:
+// plain CDR (XCDR1) and plain CDR2 (XCDR2), each in both byte orders. For a message of doubles
+// only, starting at the body's offset 0, the two lay the values out alike.
+struct Encapsulation {
+  std::uint16_t id;
+  bool little_endian;
+};
+constexpr std::array<Encapsulation, 4> kTwistEncapsulations{{
+    {0x0000, false},  // CDR_BE
+    {0x0001, true},   // CDR_LE
+    {0x0006, false},  // CDR2_BE
+    {0x0007, true},   // CDR2_LE
+}};
+
+double read_f64(const char* at, bool little_endian) {
+  unsigned char bytes[8];
+  std::memcpy(bytes, at, 8);
+  if (!little_endian) std::reverse(bytes, bytes + 8);  // the host is little endian (above)
+  double v;
+  std::memcpy(&v, bytes, 8);
+  return v;
+}
+
 }  // namespace
+
+std::optional<std::array<double, 6>> read_twist(std::string_view bytes) {
+  constexpr std::size_t kHeader = 4, kBody = 6 * 8;
+  if (bytes.size() < kHeader + kBody) return std::nullopt;
+  const auto id = static_cast<std::uint16_t>((static_cast<unsigned char>(bytes[0]) << 8) |
+                                             static_cast<unsigned char>(bytes[1]));
+  const auto* encapsulation = std::find_if(kTwistEncapsulations.begin(), kTwistEncapsulations.end(),
+                                           [id](const Encapsulation& e) { return e.id == id; });
+  if (encapsulation == kTwistEncapsulations.end()) return std::nullopt;
+  std::array<double, 6> twist{};
+  for (std::size_t i = 0; i < twist.size(); ++i)
+    twist[i] = read_f64(bytes.data() + kHeader + 8 * i, encapsulation->little_endian);
+  return twist;
+}
 
 MotionWireEncoder::MotionWireEncoder(MotionWireSetup setup) : setup_(std::move(setup)) {}
 

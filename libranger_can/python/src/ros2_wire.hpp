@@ -16,7 +16,9 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "views.hpp"
@@ -49,5 +51,14 @@ class MotionWireEncoder {
  private:
   MotionWireSetup setup_;
 };
+
+// geometry_msgs/Twist read from its serialised form, the bytes rclpy's raw subscription hands
+// over (the node's cmd_vel: no Python message is built for a command): linear x, y, z, then
+// angular x, y, z, as on the wire. Read: plain CDR and plain XCDR2 (encapsulation ids 0x0000,
+// 0x0001, 0x0006, 0x0007), either byte order, the six doubles right after the header; bytes
+// beyond the message (alignment slack, a longer serialisation) ignored. Anything else (shorter,
+// another encapsulation) gives nullopt: the caller hands the bytes to the rmw's own reader. The
+// values are not judged here (NaN and infinity stay what they are: the driver refuses them).
+std::optional<std::array<double, 6>> read_twist(std::string_view bytes);
 
 }  // namespace ranger::python

@@ -538,3 +538,23 @@ def test_motion_wire_encoder_writes_cdr_little_endian(sim):
     assert update.new_estimate and odom is not None and tf is not None
     with pytest.raises(RangerError, match="joint_names must name the 8 joints"):
         ranger_can.MotionWireEncoder("odom", "base_link", joints[:7], [0.0] * 6, [0.0] * 6)
+
+
+def test_read_twist_reads_cdr_and_xcdr2_in_either_byte_order():
+    """read_twist: linear x, y, z, angular x, y, z right after the 4-byte encapsulation header,
+    for plain CDR and plain XCDR2, little and big endian; bytes beyond ignored; what it does not
+    read (short, another encapsulation) gives None, for the rmw to read."""
+    import struct
+    values = (0.5, -0.25, 1e-9, -0.0, 3.0e300, float("-inf"))
+    for header, order in ((b"\x00\x01", "<"), (b"\x00\x00", ">"), (b"\x00\x07", "<"),
+                          (b"\x00\x06", ">")):
+        data = header + b"\x00\x00" + struct.pack(order + "6d", *values)
+        assert ranger_can.read_twist(data) == values, header
+        assert ranger_can.read_twist(data + b"\x00" * 3) == values  # slack, a longer message
+    nan = ranger_can.read_twist(b"\x00\x01\x00\x00" + struct.pack("<6d", *[float("nan")] * 6))
+    assert all(v != v for v in nan)  # passed on as NaN: the driver refuses it, naming the field
+    good = b"\x00\x01\x00\x00" + struct.pack("<6d", *values)
+    assert ranger_can.read_twist(good[:-1]) is None
+    assert ranger_can.read_twist(b"") is None
+    for other in (b"\x00\x03", b"\x00\x09", b"\x00\x0b", b"\x01\x01"):  # PL_CDR, D_CDR2, ...
+        assert ranger_can.read_twist(other + good[2:]) is None, other

@@ -7,9 +7,9 @@ import math
 
 from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
-from geometry_msgs.msg import Quaternion, TransformStamped, TwistStamped
+from geometry_msgs.msg import Quaternion, TransformStamped, Twist, TwistStamped
 from nav_msgs.msg import Odometry
-from rclpy.serialization import deserialize_message
+from rclpy.serialization import deserialize_message, serialize_message
 from ranger_msgs.msg import (ActuatorState, ActuatorStateArray, BmsFlags, BmsState, BmsStateArray,
                              DriverStatus, RemoteState, SystemErrors, SystemState,
                              UltrasonicReading, UltrasonicState)
@@ -132,6 +132,43 @@ def motion_encoder(params, joint_names):
             if read != theirs:
                 return None, name
     return encoder, None
+
+
+# Twists the reader is compared on: (linear x, y, z, angular x, y, z), signs, magnitudes and
+# special values of every kind among them.
+_TWIST_SAMPLES = (
+    (0.5, -0.25, 0.0, 0.0, 0.0, 1.5),
+    (-1.0e-300, 3.0e300, -0.125, 7.0, -8.5, -0.0),
+    (float("inf"), float("-inf"), 1.0, -1.0, 2.0, -2.0),
+)
+
+
+def twist_of(values) -> Twist:
+    msg = Twist()
+    (msg.linear.x, msg.linear.y, msg.linear.z,
+     msg.angular.x, msg.angular.y, msg.angular.z) = values
+    return msg
+
+
+def twist_values(msg: Twist):
+    """(linear x, y, z, angular x, y, z): what ranger_can.read_twist gives."""
+    return (msg.linear.x, msg.linear.y, msg.linear.z,
+            msg.angular.x, msg.angular.y, msg.angular.z)
+
+
+def twist_reader():
+    """cmd_vel's bytes -> twist_values: the binding's reader (ranger_can.read_twist: no Python
+    message built for a command), with the rmw's deserialize_message for what it does not read
+    (another encapsulation); None if this rmw serialises a Twist otherwise than the reader reads
+    it (checked on samples: the node then subscribes with messages)."""
+    for values in _TWIST_SAMPLES:
+        if ranger_can.read_twist(serialize_message(twist_of(values))) != values:
+            return None
+
+    def read(data: bytes):
+        values = ranger_can.read_twist(data)
+        return values if values is not None else twist_values(deserialize_message(data, Twist))
+    return read
 
 
 def to_ground_truth(g, params) -> Odometry:

@@ -14,7 +14,10 @@ their own (as in real use: the node serialises and sends those messages at 50 Hz
   3. latency cmd_vel -> 0x111: --samples twists 50-70 ms apart (at random, so every phase
      against the 20 ms keep-alive occurs), each with its own speed; the node (publish_cmd)
      stamps each 0x111 with its send time on cmd_vel_out; latency = that stamp - the time the
-     twist was published (the first 20 skipped: warm-up).
+     twist was published (its bytes handed to the publisher: serialised beforehand, the
+     sender's own work; the first 20 skipped: warm-up). cmd_vel_out is taken on a thread of
+     its own, and the subscribers take bytes, so the measurement's own Python work stays small
+     beside the node's (two cores: whatever else runs delays the node's threads).
 
   ros2 run ranger_base measure_performance [--duration 30] [--samples 400] [--json FILE]
       [--phases load,floor,latency]
@@ -37,11 +40,14 @@ import time
 
 import rclpy
 from geometry_msgs.msg import Twist, TwistStamped
+from rclpy.serialization import serialize_message
 
 CLK_TCK = os.sysconf("SC_CLK_TCK")
 
-# The subscribers, in a process of their own. They print "ready" once every topic has delivered,
-# and when interrupted each topic's rate (messages/s between its first and its last message).
+# The subscribers, in a process of their own: raw subscriptions (the serialised bytes, no Python
+# message built), so they cost little themselves, as the ROS 1 measurement's rospy.AnyMsg. They
+# print "ready" once every topic has delivered, and when interrupted each topic's rate
+# (messages/s between its first and its last message).
 SUBSCRIBERS = """
 import json, sys, time, rclpy
 from rclpy.executors import ExternalShutdownException
@@ -61,7 +67,7 @@ def on(topic):
             print("ready", flush=True)
     return cb
 for t, kind in topics.items():
-    n.create_subscription(kind, t if t[0] == "/" else f"{ns}/{t}", on(t), 10)
+    n.create_subscription(kind, t if t[0] == "/" else f"{ns}/{t}", on(t), 10, raw=True)
 try:
     rclpy.spin(n)
 except (KeyboardInterrupt, ExternalShutdownException):
@@ -213,19 +219,28 @@ def measure_latency(node, samples, params):
         if t is not None:
             stamp = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
             latencies.append(1000.0 * (stamp - t))
+    from .node import OwnThreadGroup, SubscriptionThread
     with Robot(node, ns, ["publish_cmd:=true", "cmd_vel_timeout:=1.0", *params]):
-        sub = node.create_subscription(TwistStamped, f"{ns}/cmd_vel_out", on_command, 1000)
+        # cmd_vel_out (50 Hz: every keep-alive) on a thread of its own, as the node takes
+        # cmd_vel: not the executor's, whose Python work at every wake-up would hold the GIL
+        # while this thread publishes the twists.
+        sub = node.create_subscription(TwistStamped, f"{ns}/cmd_vel_out", on_command, 1000,
+                                       callback_group=OwnThreadGroup())
+        receiver = SubscriptionThread(node, sub, "perf_cmd_vel_out")
+        receiver.start()
         pub = node.create_publisher(Twist, f"{ns}/cmd_vel", 1)
         wait_for(lambda: pub.get_subscription_count() > 0 and sub.get_publisher_count() > 0)
         cmd = Twist()
         for k in range(samples + 20):
             value = 200 + k % 200  # distinct speeds, 1 mm/s apart (the wire's resolution)
             cmd.linear.x = value / 1000.0
+            data = serialize_message(cmd)  # before the clock starts: the sender's own work
             with lock:
                 sent[value] = time.time()
-            pub.publish(cmd)
+            pub.publish(data)
             time.sleep(random.uniform(0.05, 0.07))
         time.sleep(0.5)
+        receiver.stop()
         node.destroy_subscription(sub)
         node.destroy_publisher(pub)
     ms = latencies[20:] if len(latencies) > 40 else latencies  # skip the warm-up
@@ -238,7 +253,8 @@ def measure_latency(node, samples, params):
 def run_floor(ns):
     """rclpy_floor: odom, /tf and joint_states at 50 Hz and cmd_vel taken, with the node's own
     message code (the binding's serialised bytes, conversions.motion_encoder, where the node uses
-    them, else conversions.MotionMessages) and threads (a publication thread waking every
+    them, else conversions.MotionMessages; cmd_vel's bytes read by conversions.twist_reader)
+    and threads (a publication thread waking every
     20 ms, cmd_vel on a thread of its own), no driver: what rclpy and DDS cost for the traffic."""
     from nav_msgs.msg import Odometry
     from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
@@ -252,8 +268,9 @@ def run_floor(ns):
     odom_pub = node.create_publisher(Odometry, "odom", 10)
     tf_pub = node.create_publisher(TFMessage, "/tf", 100)
     joint_pub = node.create_publisher(JointState, "joint_states", 10)
-    sub = node.create_subscription(Twist, "cmd_vel", lambda _: None, 1,
-                                   callback_group=OwnThreadGroup())
+    read_twist = conversions.twist_reader()  # cmd_vel's bytes read as the node reads them
+    sub = node.create_subscription(Twist, "cmd_vel", read_twist or (lambda _: None), 1,
+                                   callback_group=OwnThreadGroup(), raw=read_twist is not None)
     commands = SubscriptionThread(node, sub, "ranger_cmd_vel")
     params = {"odom_frame": "odom", "base_frame": "base_link",
               "pose_covariance_diagonal": [1e-4] * 6, "twist_covariance_diagonal": [1e-3] * 6}

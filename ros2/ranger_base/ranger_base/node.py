@@ -5,7 +5,8 @@ The driver (the bus, the 20 ms keep-alive, the 500 ms command timeout, the re-ar
 identification, the odometry) runs in C++ on a thread of the library's own; this node maps:
   * cmd_vel -> Driver.command (the driver's mailbox: never waits for the bus), on a thread of the
     node's own that waits for cmd_vel alone (not the executor, whose every wake-up rebuilds its
-    wait set in Python: that costs more than the driver itself and delays the command);
+    wait set in Python: that costs more than the driver itself and delays the command), taking
+    its bytes and reading them in C++ (ranger_can.read_twist: no Python message per command);
   * the driver's estimates -> odom, /tf, joint_states at publish_rate (each estimate once,
     stamped with its frames' time, only while the chassis is heard; Driver.wait_motion paces
     them in C++ and hands over ready values for messages allocated once), the states at
@@ -204,9 +205,12 @@ class RangerNode(Node):
         # cmd_vel on a thread of its own: never queued behind a service waiting for the chassis,
         # never behind the executor's wait-set rebuild.
         self._service_group = MutuallyExclusiveCallbackGroup()
+        # The bytes, read in C++, where this rmw serialises a Twist as the binding reads it.
+        self._read_twist = conversions.twist_reader()
         self.cmd_sub = self.create_subscription(
             Twist, "cmd_vel", self._on_cmd_vel, 1, callback_group=OwnThreadGroup(),
-            event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False))
+            event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False),
+            raw=self._read_twist is not None)
         self._cmd_thread = SubscriptionThread(self, self.cmd_sub, "ranger_cmd_vel")
         joint_names = ranger_can.steering_joint_names() + ranger_can.wheel_joint_names()
         self.motion_messages = conversions.MotionMessages(self.params, joint_names)
@@ -218,6 +222,11 @@ class RangerNode(Node):
                 f"{mismatch}: this rmw ({os.environ.get('RMW_IMPLEMENTATION', 'the default')}) "
                 "does not read the binding's serialised messages as they were meant; odom, /tf "
                 "and joint_states are published as messages (more CPU)")
+        if self._read_twist is None:
+            self.get_logger().warn(
+                f"cmd_vel: this rmw ({os.environ.get('RMW_IMPLEMENTATION', 'the default')}) "
+                "serialises a Twist otherwise than ranger_can.read_twist reads it; cmd_vel is "
+                "taken as messages (more CPU per command)")
         self.inject_sub = (self.create_subscription(String, "sim/inject", self._on_inject, 10,
                                                     callback_group=self._service_group)
                            if self.driver.is_sim else None)
@@ -290,11 +299,14 @@ class RangerNode(Node):
         return SetParametersResult(successful=True)
 
     # ---- callbacks ----
-    def _on_cmd_vel(self, msg: Twist):
+    def _on_cmd_vel(self, msg):
+        """cmd_vel: its bytes (a raw subscription, read by conversions.twist_reader) or a
+        Twist."""
+        vx, vy, vz, wx, wy, wz = (self._read_twist(msg) if self._read_twist is not None
+                                  else conversions.twist_values(msg))
         try:  # all six fields: the driver refuses NaN/inf in any of them, naming it
-            self.driver.command(msg.linear.x, msg.linear.y, msg.angular.z, vz=msg.linear.z,
-                                wx=msg.angular.x, wy=msg.angular.y)
-            if msg.linear.z or msg.angular.x or msg.angular.y:
+            self.driver.command(vx, vy, wz, vz=vz, wx=wx, wy=wy)
+            if vz or wx or wy:
                 self.get_logger().warn("cmd_vel: linear.z, angular.x and angular.y are ignored "
                                        "(planar base)", throttle_duration_sec=5.0)
         except RangerError as e:

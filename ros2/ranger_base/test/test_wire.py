@@ -4,10 +4,13 @@ node publishes as bytes: read by this rmw as exactly the messages the node would
 the rmw leaves bytes unwritten (alignment padding, slack at the end: the encoder writes zeros and
 no slack), for frame names of every length modulo the alignment, joint names of every prefix,
 stamps and values of every sign; read back by rclpy as the values given; and the node's check
-(conversions.motion_encoder) that falls back to messages when the rmw misreads the bytes."""
+(conversions.motion_encoder) that falls back to messages when the rmw misreads the bytes.
+cmd_vel's bytes (ranger_can.read_twist): the rmw's serialisation of every twist read bit for bit,
+what the binding does not read handed to the rmw, and messages where the two disagree."""
 
 import math
 import random
+import struct
 
 import pytest
 from nav_msgs.msg import Odometry
@@ -145,3 +148,46 @@ def test_bad_encoder_arguments_are_named():
         ranger_can.MotionWireEncoder("odom", "base_link", JOINTS[:7], [0.0] * 6, [0.0] * 6)
     with pytest.raises(ranger_can.RangerError, match="covariance diagonal has 6 values, not 5"):
         ranger_can.MotionWireEncoder("odom", "base_link", JOINTS, [0.0] * 5, [0.0] * 6)
+
+
+# cmd_vel's bytes (ranger_can.read_twist, through conversions.twist_reader): what the node reads
+# for every command instead of a Python message.
+def same_values(a, b):
+    """Equal bit for bit, field by field (NaN equals NaN, -0.0 differs from 0.0)."""
+    return len(a) == len(b) and all(struct.pack("<d", x) == struct.pack("<d", y)
+                                    for x, y in zip(a, b))
+
+
+def test_the_reader_reads_the_rmws_own_twists_bit_for_bit():
+    rng = random.Random(4)
+    specials = [0.0, -0.0, math.nan, math.inf, -math.inf, 5e-324, -1.7976931348623157e308]
+    for i in range(300):
+        values = tuple(rng.choice(specials) if rng.random() < 0.2 else
+                       rng.uniform(-1e3, 1e3) * 10.0 ** rng.randint(-12, 12) for _ in range(6))
+        data = serialize_message(conversions.twist_of(values))
+        assert same_values(ranger_can.read_twist(data), values), (i, data.hex())
+
+
+def test_the_node_reads_cmd_vel_bytes_under_this_rmw():
+    read = conversions.twist_reader()
+    assert read is not None
+    values = (0.5, -0.25, 0.0, 0.0, 0.0, 1.5)
+    assert read(serialize_message(conversions.twist_of(values))) == values
+
+
+def test_bytes_the_reader_does_not_read_go_to_the_rmw(monkeypatch):
+    """An encapsulation the binding does not read (read_twist gives None): the rmw reads it."""
+    read = conversions.twist_reader()
+    monkeypatch.setattr(ranger_can, "read_twist", lambda data: None)
+    values = (0.125, 0.0, -1.0, 2.0, 0.0, -0.75)
+    assert read(serialize_message(conversions.twist_of(values))) == values
+
+
+def test_a_reader_that_misreads_this_rmw_means_messages(monkeypatch):
+    real = ranger_can.read_twist
+
+    def swapped(data):  # linear and angular the other way round
+        v = real(data)
+        return v[3:] + v[:3]
+    monkeypatch.setattr(ranger_can, "read_twist", swapped)
+    assert conversions.twist_reader() is None
