@@ -4,16 +4,16 @@
 # Usage: scripts/build.sh [lib|ros|all]    (default all; in the ROS workspace the library's own
 # tests are off: they are built in build/lib)
 # Environment: RANGER_BUILD_TYPE (default RelWithDebInfo), RANGER_JOBS (default nproc).
-# RelWithDebInfo here is -O2 with line tables only (-g1): backtraces, sanitizers and perf keep file
-# and line, and the build takes about a third less time than with full debug information (-g: every
-# type and variable; test_codec.cpp compiles in 15 s against 22 s). For a debugger session:
-# RANGER_BUILD_TYPE=Debug. RANGER_RELWITHDEBINFO_FLAGS replaces the flags.
+# RelWithDebInfo here is -O2 with line tables only (-g1; scripts/build_flags.sh says why and
+# RANGER_RELWITHDEBINFO_FLAGS replaces them). For a debugger session: RANGER_BUILD_TYPE=Debug.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# shellcheck source=build_flags.sh
+source scripts/build_flags.sh
 what=${1:-all}
 build_type=${RANGER_BUILD_TYPE:-RelWithDebInfo}
 jobs=${RANGER_JOBS:-$(nproc)}
-relwithdebinfo=-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=${RANGER_RELWITHDEBINFO_FLAGS:--O2 -g1 -DNDEBUG}
+relwithdebinfo=-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=$ranger_relwithdebinfo_flags
 generator=()
 command -v ninja >/dev/null && generator=(-G Ninja)
 

@@ -15,6 +15,8 @@
 # the repository's seed corpus stays small); crashes go to build/fuzz/artifacts/<target>/.
 set -uo pipefail
 cd "$(dirname "$0")/.."
+# shellcheck source=build_flags.sh
+source scripts/build_flags.sh
 root=$(pwd)
 total=${1:-60}
 shift || true
@@ -50,7 +52,7 @@ start=$SECONDS
 # libranger_can on its own (not the repository root): the fuzzers need neither the unit tests
 # nor the system suites.
 CC=clang CXX=clang++ cmake -S libranger_can -B "$build" "${generator[@]}" \
-  -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -g1 -DNDEBUG" \
+  -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=$ranger_relwithdebinfo_flags" \
   -DRANGER_BUILD_FUZZERS=ON -DRANGER_BUILD_TESTS=OFF \
   -DRANGER_BUILD_BENCHMARKS=OFF >/dev/null || { echo "fuzz.sh: configure failed" >&2; exit 1; }
 cmake --build "$build" -j "$jobs" --target "${targets[@]}" ||

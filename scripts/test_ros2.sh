@@ -13,6 +13,8 @@
 # RANGER_JOBS, RANGER_ROS2_SKIP_PIP=1 to leave out step 4.
 set -uo pipefail
 cd "$(dirname "$0")/.."
+# shellcheck source=build_flags.sh
+source scripts/build_flags.sh
 root=$(pwd)
 results=${1:-$root/build/test-results}
 mkdir -p "$results"
@@ -32,7 +34,7 @@ failed=0
   cd "$ws"
   colcon --log-base log build --paths src/ranger_ros/ros2/* \
     --event-handlers console_cohesion- summary+ --parallel-workers "$jobs" \
-    --cmake-args -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -g1 -DNDEBUG" \
+    --cmake-args -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=$ranger_relwithdebinfo_flags" \
     -DBUILD_TESTING=OFF
 ) || { echo "test_ros2: the colcon build failed" >&2; exit 1; }
 

@@ -51,11 +51,11 @@ if [ -f /opt/ros/noetic/setup.bash ]; then set +u; source /opt/ros/noetic/setup.
 mkdir -p "$work" && touch "$root/build/COLCON_IGNORE" "$root/build/CATKIN_IGNORE"
 failed=()
 
-# A fresh workspace WS with the repository in WS/src/ranger_ros. Every tool gets a fresh one at
-# the same path (build/workspaces/ws), so that with ccache (below) the library's files, compiled
-# alike by each tool, are compiled once.
+# A fresh workspace $ws with the repository in $ws/src/ranger_ros. Every tool gets a fresh one at
+# the same path, so that with ccache (below) the library's files, compiled alike by each tool, are
+# compiled once.
+ws=$work/ws
 fresh_workspace() {
-  local ws=$1
   rm -rf "$ws" && mkdir -p "$ws/src/ranger_ros"
   git ls-files -z | tar --null -T - --ignore-failed-read -c 2>/dev/null \
     | tar -x -C "$ws/src/ranger_ros"
@@ -152,28 +152,24 @@ launcher_args=()
 # CMake >= 3.20 (Noetic's catkin on Ubuntu 20.04 does not), so catkin with CMake 3.16 is a
 # combination no user has.
 step_catkin_make() {
-  local ws=$work/ws
-  fresh_workspace "$ws"
+  fresh_workspace
   (cd "$ws" && checked_build "$work/catkin_make.log" catkin_make -j"$jobs") || return 1
   run_driver "$ws/devel/setup.bash"
 }
 
 step_catkin_make_isolated() {
-  local ws=$work/ws
-  fresh_workspace "$ws"
+  fresh_workspace
   (cd "$ws" && checked_build "$work/catkin_make_isolated.log" catkin_make_isolated -j"$jobs")
 }
 
 step_catkin_build() {
-  local ws=$work/ws
-  fresh_workspace "$ws"
+  fresh_workspace
   (cd "$ws" && catkin init >/dev/null &&
     checked_build "$work/catkin_build.log" catkin build --no-status --no-notify -j"$jobs" -p 1)
 }
 
 step_colcon() {
-  local ws=$work/ws
-  fresh_workspace "$ws"
+  fresh_workspace
   # colcon runs make with -j<cores> -l<cores> unless MAKEFLAGS is set: the load limit would make
   # it build one file at a time while CI's background lane (scripts/test.sh) is busy.
   (cd "$ws" && MAKEFLAGS=-j$jobs checked_build "$work/colcon.log" colcon build \

@@ -122,13 +122,13 @@ def test_rviz_draws_the_moving_robot(master):
         # Mesa's software GL (llvmpipe) has been seen to crash inside libLLVM while rviz starts on
         # a busy machine (SIGSEGV, once in many runs): rviz is started once more then, and the test
         # says so; a second death fails it.
-        restarted = []
+        restarted = False
 
         def drawn():
-            nonlocal rviz
+            nonlocal rviz, restarted
             if not rviz.alive() and not restarted:
-                restarted.append(rviz.log_text()[-1500:])
-                print("rviz died; starting it once more. Its log:\n" + restarted[0])
+                restarted = True
+                print("rviz died; starting it once more. Its log:\n" + rviz.log_text()[-1500:])
                 rviz.stop()
                 rviz = Launch(master, "display.launch", log_name="rviz-again", env=env)
             cmd_vel.publish(arc)
