@@ -205,28 +205,29 @@ class RangerNode(Node):
         # cmd_vel on a thread of its own: never queued behind a service waiting for the chassis,
         # never behind the executor's wait-set rebuild.
         self._service_group = MutuallyExclusiveCallbackGroup()
-        # The bytes, read in C++, where this rmw serialises a Twist as the binding reads it.
-        self._read_twist = conversions.twist_reader()
+        # The bytes, read in C++, where this rmw serialises a Twist as the binding reads it;
+        # else messages. Either way _twist_values gives (linear x, y, z, angular x, y, z).
+        read_twist = conversions.twist_reader()
+        self._twist_values = read_twist or conversions.twist_values
         self.cmd_sub = self.create_subscription(
             Twist, "cmd_vel", self._on_cmd_vel, 1, callback_group=OwnThreadGroup(),
             event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False),
-            raw=self._read_twist is not None)
+            raw=read_twist is not None)
         self._cmd_thread = SubscriptionThread(self, self.cmd_sub, "ranger_cmd_vel")
         joint_names = ranger_can.steering_joint_names() + ranger_can.wheel_joint_names()
         self.motion_messages = conversions.MotionMessages(self.params, joint_names)
         # odom, /tf and joint_states serialised in C++ where this rmw reads the bytes as the
         # messages themselves.
         self.motion_wire, mismatch = conversions.motion_encoder(self.params, joint_names)
+        rmw = f"this rmw ({os.environ.get('RMW_IMPLEMENTATION', 'the default')})"
         if mismatch:
             self.get_logger().warn(
-                f"{mismatch}: this rmw ({os.environ.get('RMW_IMPLEMENTATION', 'the default')}) "
-                "does not read the binding's serialised messages as they were meant; odom, /tf "
-                "and joint_states are published as messages (more CPU)")
-        if self._read_twist is None:
+                f"{mismatch}: {rmw} does not read the binding's serialised messages as they "
+                "were meant; odom, /tf and joint_states are published as messages (more CPU)")
+        if read_twist is None:
             self.get_logger().warn(
-                f"cmd_vel: this rmw ({os.environ.get('RMW_IMPLEMENTATION', 'the default')}) "
-                "serialises a Twist otherwise than ranger_can.read_twist reads it; cmd_vel is "
-                "taken as messages (more CPU per command)")
+                f"cmd_vel: {rmw} serialises a Twist otherwise than ranger_can.read_twist reads "
+                "it; cmd_vel is taken as messages (more CPU per command)")
         self.inject_sub = (self.create_subscription(String, "sim/inject", self._on_inject, 10,
                                                     callback_group=self._service_group)
                            if self.driver.is_sim else None)
@@ -302,8 +303,7 @@ class RangerNode(Node):
     def _on_cmd_vel(self, msg):
         """cmd_vel: its bytes (a raw subscription, read by conversions.twist_reader) or a
         Twist."""
-        vx, vy, vz, wx, wy, wz = (self._read_twist(msg) if self._read_twist is not None
-                                  else conversions.twist_values(msg))
+        vx, vy, vz, wx, wy, wz = self._twist_values(msg)
         try:  # all six fields: the driver refuses NaN/inf in any of them, naming it
             self.driver.command(vx, vy, wz, vz=vz, wx=wx, wy=wy)
             if vz or wx or wy:
