@@ -221,11 +221,11 @@ class RangerNode(Node):
         self.motion_wire, mismatch = conversions.motion_encoder(self.params, joint_names)
         rmw = f"this rmw ({os.environ.get('RMW_IMPLEMENTATION', 'the default')})"
         if mismatch:
-            self.get_logger().warn(
+            self.get_logger().warning(
                 f"{mismatch}: {rmw} does not read the binding's serialised messages as they "
                 "were meant; odom, /tf and joint_states are published as messages (more CPU)")
         if read_twist is None:
-            self.get_logger().warn(
+            self.get_logger().warning(
                 f"cmd_vel: {rmw} serialises a Twist otherwise than ranger_can.read_twist reads "
                 "it; cmd_vel is taken as messages (more CPU per command)")
         self.inject_sub = (self.create_subscription(String, "sim/inject", self._on_inject, 10,
@@ -307,20 +307,20 @@ class RangerNode(Node):
         try:  # all six fields: the driver refuses NaN/inf in any of them, naming it
             self.driver.command(vx, vy, wz, vz=vz, wx=wx, wy=wy)
             if vz or wx or wy:
-                self.get_logger().warn("cmd_vel: linear.z, angular.x and angular.y are ignored "
-                                       "(planar base)", throttle_duration_sec=5.0)
+                self.get_logger().warning("cmd_vel: linear.z, angular.x and angular.y are "
+                                          "ignored (planar base)", throttle_duration_sec=5.0)
         except RangerError as e:
             if e.code == "not_finite":
                 self.get_logger().error(f"cmd_vel refused, chassis stopped: {e}",
                                         throttle_duration_sec=1.0)
             else:
-                self.get_logger().warn(f"cmd_vel not applied: {e}", throttle_duration_sec=5.0)
+                self.get_logger().warning(f"cmd_vel not applied: {e}", throttle_duration_sec=5.0)
 
     def _on_inject(self, msg: String):
         try:
             said = self.driver.inject(msg.data)
         except RangerError as e:
-            self.get_logger().warn(f"sim/inject \"{msg.data}\" not applied: {e}")
+            self.get_logger().warning(f"sim/inject \"{msg.data}\" not applied: {e}")
             return
         self.get_logger().info(f"sim/inject \"{msg.data}\" applied to the virtual chassis"
                                + (f": {said}" if said else ""))
@@ -445,7 +445,7 @@ class RangerNode(Node):
         reported = self.driver.snapshot().drive_mode_raw
         response.drive_mode = SystemState.DRIVE_MODE_NONE if reported is None else reported
         if not response.success:
-            self.get_logger().warn(f"set_drive_mode: {response.message}")
+            self.get_logger().warning(f"set_drive_mode: {response.message}")
         return response
 
     # ---- publication (a thread of the node's own) ----
@@ -565,10 +565,18 @@ class RangerNode(Node):
             self._log_at(event.severity, event.text)
 
     def _log_at(self, severity, text):
-        """A line of the library's at its severity (debug, info, warn, error)."""
+        """A line of the library's at its severity (debug, info, warn, error). A call site of its
+        own per severity: rclpy keeps a logging call's context (severity, filters) by where it is
+        called from and refuses another severity there (ValueError: the line is lost)."""
         log = self.get_logger()
-        {"debug": log.debug, "info": log.info, "warn": log.warn,
-         "error": log.error}.get(severity, log.info)(text)
+        if severity == "error":
+            log.error(text)
+        elif severity == "warn":
+            log.warning(text)
+        elif severity == "debug":
+            log.debug(text)
+        else:
+            log.info(text)
 
     def _publish_diagnostics(self):
         """The library's diagnostic groups of the latest snapshot (ranger_can's
