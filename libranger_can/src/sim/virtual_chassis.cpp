@@ -137,20 +137,27 @@ void VirtualChassis::step(Timestamp now) {
   }
 }
 
-void VirtualChassis::poll(Timestamp now) {
+bool VirtualChassis::poll(Timestamp now) {
+  bool ok = true;
   for (;;) {
     auto r = bus_.receive(std::chrono::nanoseconds(0));
-    if (!r) break;
+    if (!r) {
+      ok = r.error().code == Errc::kTimeout;
+      break;
+    }
     on_frame(*r, now);
   }
   step(now);
+  return ok;
 }
 
 void VirtualChassis::advance_to(Timestamp t) {
   t = std::max(t, now_);
-  // After a long stall, do not replay a burst of stale feedback: resume the schedule from now.
+  // After a stall longer than the replay window, do not replay a burst of stale feedback: resume
+  // the schedule from now.
   for (auto& s : schedules_) {
-    if (s.next_due + 5 * s.period < t) s.next_due = t;
+    const auto window = config_.replay_window.count() > 0 ? config_.replay_window : 5 * s.period;
+    if (s.next_due + window < t) s.next_due = t;
   }
   for (;;) {
     const Timestamp next = next_timed_event();

@@ -1,5 +1,6 @@
 #include "ranger_can/sim/virtual_chassis_runner.hpp"
 
+#include <poll.h>
 #include <pthread.h>
 
 #include <algorithm>
@@ -30,7 +31,30 @@ void VirtualChassisRunner::stop() {
   stop_requested_ = true;
   if (thread_.joinable()) thread_.join();
   running_ = false;
+  std::lock_guard<std::mutex> lock(mutex_);
+  closed_ = true;
 }
+
+void VirtualChassisRunner::catch_up() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!closed_) chassis_->poll(clock_.now());
+}
+
+namespace {
+
+// Waits until `fd` is readable or `timeout` has passed (EINTR counts as a wake-up).
+void wait_readable(int fd, std::chrono::nanoseconds timeout) {
+  if (fd < 0) {
+    std::this_thread::sleep_for(timeout);
+    return;
+  }
+  pollfd p{fd, POLLIN, 0};
+  const timespec ts{static_cast<time_t>(timeout.count() / 1'000'000'000),
+                    static_cast<long>(timeout.count() % 1'000'000'000)};
+  ::ppoll(&p, 1, &ts, nullptr);
+}
+
+}  // namespace
 
 std::string VirtualChassisRunner::failure() const {
   std::lock_guard<std::mutex> lock(mutex_);
@@ -49,14 +73,16 @@ void VirtualChassisRunner::loop() {
       }
       const auto wait = std::clamp<std::chrono::nanoseconds>(deadline - clock_.now(),
                                                              std::chrono::nanoseconds(0), kMaxWait);
-      auto frame = bus_.receive(wait);
-      if (!frame && frame.error().code != Errc::kTimeout) {
-        // The bus reopens a lost interface by itself; do not spin meanwhile.
-        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      // Frames are taken only with the chassis held (here or in catch_up()), so that the chassis
+      // sees them in the order they came whichever thread hands them over.
+      wait_readable(bus_.fd(), wait);
+      bool bus_ok = true;
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        bus_ok = chassis_->poll(clock_.now());
       }
-      std::lock_guard<std::mutex> lock(mutex_);
-      if (frame) chassis_->on_frame(*frame, clock_.now());
-      chassis_->step(clock_.now());
+      // The bus reopens a lost interface by itself; do not spin meanwhile.
+      if (!bus_ok) std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
   } catch (const std::exception& e) {  // never let an exception escape the thread
     std::lock_guard<std::mutex> lock(mutex_);

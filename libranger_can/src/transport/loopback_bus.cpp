@@ -70,7 +70,7 @@ struct Wire {
 
   // Puts `frame` on the wire now: every other attached endpoint whose filter accepts it.
   void deliver(std::uint64_t sender, CanFrame frame) {
-    frame.stamp = clock->now();
+    if (!options.sender_stamps || frame.stamp == Timestamp{0}) frame.stamp = clock->now();
     for (const auto& ep : endpoints) {
       if (ep->number == sender || !ep->attached || ep->loss_pending) continue;
       if (!frame.is_error && !ep->filter.accepts(frame.id)) continue;

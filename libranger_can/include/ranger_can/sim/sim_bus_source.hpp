@@ -59,7 +59,10 @@ class SimBusSource final : public BusSource {
                const Clock& clock);
   ~SimBusSource() override;
 
-  Result<std::unique_ptr<Bus>> open() override;  // a new endpoint on the chassis's network
+  // A new endpoint on the chassis's network. With the chassis on a thread of its own, every
+  // receive on it first catches the chassis up to the clock (VirtualChassisRunner::catch_up), as
+  // a reader of a real bus finds what a chassis sent while the reader's host was busy.
+  Result<std::unique_ptr<Bus>> open() override;
   std::string name() const override { return spec_; }
 
   // Runs `f(VirtualChassis&)` with the chassis held (fault injection, ground truth).
@@ -86,7 +89,7 @@ class SimBusSource final : public BusSource {
   std::string spec_;
   std::unique_ptr<LoopbackNetwork> network_;
   std::unique_ptr<Bus> chassis_bus_;
-  std::unique_ptr<VirtualChassisRunner> runner_;  // threaded
+  std::shared_ptr<VirtualChassisRunner> runner_;  // threaded (the endpoints hold it weakly)
   std::mutex mutex_;                              // lock-step
   std::unique_ptr<VirtualChassis> chassis_;       // lock-step
 };

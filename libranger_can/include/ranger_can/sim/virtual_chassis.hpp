@@ -138,6 +138,12 @@ struct VirtualChassisConfig {
   bool ultrasonic_enabled = false;
   std::int16_t ultrasonic_stop_distance_mm = 300;  // avoidance triggers below this (if enabled)
   std::uint32_t garbage_seed = 1;                  // the garbage-frame generator is deterministic
+  // The chassis keeps its own timeline: stepped late (its thread not run for a while), it sends
+  // the frames that fell due meanwhile, each stamped with its due time, as a real chassis's
+  // frames wait in the kernel's queue with their reception times. A stall longer than this is
+  // not replayed: the schedule resumes from now (a chassis that was truly silent, or a lock-step
+  // owner that jumped its clock). Zero: five periods of each frame.
+  std::chrono::nanoseconds replay_window{0};
 };
 
 // Something the chassis did that a person watching would want to know.
@@ -198,8 +204,9 @@ class VirtualChassis {
   // Advances to `now` and sends the feedback that fell due. Time never runs backwards: an
   // earlier `now` is treated as the last one.
   void step(Timestamp now);
-  // Convenience: hands every frame waiting on the bus to on_frame, then steps to `now`.
-  void poll(Timestamp now);
+  // Convenience: hands every frame waiting on the bus to on_frame, then steps to `now`. false when
+  // the bus reported an error (other than "nothing waiting") instead of a frame.
+  bool poll(Timestamp now);
   // The earliest time at which step() has something to do (a feedback frame or a timeout).
   Timestamp next_deadline() const;
   Timestamp now() const { return now_; }

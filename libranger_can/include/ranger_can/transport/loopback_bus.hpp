@@ -35,11 +35,11 @@
 #include <string_view>
 #include <vector>
 
-#include "ranger_can/transport/bus.hpp"
 #include "ranger_can/clock.hpp"
+#include "ranger_can/result.hpp"
+#include "ranger_can/transport/bus.hpp"
 #include "ranger_can/wire/frame.hpp"
 #include "ranger_can/wire/protocol.hpp"
-#include "ranger_can/result.hpp"
 
 namespace ranger {
 
@@ -53,6 +53,10 @@ struct LoopbackOptions {
   // Stamps frames and rate-limits reopening. nullptr = SystemClock (the epoch of SocketCAN's
   // timestamps). Must outlive the network and its endpoints.
   const Clock* clock = nullptr;
+  // false: every frame is stamped with the clock when it goes on the wire. true: a frame that
+  // carries a stamp keeps it (a sender with a timeline of its own, the virtual chassis, sends the
+  // frames of a late step stamped with their due times); an unstamped one gets the clock's.
+  bool sender_stamps = false;
 };
 
 namespace loopback_detail {
