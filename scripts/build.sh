@@ -34,7 +34,10 @@ echo "== build: ROS packages (colcon -> install/)"
 # The ROS build must use the system Python (python3 on PATH may be a pyenv without ROS modules).
 export PATH=/usr/bin:$PATH
 if [ -f /opt/ros/noetic/setup.bash ]; then set +u; source /opt/ros/noetic/setup.bash; set -u; fi
-colcon --log-base build/log build --base-paths . --build-base build/ws --install-base install \
+# colcon runs make with -j<cores> -l<cores> unless MAKEFLAGS is set: under load (scripts/test.sh's
+# background lane) the load limit would build one file at a time.
+MAKEFLAGS=${MAKEFLAGS:--j$jobs} colcon --log-base build/log build --base-paths . \
+  --build-base build/ws --install-base install \
   --event-handlers console_cohesion- summary+ \
   --parallel-workers "$jobs" \
   --cmake-args -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE="$build_type" "$relwithdebinfo"

@@ -39,6 +39,14 @@ results=$root/build/test-results
 stages=${RANGER_STAGES:-unit vcan ros_vcan ros ros2 workspaces sanitize fuzz}
 failed=()
 passed=()
+declare -A stage_time=()   # stage -> "SECONDS s" (with ", background" for the lane's)
+timing_order=()            # the order the stages ended in, for the summary
+run_start=$SECONDS
+
+note_time() {  # name seconds [where]
+  stage_time[$1]="$2 s${3:+, $3}"
+  timing_order+=("$1")
+}
 
 run_stage() {  # name command...
   local name=$1
@@ -53,6 +61,7 @@ run_stage() {  # name command...
     failed+=("$name")
     echo "== stage $name: FAILED ($((SECONDS - start)) s)"
   fi
+  note_time "$name" $((SECONDS - start))
 }
 
 stage_unit() {
@@ -118,7 +127,10 @@ start_lane() {  # stages...: run them in turn in the background, each into lane/
   lane_pid=$!
   set +m
 }
-stop_lane() { [ -z "$lane_pid" ] || kill -TERM -- "-$lane_pid" 2>/dev/null; }
+stop_lane() {
+  [ -z "$lane_pid" ] || kill -TERM -- "-$lane_pid" 2>/dev/null
+  [ -z "${prepare_pid:-}" ] || kill -TERM "$prepare_pid" 2>/dev/null
+}
 trap stop_lane EXIT
 trap 'stop_lane; exit 130' INT TERM
 finish_lane() {  # stages...: wait for the lane, then print and count each stage
@@ -133,21 +145,66 @@ finish_lane() {  # stages...: wait for the lane, then print and count each stage
     echo
     echo "==================== stage: $s (background lane) ===================="
     cat "$lane_dir/$s.log" 2>/dev/null
-    if read -r rc seconds 2>/dev/null <"$lane_dir/$s.status" && [ "$rc" = 0 ]; then
+    rc=1 seconds=
+    read -r rc seconds 2>/dev/null <"$lane_dir/$s.status"
+    if [ "$rc" = 0 ]; then
       passed+=("$s")
       echo "== stage $s: ok ($seconds s, in the background)"
     else
       failed+=("$s")
       echo "== stage $s: FAILED (${seconds:-?} s, in the background)"
     fi
+    note_time "$s" "${seconds:-?}" background
   done
 }
 
+# ---- what only downloads, beside the first build ----
+# The Python environments the later stages install from PyPI (the ROS 2 wheels, CMake 3.16 for the
+# workspaces stage, cantools for the DBC check) are made while the first build compiles; the
+# stages find them complete. Their output: build/lane/prepare.log, printed when it fails.
+wants() {  # stage: is it among the selected stages?
+  local s
+  for s in $stages; do [ "$s" = "$1" ] && return 0; done
+  return 1
+}
+prepare_pid=
+start_prepare() {
+  (
+    rc=0
+    if wants ros2; then scripts/setup_ros2.sh >/dev/null || rc=1; fi
+    if wants workspaces; then scripts/test_workspaces.sh prepare || rc=1; fi
+    if wants unit; then
+      /usr/bin/python3 tests/dbc/check_dbc.py --venv "$root/build/lib/dbc-venv" --venv-only || rc=1
+    fi
+    exit $rc
+  ) </dev/null >"$lane_dir/prepare.log" 2>&1 &
+  prepare_pid=$!
+}
+finish_prepare() {
+  [ -n "$prepare_pid" ] || return 0
+  local start=$SECONDS
+  if wait "$prepare_pid"; then
+    echo "== downloads done (waited $((SECONDS - start)) s after the build)"
+  else
+    echo "== preparing the stages' Python environments failed (the stages try again):"
+    tail -30 "$lane_dir/prepare.log"
+  fi
+  prepare_pid=
+}
+
 echo "== setup"
+setup_start=$SECONDS
 scripts/setup.sh test || { echo "setup failed: cannot install the system packages" >&2; exit 1; }
+note_time setup $((SECONDS - setup_start))
+# shellcheck source=ccache_env.sh
+source scripts/ccache_env.sh
 rm -rf "$results" "$lane_dir" && mkdir -p "$results" "$lane_dir"
+start_prepare
 echo "== build"
+build_start=$SECONDS
 scripts/build.sh all || { echo "build failed" >&2; exit 1; }
+note_time build $((SECONDS - build_start))
+finish_prepare
 
 read -r -a stage_list <<<"$stages"
 lane=()
@@ -178,5 +235,9 @@ echo
 echo "==================== summary ===================="
 echo "stages passed: ${passed[*]:-none}"
 echo "stages failed: ${failed[*]:-none}"
+echo "wall time per stage (the background lane's beside the foreground's):"
+for s in "${timing_order[@]}"; do printf '  %-11s %s\n' "$s" "${stage_time[$s]}"; done
+printf '  %-11s %s s\n' total $((SECONDS - run_start))
+ranger_ccache_summary
 python3 scripts/junit_summary.py "$results"
 [ ${#failed[@]} -eq 0 ]

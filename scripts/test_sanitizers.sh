@@ -4,7 +4,12 @@
 #   address  libranger_can, its tool, its unit tests and the system suites in tests/ with
 #            AddressSanitizer + UndefinedBehaviorSanitizer (build/asan); every CTest case that
 #            needs no kernel CAN support (label != vcan) but the lock-step suites (see below).
-#   thread   the same with ThreadSanitizer (build/tsan).
+#   thread   ThreadSanitizer (build/tsan) on the suites that start threads: the tool and the
+#            test executables labelled `threads` (CTest label; target ranger_threaded_tests), and
+#            only their cases. The plain build's thread guard (libranger_can/test/thread_guard/)
+#            fails a suite that starts a thread without the label, so a new threaded suite is
+#            chosen by labelling it. The other suites run on the test's one thread: TSan has
+#            nothing to watch in them.
 #   ros      the ROS packages up to ranger_base (libranger_can, ranger_msgs, ranger_base) with
 #            ASan + UBSan in a colcon workspace of their own (build/asan-ws, build/asan-install),
 #            then ranger_base's gtests and rostests (the node itself runs instrumented).
@@ -66,8 +71,15 @@ check_reports() {  # name report_dir
 }
 
 # libranger_can + tests/ with one sanitizer, via plain CMake from the repository root.
-run_cmake_build() {  # name dir RANGER_SANITIZE common_flags flags [ctest -E regex]
-  local name=$1 dir=$2 sanitize=$3 common_flags=$4 flags=$5 exclude=${6:-} start=$SECONDS rc=0
+# SELECT: "all" (every target; every CTest case but the vcan ones) or "threads" (the tool and the
+# suites labelled `threads`, ranger_threaded_tests; only their cases).
+run_cmake_build() {  # name dir RANGER_SANITIZE common_flags flags SELECT [ctest -E regex]
+  local name=$1 dir=$2 sanitize=$3 common_flags=$4 flags=$5 select=$6 exclude=${7:-}
+  local start=$SECONDS rc=0 targets=() labels=(-LE vcan)
+  if [ "$select" = threads ]; then
+    targets=(--target ranger_can_tool ranger_threaded_tests)
+    labels=(-L threads -LE vcan)
+  fi
   echo "== $name: configure + build ($dir)"
   # RANGER_SANITIZE instruments libranger_can's directory; the system suites in tests/ are a
   # sibling directory, so the same flags also go in CMAKE_CXX_FLAGS to instrument them too.
@@ -75,7 +87,7 @@ run_cmake_build() {  # name dir RANGER_SANITIZE common_flags flags [ctest -E reg
     -DRANGER_SANITIZE="$sanitize" -DRANGER_BUILD_BENCHMARKS=OFF -DRANGER_BUILD_TESTS=ON \
     -DCMAKE_CXX_FLAGS="$common_flags $flags" \
     -DCMAKE_EXE_LINKER_FLAGS="$flags" -DCMAKE_SHARED_LINKER_FLAGS="$flags" >/dev/null ||
-    ! cmake --build "$dir" -j "$jobs"; then
+    ! cmake --build "$dir" -j "$jobs" "${targets[@]}"; then
     echo "== $name: BUILD FAILED"
     return 1
   fi
@@ -84,12 +96,12 @@ run_cmake_build() {  # name dir RANGER_SANITIZE common_flags flags [ctest -E reg
   start=$SECONDS
   (
     set_sanitizer_env "$root/$dir/sanitizer-reports"
-    echo "== $name: ctest (label != vcan)"
+    echo "== $name: ctest (${labels[*]})"
     rc=0
     local skip=()
     [ -n "$exclude" ] && skip=(-E "$exclude")
-    ctest --test-dir "$dir" -LE vcan "${skip[@]}" --output-on-failure -j "$jobs" --timeout 600 \
-      --output-junit "$results/$name.xml" || rc=1
+    ctest --test-dir "$dir" "${labels[@]}" "${skip[@]}" --output-on-failure -j "$jobs" \
+      --timeout 600 --no-tests=error --output-junit "$results/$name.xml" || rc=1
     if [ "${RANGER_SANITIZE_VCAN:-0}" = 1 ] && [ "$sanitize" = address ]; then
       echo "== $name: vcan suites"
       scripts/run_vcan_tests.sh "$dir" --junit "$results/$name-vcan.xml" || rc=1
@@ -110,8 +122,10 @@ run_ros_build() {
     # ROS's Python tools need the system interpreter (python3 on PATH may be a pyenv).
     export PATH=/usr/bin:$PATH
     if [ -f /opt/ros/noetic/setup.bash ]; then set +u; source /opt/ros/noetic/setup.bash; set -u; fi
-    colcon --log-base build/log-asan build --base-paths . --packages-up-to ranger_base \
-      --build-base "$ws" --install-base "$install" \
+    # Without make's load limit (colcon's default -l<cores>): beside the foreground's stages it
+    # would build one file at a time.
+    MAKEFLAGS=-j$jobs colcon --log-base build/log-asan build --base-paths . \
+      --packages-up-to ranger_base --build-base "$ws" --install-base "$install" \
       --event-handlers console_cohesion- summary+ --parallel-workers 1 \
       --cmake-args -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=Debug \
       "-DCMAKE_CXX_FLAGS=$asan_common_flags $asan_flags" \
@@ -156,11 +170,11 @@ for kind in "${kinds[@]}"; do
     # build they take half of the run time.
     address)
       name=asan
-      run=(run_cmake_build asan build/asan address "$asan_common_flags" "$asan_flags" '^LockStep/')
+      run=(run_cmake_build asan build/asan address "$asan_common_flags" "$asan_flags" all '^LockStep/')
       ;;
     thread)
       name=tsan
-      run=(run_cmake_build tsan build/tsan thread "$tsan_common_flags" "$tsan_flags" '^LockStep/')
+      run=(run_cmake_build tsan build/tsan thread "$tsan_common_flags" "$tsan_flags" threads)
       ;;
     ros) name=asan-ros; run=(run_ros_build) ;;
     *)

@@ -15,6 +15,7 @@
 #   catkin_build          `catkin build` (catkin_tools) in a fresh build/workspaces/ws
 #   colcon                `colcon build` in a fresh build/workspaces/ws
 #                         (each build's output: build/workspaces/<step>.log)
+#   prepare               only CMake 3.16's venv (below), nothing built
 #   cmake316              CMake 3.16 (pip, in a venv cached under build/cmake-3.16): the top-level
 #                         build configured (library, tool, unit tests, system suites) and the tool
 #                         and two test executables built and run; RANGER_CMAKE316_FULL=1 builds and
@@ -39,12 +40,16 @@ steps=${*:-lint catkin_make catkin_build colcon cmake316}
 build_type=${RANGER_WORKSPACE_BUILD_TYPE-Debug}
 if [ -n "$build_type" ]; then export CMAKE_BUILD_TYPE=$build_type; else unset CMAKE_BUILD_TYPE; fi
 # ccache (where installed; RANGER_WORKSPACE_CCACHE=0 turns it off) through CMake's
-# CMAKE_CXX_COMPILER_LAUNCHER environment variable, with a cache of this run's own (emptied first:
-# the first tool compiles everything): the later tools find the library's objects in it. The
-# directory is not hashed (the build directories differ by tool; only debug information names it).
+# CMAKE_CXX_COMPILER_LAUNCHER environment variable: the test run's one cache (scripts/ccache_env.sh,
+# which scripts/test.sh sources, or sourced here when run alone). Each tool builds in a fresh
+# workspace at the same path, so the later tools find the library's objects in it.
 if [ "${RANGER_WORKSPACE_CCACHE:-1}" != 0 ] && command -v ccache >/dev/null; then
-  export CMAKE_CXX_COMPILER_LAUNCHER=ccache CCACHE_DIR=$work/ccache CCACHE_NOHASHDIR=true
-  rm -rf "$CCACHE_DIR"
+  if [ -z "${CMAKE_CXX_COMPILER_LAUNCHER:-}" ]; then
+    # shellcheck source=ccache_env.sh
+    source scripts/ccache_env.sh
+  fi
+else
+  unset CMAKE_CXX_COMPILER_LAUNCHER CMAKE_C_COMPILER_LAUNCHER
 fi
 export PATH=/usr/bin:$PATH  # the ROS tools need Debian's python3, not a pyenv one
 if [ -f /opt/ros/noetic/setup.bash ]; then set +u; source /opt/ros/noetic/setup.bash; set -u; fi
@@ -175,6 +180,9 @@ step_colcon() {
   (cd "$ws" && MAKEFLAGS=-j$jobs checked_build "$work/colcon.log" colcon build \
     --event-handlers console_direct+ --executor sequential)
 }
+
+# Not a build: only makes CMake 3.16's venv (scripts/test.sh runs it beside its first build).
+step_prepare() { cmake316_tools; }
 
 step_cmake316() {
   local build=$root/build/cmake316 tools=$cmake316/tools

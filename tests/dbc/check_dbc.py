@@ -38,15 +38,19 @@ REVISIONS = ("manual", "agx_v2", "mini_v3")
 
 def parse_args(argv):
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("--cli", required=True, help="the ranger_can executable")
-    p.add_argument("--dbc", required=True, help="the DBC file to check")
-    p.add_argument("--protocol", required=True, choices=list(REVISIONS),
+    checking = "--venv-only" not in argv  # the checks' arguments are needed only to check
+    p.add_argument("--cli", required=checking, help="the ranger_can executable")
+    p.add_argument("--dbc", required=checking, help="the DBC file to check")
+    p.add_argument("--protocol", required=checking, choices=list(REVISIONS),
                    help="the protocol revision the DBC describes (ranger_can --protocol)")
     p.add_argument("--other-dbc", action="append", default=[],
                    help="another revision's DBC (repeatable): its IDs that this DBC does not "
                    "list are known to the codec under every profile and are not checked here")
     p.add_argument("--venv", required=True, help="virtual environment for cantools (created if absent)")
-    p.add_argument("--work", required=True, help="directory for the generated log")
+    p.add_argument("--venv-only", action="store_true",
+                   help="only create or complete the virtual environment, then exit (scripts/test.sh "
+                        "does it beside its first build)")
+    p.add_argument("--work", required=checking, help="directory for the generated log")
     p.add_argument("--frames", type=int, default=400, help="random payloads per message")
     p.add_argument("--frame-table", default=os.path.join(
         os.path.dirname(os.path.abspath(__file__)), "..", "..", "libranger_can", "include",
@@ -77,6 +81,8 @@ def ensure_venv_and_reexec(args):
                             "cantools"])
         if r.returncode != 0:
             die("pip could not install cantools from PyPI (is the network reachable?)")
+    if args.venv_only:
+        sys.exit(0)
     os.execv(py, [py, os.path.abspath(__file__)] + sys.argv[1:] + [IN_VENV_FLAG])
 
 
