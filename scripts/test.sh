@@ -12,7 +12,8 @@
 #   workspaces  the repository in the src/ of fresh ROS 1 workspaces (scripts/test_workspaces.sh):
 #             catkin_make (and the driver run from its devel space), catkin build, colcon; the
 #             plain build with CMake 3.16; catkin_lint -W1
-#   sanitize  ASan+UBSan and TSan builds of the library and its tests, ASan build of the ROS node
+#   sanitize  ASan+UBSan build of the library and its tests, TSan build of the suites labelled
+#             `threads`, ASan build of the ROS node
 #   fuzz      every libFuzzer target for a bounded time (RANGER_FUZZ_SECONDS, default 60)
 #   ros2      the Python binding and the ROS 2 packages (scripts/test_ros2.sh): the venv of ROS 2
 #             wheels (scripts/setup_ros2.sh), the colcon build of ros2/ as the README has it, the
@@ -28,6 +29,11 @@
 # best-effort 7), so that they take mostly what the stage in the foreground leaves; their output
 # is printed when they are done, each stage's as a whole, and they count as any other stage.
 # RANGER_LANES=1 runs every stage in the foreground, in turn.
+#
+# Every build goes through one compiler cache kept between runs (scripts/ccache_env.sh); the
+# Python environments of the later stages (ROS 2 wheels, CMake 3.16, cantools) are made beside
+# the first build. The summary at the end gives each stage's wall time, the total, the cache's
+# hit rate and the count of test cases.
 #
 # The builds are RelWithDebInfo with line tables only (scripts/build.sh); the workspaces stage
 # builds without optimisation (scripts/test_workspaces.sh); ASan+UBSan at -O0, TSan at -O1
