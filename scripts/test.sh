@@ -22,13 +22,15 @@
 # RANGER_STAGES="unit ros" runs a subset (default: all of the above, in the order
 # unit vcan ros_vcan ros ros2 workspaces sanitize fuzz).
 #
-# Two lanes. ros and ros2 mostly wait on nodes, clocks and DDS; workspaces, sanitize and fuzz
-# mostly compile. Once no stage that runs the qemu VM (vcan, ros_vcan) is left, the stages among
-# workspaces, sanitize and fuzz run one after the other in the background at a lower CPU and I/O
-# priority (nice 10: about a tenth of the CPU against a busy foreground, never starved; ionice
-# best-effort 7), so that they take mostly what the stage in the foreground leaves; their output
-# is printed when they are done, each stage's as a whole, and they count as any other stage.
-# RANGER_LANES=1 runs every stage in the foreground, in turn.
+# Lanes. ros and ros2 mostly wait on nodes, clocks and DDS; workspaces, sanitize and fuzz mostly
+# compile. Once no stage that runs the qemu VM (vcan, ros_vcan) is left, the stages among
+# workspaces, sanitize and fuzz run one after the other in a background lane at a lower CPU and
+# I/O priority (nice 10: about a tenth of the CPU against a busy foreground, never starved;
+# ionice best-effort 7), so that they take mostly what the stages in the foreground leave, and
+# ros2 runs in a lane of its own beside ros (ROS 1's master and ROS 2's DDS domain do not meet);
+# their output is printed when they are done, each stage's as a whole, and they count as any
+# other stage. RANGER_LANES=2 keeps ros2 in the foreground after ros; RANGER_LANES=1 runs every
+# stage in the foreground, in turn.
 #
 # Every build goes through one compiler cache kept between runs (scripts/ccache_env.sh); the
 # Python environments of the later stages (ROS 2 wheels, CMake 3.16, cantools) are made beside
@@ -100,16 +102,21 @@ stage_sanitize() { scripts/test_sanitizers.sh; }
 stage_fuzz() { scripts/fuzz.sh "${RANGER_FUZZ_SECONDS:-60}"; }
 stage_ros2() { scripts/test_ros2.sh "$results"; }
 
-# ---- the background lane ----
-background=(workspaces sanitize fuzz)
-lane_pid=
+# ---- the lanes ----
+# A stage in a lane runs in the background, the lane's stages one after the other, once no stage
+# that boots the VM is left; its output is printed when the lane is done, each stage's as a
+# whole, and it counts as any other stage.
+declare -A lane_of=()  # stage -> its lane (none: the foreground)
+case ${RANGER_LANES:-3} in
+  1) ;;
+  2) lane_of=([workspaces]=compile [sanitize]=compile [fuzz]=compile) ;;
+  *) lane_of=([workspaces]=compile [sanitize]=compile [fuzz]=compile [ros2]=ros2) ;;
+esac
+declare -A lane_nice=([compile]=10 [ros2]=0)
+lane_names=(ros2 compile)  # the order their output is printed in
+declare -A lane_pid=() lane_stages=()
+lanes_started=0
 lane_dir=$root/build/lane
-in_background() {  # stage
-  local b
-  [ "${RANGER_LANES:-2}" != 1 ] || return 1
-  for b in "${background[@]}"; do [ "$b" = "$1" ] && return 0; done
-  return 1
-}
 vm_left() {  # stages...: is vcan or ros_vcan among them?
   local s
   for s in "$@"; do
@@ -117,50 +124,59 @@ vm_left() {  # stages...: is vcan or ros_vcan among them?
   done
   return 1
 }
-start_lane() {  # stages...: run them in turn in the background, each into lane/<stage>.log
+start_lane() {  # lane stages...: run them in turn in the background, each into lane/<stage>.log
+  local lane=$1 nice=${lane_nice[$1]}
+  shift
   [ $# -gt 0 ] || return 0
-  echo "== background lane (nice 10): $* (logs: build/lane/)"
+  echo "== background lane $lane (nice $nice): $* (logs: build/lane/)"
   set -m  # a process group of its own, which the trap below can stop whole
   (
-    renice -n 10 -p "$BASHPID" >/dev/null
-    ionice -c 2 -n 7 -p "$BASHPID" 2>/dev/null
+    if [ "$nice" != 0 ]; then
+      renice -n "$nice" -p "$BASHPID" >/dev/null
+      ionice -c 2 -n 7 -p "$BASHPID" 2>/dev/null
+    fi
     for s in "$@"; do
       start=$SECONDS
       if "stage_$s" >"$lane_dir/$s.log" 2>&1; then rc=0; else rc=$?; fi
       echo "$rc $((SECONDS - start))" >"$lane_dir/$s.status"
     done
   ) </dev/null &
-  lane_pid=$!
+  lane_pid[$lane]=$!
+  lane_stages[$lane]="$*"
   set +m
 }
-stop_lane() {
-  [ -z "$lane_pid" ] || kill -TERM -- "-$lane_pid" 2>/dev/null
+stop_lanes() {
+  local lane
+  for lane in "${!lane_pid[@]}"; do kill -TERM -- "-${lane_pid[$lane]}" 2>/dev/null; done
   [ -z "${prepare_pid:-}" ] || kill -TERM "$prepare_pid" 2>/dev/null
 }
-trap stop_lane EXIT
-trap 'stop_lane; exit 130' INT TERM
-finish_lane() {  # stages...: wait for the lane, then print and count each stage
-  [ -n "$lane_pid" ] || return 0
-  local start=$SECONDS s rc seconds
-  echo
-  echo "== waiting for the background lane"
-  wait "$lane_pid"
-  lane_pid=
-  echo "== background lane done (waited $((SECONDS - start)) s)"
-  for s in "$@"; do
+trap stop_lanes EXIT
+trap 'stop_lanes; exit 130' INT TERM
+finish_lanes() {  # wait for every lane, then print and count each of its stages
+  local lane start s rc seconds
+  for lane in "${lane_names[@]}"; do
+    [ -n "${lane_pid[$lane]:-}" ] || continue
+    start=$SECONDS
     echo
-    echo "==================== stage: $s (background lane) ===================="
-    cat "$lane_dir/$s.log" 2>/dev/null
-    rc=1 seconds=
-    read -r rc seconds 2>/dev/null <"$lane_dir/$s.status"
-    if [ "$rc" = 0 ]; then
-      passed+=("$s")
-      echo "== stage $s: ok ($seconds s, in the background)"
-    else
-      failed+=("$s")
-      echo "== stage $s: FAILED (${seconds:-?} s, in the background)"
-    fi
-    note_time "$s" "${seconds:-?}" background
+    echo "== waiting for the background lane $lane"
+    wait "${lane_pid[$lane]}"
+    unset "lane_pid[$lane]"
+    echo "== background lane $lane done (waited $((SECONDS - start)) s)"
+    for s in ${lane_stages[$lane]}; do
+      echo
+      echo "==================== stage: $s (background lane $lane) ===================="
+      cat "$lane_dir/$s.log" 2>/dev/null
+      rc=1 seconds=
+      read -r rc seconds 2>/dev/null <"$lane_dir/$s.status"
+      if [ "$rc" = 0 ]; then
+        passed+=("$s")
+        echo "== stage $s: ok ($seconds s, in the background)"
+      else
+        failed+=("$s")
+        echo "== stage $s: FAILED (${seconds:-?} s, in the background)"
+      fi
+      note_time "$s" "${seconds:-?}" "background, lane $lane"
+    done
   done
 }
 
@@ -213,7 +229,6 @@ note_time build $((SECONDS - build_start))
 finish_prepare
 
 read -r -a stage_list <<<"$stages"
-lane=()
 for i in "${!stage_list[@]}"; do
   s=${stage_list[$i]}
   if [ "$(type -t "stage_$s")" != function ]; then
@@ -225,23 +240,28 @@ for i in "${!stage_list[@]}"; do
     sanitize) [ -x scripts/test_sanitizers.sh ] || { echo "(no sanitizer script yet)"; continue; } ;;
     fuzz) [ -x scripts/fuzz.sh ] || { echo "(no fuzz script yet)"; continue; } ;;
   esac
-  if [ -z "$lane_pid" ] && [ ${#lane[@]} -eq 0 ] && ! vm_left "${stage_list[@]:$i}"; then
-    # From here on no VM stage is left: the background lane takes its stages from the rest.
-    for rest in "${stage_list[@]:$i}"; do
-      if in_background "$rest"; then lane+=("$rest"); fi
+  if [ "$lanes_started" = 0 ] && ! vm_left "${stage_list[@]:$i}"; then
+    # From here on no VM stage is left: each lane takes its stages from the rest.
+    lanes_started=1
+    for lane in "${lane_names[@]}"; do
+      mine=()
+      for rest in "${stage_list[@]:$i}"; do
+        [ "${lane_of[$rest]:-}" = "$lane" ] && [ "$(type -t "stage_$rest")" = function ] &&
+          mine+=("$rest")
+      done
+      start_lane "$lane" "${mine[@]}"
     done
-    start_lane "${lane[@]}"
   fi
-  in_background "$s" && [ -n "$lane_pid" ] && continue
+  [ "$lanes_started" = 1 ] && [ -n "${lane_of[$s]:-}" ] && continue
   run_stage "$s" "stage_$s"
 done
-finish_lane "${lane[@]}"
+finish_lanes
 
 echo
 echo "==================== summary ===================="
 echo "stages passed: ${passed[*]:-none}"
 echo "stages failed: ${failed[*]:-none}"
-echo "wall time per stage (the background lane's beside the foreground's):"
+echo "wall time per stage (the background lanes' beside the foreground's):"
 for s in "${timing_order[@]}"; do printf '  %-11s %s\n' "$s" "${stage_time[$s]}"; done
 printf '  %-11s %s s\n' total $((SECONDS - run_start))
 ranger_ccache_summary
