@@ -578,7 +578,13 @@ void ChassisController::update_causes() {
   if (state_.link == LinkState::kStale) active = active | StopCause::kLinkLost;
   if (state_.link == LinkState::kConnected) {
     if (state_.control_mode == ControlMode::kRemote) active = active | StopCause::kRemote;
-    if (state_.vehicle_status == protocol::VehicleStatus::kEmergencyStop) {
+    // The e-stop by its fault bit too, where the fault word has one: a real RANGER MINI 3.0
+    // reports a pressed e-stop as body status 2 (abnormal) with fault bit 7, never as status 1
+    // (docs/FIELD_FACTS.md), so status 1 alone would miss it.
+    const std::uint32_t estop_bit =
+        protocol::fault_bit(protocol::Fault::kEmergencyStop, config_.profile.error_word);
+    if (state_.vehicle_status == protocol::VehicleStatus::kEmergencyStop ||
+        (state_.error_bits & estop_bit) != 0) {
       active = active | StopCause::kEstop;
     }
     if (protocol::is_critical_error(state_.error_bits, config_.profile.error_word)) {

@@ -1,9 +1,10 @@
-// The field's motion-mode switch (docs/FIELD_FACTS.md): a real RANGER MINI 3.0 reports the new mode
-// in 0x291 as soon as 0x141 arrives, raises the switching flag on some switches only, and turns its
-// wheels at about 3.26 rad/s (t = d / 3.26 + 0.064 s, triangular below 0.21 rad), ignoring speed
-// commands until they are there. First the virtual chassis's frames (sim:mini_v3 and the RANGER's
-// variant sim:field_switch), then the driver on them: 100 switches at field timing in lock-step
-// with a ManualClock, no sleeping.
+// The field facts (docs/FIELD_FACTS.md): what a real RANGER MINI 3.0 was observed to do, as tests
+// against the virtual chassis's frames and, where it touches the driver, against the driver.
+// The motion-mode switch first: the new mode in 0x291 as soon as 0x141 arrives, the switching flag
+// on some switches only, the wheels at about 3.26 rad/s (t = d / 3.26 + 0.064 s, triangular below
+// 0.21 rad), speed commands ignored until they are there (sim:mini_v3 and the RANGER's variant
+// sim:field_switch); then the driver on them: 100 switches at field timing in lock-step with a
+// ManualClock, no sleeping; then the run as a candump record; then the other facts of the table.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -433,6 +434,129 @@ TEST(FieldSwitchRecord, TheCandumpOfARunDecodesWithTheTargetModeAtOnce) {
   EXPECT_GE(switches, 2) << "oblique and spin at least";
   std::remove(script.c_str());
   std::remove(log.c_str());
+}
+
+// ---- the other facts of the table ---------------------------------------------------------------
+
+CanFrame last_frame(const test::FakeBus& bus, std::uint32_t id) {
+  for (auto it = bus.sent.rbegin(); it != bus.sent.rend(); ++it) {
+    if (it->id == id) return *it;
+  }
+  ADD_FAILURE() << "no frame " << id;
+  return CanFrame{};
+}
+
+std::vector<int> bytes(const CanFrame& f, int from, int to) {
+  return std::vector<int>(f.data.begin() + from, f.data.begin() + to);
+}
+
+TEST(FieldFacts, ControlModeIsZeroStandbyOneCanThreeRemote) {
+  auto model = model_preset("ranger_mini_v3");
+  ASSERT_TRUE(model.ok());
+  test::FakeBus bus;
+  sim::VirtualChassis chassis(bus, sim::chassis_for_model(*model), Timestamp{0});
+  chassis.step(Timestamp{20ms});
+  EXPECT_EQ(last_frame(bus, protocol::kSystemStatusId).data[1], 0) << "standby at power-on";
+  Chassis c("mini_v3");  // after 0x421
+  EXPECT_EQ(last_frame(c.bus, protocol::kSystemStatusId).data[1], 1);
+  c.chassis.remote_takeover();
+  c.advance(40ms);
+  EXPECT_EQ(last_frame(c.bus, protocol::kSystemStatusId).data[1], 3);
+}
+
+TEST(FieldFacts, EstopIsFaultBit7AndBodyStatusTwoAsTheFieldReportsIt) {
+  // The field's body status (vehicle_status_1_is_estop = false: 0 normal, 2 abnormal).
+  auto model = model_preset("ranger_mini_v3");
+  ASSERT_TRUE(model.ok());
+  sim::VirtualChassisConfig field = sim::chassis_for_model(*model);
+  field.profile.vehicle_status_1_is_estop = false;
+  test::FakeBus bus;
+  sim::VirtualChassis chassis(bus, field, Timestamp{0});
+  chassis.step(Timestamp{40ms});
+  EXPECT_EQ(last_frame(bus, protocol::kSystemStatusId).data[0], 0);
+  chassis.set_emergency_stop(true);
+  chassis.step(Timestamp{80ms});
+  const CanFrame f = last_frame(bus, protocol::kSystemStatusId);
+  EXPECT_EQ(f.data[0], 2) << "0 normal / 2 abnormal: 1 does not exist on this model";
+  EXPECT_EQ(bytes(f, 4, 8), (std::vector<int>{0, 0, 0, 0x80})) << "error_code_full 0x00000080";
+  // Our transcription's reading (the preset) reports 1 with the same bit.
+  Chassis c("mini_v3");
+  c.chassis.set_emergency_stop(true);
+  c.advance(40ms);
+  EXPECT_EQ(last_frame(c.bus, protocol::kSystemStatusId).data[0], 1);
+  EXPECT_EQ(bytes(last_frame(c.bus, protocol::kSystemStatusId), 4, 8),
+            (std::vector<int>{0, 0, 0, 0x80}));
+}
+
+TEST(FieldFacts, TheDriverStopsOnTheEstopBitWhicheverTheBodyStatus) {
+  for (const bool status_1_is_estop : {true, false}) {
+    SCOPED_TRACE(status_1_is_estop ? "status 1 = e-stop" : "status 2 (the field's)");
+    ManualClock clock{Timestamp(1000s)};
+    sim::SimSourceOptions options;
+    options.lock_step = true;
+    options.chassis = sim::chassis_for_model(*model_preset("ranger_mini_v3"));
+    options.chassis.profile.vehicle_status_1_is_estop = status_1_is_estop;
+    auto source = sim::open_bus_source("sim", clock, options);
+    ASSERT_TRUE(source.ok());
+    auto sim = std::static_pointer_cast<sim::SimBusSource>(*source);
+    // The driver reads the preset (status 1 = e-stop) either way.
+    Driver driver(driver_for("mini_v3"), *source, clock);
+    // The commander publishes 0.3 m/s every 50 ms.
+    auto step = [&](std::chrono::nanoseconds d) {
+      for (auto e = 0ns; e < d; e += 1ms) {
+        // (refused before the driver's first step: nothing to command yet)
+        if (e % 50ms == 0ns)
+          (void)driver.command(MotionRequest{BodyTwist{0.3, 0, 0}, std::nullopt});
+        clock.advance(1ms);
+        sim->step(clock.now());
+        driver.step(clock.now());
+      }
+    };
+    step(1500ms);
+    ASSERT_EQ(driver.snapshot()->controller.refusal, MotionRefusal::kNone);
+    sim->with_chassis([](sim::VirtualChassis& c) {
+      c.set_emergency_stop(true);
+      return 0;
+    });
+    step(100ms);
+    EXPECT_EQ(driver.snapshot()->controller.refusal, MotionRefusal::kEstop);
+    EXPECT_TRUE(has(driver.snapshot()->controller.latched_causes, StopCause::kEstop));
+  }
+}
+
+TEST(FieldFacts, RemoteOffRaisesRemoteLost) {
+  Chassis c("mini_v3");
+  c.chassis.remote_takeover();  // the remote has the chassis, then is lost
+  c.chassis.remote_signal_lost();
+  c.advance(40ms);
+  const CanFrame f = last_frame(c.bus, protocol::kSystemStatusId);
+  EXPECT_EQ(bytes(f, 4, 8), (std::vector<int>{0, 0, 0, 0x04})) << "the notes' 0x4";
+  EXPECT_EQ(f.data[1], 0) << "standby";
+  EXPECT_EQ(f.data[0], 2) << "abnormal";
+}
+
+TEST(FieldFacts, BmsPayloadOfTheNotesDecodesUnderTheFieldsScale) {
+  CanFrame f;
+  f.id = protocol::kBmsBaseId;
+  f.dlc = 8;
+  f.data = {0x64, 0x64, 0x14, 0xB4, 0x00, 0x00, 0x01, 0x24};
+  // The field's reading: 0.01 V (`--set bms_voltage_scale=0.01`).
+  ProtocolProfile field = *protocol_preset("mini_v3");
+  field.bms_voltage_scale = 0.01;
+  auto m = decode(f, field);
+  ASSERT_TRUE(m.ok());
+  const auto& b = std::get<BmsData>(*m);
+  EXPECT_DOUBLE_EQ(b.soc, 100.0);
+  EXPECT_DOUBLE_EQ(b.soh, 100.0);
+  EXPECT_NEAR(b.voltage, 53.0, 1e-9) << "0.01 V";
+  EXPECT_DOUBLE_EQ(b.current, 0.0);
+  EXPECT_NEAR(b.temperature, 29.2, 1e-9);
+  // Our transcription of the manual (the preset) reads 530 V: the disagreement, kept.
+  auto preset = decode(f, *protocol_preset("mini_v3"));
+  ASSERT_TRUE(preset.ok());
+  EXPECT_NEAR(std::get<BmsData>(*preset).voltage, 530.0, 1e-9);
+  // Charging is positive on the wire (+19 A while the SOC rose): a negative discharge.
+  EXPECT_LT(interpretation::bms_discharge_current(19.0, field), 0.0);
 }
 
 }  // namespace
