@@ -432,6 +432,31 @@ TEST(FieldSwitchRecord, TheCandumpOfARunDecodesWithTheTargetModeAtOnce) {
     }
   }
   EXPECT_GE(switches, 2) << "oblique and spin at least";
+  // 0x271 in the log: the fastest wheel turns at the field's 3.26 rad/s (during the switches).
+  double fastest = 0.0, last_t = NAN;
+  std::vector<double> last_angles;
+  for (const std::string& l : lines) {
+    if (l.find("\"id\":625,") == std::string::npos) continue;  // 0x271
+    const auto at = l.find("\"angles\":[");
+    ASSERT_NE(at, std::string::npos) << l;
+    std::vector<double> angles;
+    const char* p = l.c_str() + at + 10;
+    for (int w = 0; w < 4; ++w) {
+      char* end = nullptr;
+      angles.push_back(std::strtod(p, &end));
+      p = end + 1;
+    }
+    const double t = json_number(l, "t");
+    if (!last_angles.empty() && t > last_t) {
+      for (int w = 0; w < 4; ++w)
+        // Modulo pi: a wheel at +90 deg stands as one at -90 deg.
+        fastest = std::max(
+            fastest, std::abs(std::remainder(angles[w] - last_angles[w], M_PI)) / (t - last_t));
+    }
+    last_angles = angles;
+    last_t = t;
+  }
+  EXPECT_NEAR(fastest, 3.26, 0.05) << "the measured steering rate";
   std::remove(script.c_str());
   std::remove(log.c_str());
 }
