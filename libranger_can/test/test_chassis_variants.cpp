@@ -105,8 +105,8 @@ MotionCommand ackermann(double v, double rep103_steering) {
 
 TEST(ChassisVariants, TableNamesEveryVariantWithADescriptionAndTheDriverOptions) {
   const std::vector<std::string> expected = {
-      "manual",        "agx_v2",      "padded",  "spin_cw", "steer_left_positive",
-      "speed221_body", "inner_angle", "mini_v1", "mini_v3", "undecidable"};
+      "manual",      "agx_v2",  "padded",  "spin_cw",      "steer_left_positive", "speed221_body",
+      "inner_angle", "mini_v1", "mini_v3", "field_switch", "mode_left",           "undecidable"};
   EXPECT_EQ(variant_names(), expected);
   for (const VariantInfo& v : variants()) {
     SCOPED_TRACE(v.name);
@@ -122,7 +122,8 @@ TEST(ChassisVariants, UnknownVariantListsTheValidOnes) {
   EXPECT_EQ(c.error().code, Errc::kInvalidArgument);
   EXPECT_EQ(c.error().message,
             "unknown virtual chassis variant 'ranger_xl' (valid: manual, agx_v2, padded, spin_cw, "
-            "steer_left_positive, speed221_body, inner_angle, mini_v1, mini_v3, undecidable)");
+            "steer_left_positive, speed221_body, inner_angle, mini_v1, mini_v3, field_switch, "
+            "mode_left, undecidable)");
 }
 
 TEST(ChassisVariants, EachSettingVariantChangesOneReadingOfTheManual) {

@@ -307,8 +307,8 @@ std::optional<ProtocolProfile> truth(const std::string& v) {
 }
 
 const std::vector<std::string> kAll = {
-    "manual",        "agx_v2",      "padded",  "spin_cw", "steer_left_positive",
-    "speed221_body", "inner_angle", "mini_v1", "mini_v3", "undecidable"};
+    "manual",      "agx_v2",  "padded",  "spin_cw",      "steer_left_positive", "speed221_body",
+    "inner_angle", "mini_v1", "mini_v3", "field_switch", "mode_left",           "undecidable"};
 
 }  // namespace variants
 

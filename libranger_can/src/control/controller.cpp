@@ -99,6 +99,8 @@ Status ControllerConfig::validate() const {
                    {"min_command_interval", min_command_interval},
                    {"cmd_timeout", cmd_timeout},
                    {"mode_switch_timeout", mode_switch_timeout},
+                   {"mode_switch_blind_time", mode_switch_blind_time},
+                   {"mode_switch_min_time", mode_switch_min_time},
                    {"ultrasonic_confirm_timeout", ultrasonic_confirm_timeout}};
   for (const auto& d : durations) {
     if (Status st = check_duration(d.name, d.value); !st) return st;
@@ -129,7 +131,8 @@ ChassisController::ChassisController(Bus& bus, ControllerConfig config)
     : bus_(bus),
       config_(std::move(config)),
       selector_(config_.mode_selection),
-      mode_switch_(ModeSwitchConfig{config_.mode_switch_timeout, config_.mode_switch_max_attempts}),
+      mode_switch_(ModeSwitchConfig{config_.mode_switch_timeout, config_.mode_switch_max_attempts,
+                                    config_.mode_switch_blind_time, config_.mode_switch_min_time}),
       limiter_vx_(config_.limit_vx),
       limiter_vy_(config_.limit_vy),
       limiter_wz_(config_.limit_wz) {
@@ -178,6 +181,17 @@ void ChassisController::on_message(const Message& message, Timestamp stamp, Time
     on_system_status(*status, now);
   } else if (const auto* mode = std::get_if<MotionModeFeedback>(&message)) {
     on_motion_mode(*mode);
+  } else if (const auto* angles = std::get_if<SteeringAnglesFeedback>(&message)) {
+    constexpr double kStill = 0.005;  // rad between two frames: the wheels stand
+    wheels_still_ = previous_wheel_angles_.has_value();
+    for (std::size_t i = 0; wheels_still_ && i < angles->angles.size(); ++i) {
+      // Modulo pi: a wheel at +90 deg stands as one at -90 deg.
+      wheels_still_ = std::fabs(std::remainder(angles->angles[i] - (*previous_wheel_angles_)[i],
+                                               M_PI)) <= kStill;
+    }
+    previous_wheel_angles_ = angles->angles;
+    settle_switch(now);  // the wheels may have arrived at a switch's angles
+    return;
   } else if (const auto* bms = std::get_if<BmsData>(&message)) {
     if (bms->battery == 0) state_.battery_soc = bms->soc;
   } else if (const auto* us = std::get_if<UltrasonicSettingFeedback>(&message)) {
@@ -226,7 +240,8 @@ void ChassisController::on_motion_mode(const MotionModeFeedback& m) {
     // Park: nothing to command in, but the switch into it (request_park) completes here.
     state_.motion_mode.reset();
     state_.chassis_switching = m.switching;
-    if (mode_switch_.on_feedback(m.mode, m.switching)) command_changed_ = true;
+    mode_switch_.on_feedback(m.mode, m.switching);
+    settle_switch(state_.now);
     return;
   }
   if (!m.mode_known || !drivable_mode(m.mode)) {
@@ -238,7 +253,30 @@ void ChassisController::on_motion_mode(const MotionModeFeedback& m) {
   }
   state_.motion_mode = m.mode;
   state_.chassis_switching = m.switching;
-  if (mode_switch_.on_feedback(m.mode, m.switching)) command_changed_ = true;
+  mode_switch_.on_feedback(m.mode, m.switching);
+  settle_switch(state_.now);
+}
+
+std::optional<bool> ChassisController::wheels_at_switch_target(Timestamp now) const {
+  const auto& target = mode_switch_.status().target;
+  if (!target || !is_fresh(feedback_.steering_angles, now, config_.link_timeout)) {
+    return std::nullopt;
+  }
+  if (!wheels_still_) return false;  // still turning
+  const auto wanted =
+      wheel_angles_for_command(MotionCommand{}, *target, config_.geometry, config_.profile);
+  for (std::size_t i = 0; i < wanted.size(); ++i) {
+    const double measured =
+        interpretation::rep103_from_manual_wheel_angle(feedback_.steering_angles->value.angles[i]);
+    // A wheel at +90 deg stands as one at -90 deg: compare modulo pi.
+    const double off = std::remainder(measured - wanted[i], M_PI);
+    if (std::fabs(off) > config_.mode_switch_wheel_tolerance) return false;
+  }
+  return true;
+}
+
+void ChassisController::settle_switch(Timestamp now) {
+  if (mode_switch_.settle(wheels_at_switch_target(now), now)) command_changed_ = true;
 }
 
 // ---- commands ----------------------------------------------------------------------------------
@@ -540,7 +578,13 @@ void ChassisController::update_causes() {
   if (state_.link == LinkState::kStale) active = active | StopCause::kLinkLost;
   if (state_.link == LinkState::kConnected) {
     if (state_.control_mode == ControlMode::kRemote) active = active | StopCause::kRemote;
-    if (state_.vehicle_status == protocol::VehicleStatus::kEmergencyStop) {
+    // The e-stop by its fault bit too, where the fault word has one: a real RANGER MINI 3.0
+    // reports a pressed e-stop as body status 2 (abnormal) with fault bit 7, never as status 1
+    // (docs/FIELD_FACTS.md), so status 1 alone would miss it.
+    const std::uint32_t estop_bit =
+        protocol::fault_bit(protocol::Fault::kEmergencyStop, config_.profile.error_word);
+    if (state_.vehicle_status == protocol::VehicleStatus::kEmergencyStop ||
+        (state_.error_bits & estop_bit) != 0) {
       active = active | StopCause::kEstop;
     }
     if (protocol::is_critical_error(state_.error_bits, config_.profile.error_word)) {
@@ -732,6 +776,7 @@ std::optional<MotionMode> ChassisController::switch_mode(const MotionGate& g, Ti
   } else {
     const MotionMode current = state_.motion_mode ? *state_.motion_mode : *state_.chassis_mode;
     const MotionMode wanted = wanted_mode(g, current, now);
+    settle_switch(now);  // without 0x271: the chassis's switch time may have passed
     const bool was_active = mode_switch_.active();
     const int attempts = mode_switch_.status().attempts;
     mode_to_send = mode_switch_.update(wanted, current, at_standstill(now), now);

@@ -22,6 +22,7 @@ std::optional<protocol::MotionMode> ModeSwitchSequencer::update(protocol::Motion
       status_.target = wanted;
       break;
     case ModeSwitchPhase::kAwaitingConfirmation:
+    case ModeSwitchPhase::kAwaitingWheels:
       if (now - sent_ < config_.timeout) return std::nullopt;
       // Reported as failed once the attempts are used up; retried at the same bounded rate all the
       // same (the chassis stands still meanwhile), so a chassis that recovers completes it.
@@ -33,15 +34,29 @@ std::optional<protocol::MotionMode> ModeSwitchSequencer::update(protocol::Motion
   if (status_.phase == ModeSwitchPhase::kStopping && at_standstill) {
     status_.phase = ModeSwitchPhase::kAwaitingConfirmation;
     status_.attempts = 1;
-    sent_ = now;
+    sent_ = first_ = now;
     return status_.target;
   }
   return std::nullopt;
 }
 
-bool ModeSwitchSequencer::on_feedback(protocol::MotionMode mode, bool switching) {
-  if (switching || !status_.target || *status_.target != mode) return false;
-  if (status_.phase != ModeSwitchPhase::kAwaitingConfirmation) return false;
+void ModeSwitchSequencer::on_feedback(protocol::MotionMode mode, bool switching) {
+  if (status_.phase != ModeSwitchPhase::kAwaitingConfirmation &&
+      status_.phase != ModeSwitchPhase::kAwaitingWheels) {
+    return;
+  }
+  const bool confirmed = !switching && status_.target && *status_.target == mode;
+  status_.phase =
+      confirmed ? ModeSwitchPhase::kAwaitingWheels : ModeSwitchPhase::kAwaitingConfirmation;
+}
+
+bool ModeSwitchSequencer::settle(std::optional<bool> wheels_at_target, Timestamp now) {
+  if (status_.phase != ModeSwitchPhase::kAwaitingWheels) return false;
+  // The wheels seen there, or the chassis's own switch time over (with or without 0x271: wheels
+  // that settle a little off their nominal angles do not hold a switch forever).
+  const bool there = (wheels_at_target && *wheels_at_target && now - first_ >= config_.min_time) ||
+                     now - first_ >= config_.blind_time;
+  if (!there) return false;
   status_ = ModeSwitchStatus{};
   return true;
 }
@@ -51,8 +66,14 @@ void ModeSwitchSequencer::cancel() {
 }
 
 Timestamp ModeSwitchSequencer::next_due() const {
-  if (status_.phase != ModeSwitchPhase::kAwaitingConfirmation) return Timestamp::max();
-  return sent_ + config_.timeout;
+  switch (status_.phase) {
+    case ModeSwitchPhase::kAwaitingConfirmation:
+      return sent_ + config_.timeout;
+    case ModeSwitchPhase::kAwaitingWheels:
+      return std::min(sent_ + config_.timeout, first_ + config_.blind_time);
+    default:
+      return Timestamp::max();
+  }
 }
 
 }  // namespace ranger

@@ -495,7 +495,8 @@ void add_ultrasonic_and_sim(std::vector<Binding>& out) {
           .apply(RANGER_SET(sim.chassis.initial_soc, v.number)));
   out.push_back(Row("sim/mode_switch_duration", T::kSeconds, "s", closed(0.0, 10.0),
                     std::chrono::duration<double>(s.mode_switch_duration).count(),
-                    "how long a motion-mode switch takes")
+                    "how long a motion-mode switch takes (the manual's fixed-time switch; "
+                    "not the field's, ranger_mini_v3, whose wheels turn at 3.26 rad/s)")
                     .apply(RANGER_SET(sim.chassis.mode_switch_duration, from_secs(v.number))));
   out.push_back(Row("sim/boot_in_remote_mode", T::kBool, "", {}, s.boot_in_remote_mode,
                     "boot with the remote control in charge")

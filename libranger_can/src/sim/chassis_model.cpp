@@ -67,22 +67,34 @@ void ChassisModel::stop(bool emergency) {
   emergency_ = emergency;
 }
 
-bool ChassisModel::begin_mode_switch(MotionMode mode, double turn_duration_s) {
+bool ChassisModel::begin_mode_switch(MotionMode mode, const TurnProfile& turn) {
   if (!switching() && mode == mode_) return false;
   if (switching() && mode == switch_target_) return false;
+  const WheelStates standing = wheels();  // before the target changes
+  switch_target_ = mode;
+  switch_turn_ = turn;
   if (switch_phase_ == SwitchPhase::kTurning) {
-    // Turn from wherever the wheels stand now towards the new target.
-    const WheelStates now = wheels();
-    for (int i = 0; i < kWheelCount; ++i)
-      switch_from_[i] = {now[i].angle, 0.0};
-    switch_elapsed_ = 0.0;
+    start_turning(standing);  // from wherever the wheels stand now towards the new target
   } else if (switch_phase_ == SwitchPhase::kNone) {
     switch_phase_ = SwitchPhase::kStopping;
     target_.speed = 0.0;
   }
-  switch_target_ = mode;
-  switch_duration_ = std::max(0.0, turn_duration_s);
   return true;
+}
+
+void ChassisModel::start_turning(const WheelStates& now) {
+  const WheelStates to = wheels_for(switch_target_, 0.0, 0.0);
+  switch_distance_ = 0.0;
+  for (int i = 0; i < kWheelCount; ++i) {
+    // The short way: a wheel at +90 deg stands as one at -90 deg (running backwards), so no
+    // wheel turns by more than 90 deg (the field's longest switch, 1.57 rad in 0.54 s).
+    switch_from_[i] = {now[i].angle, 0.0};
+    switch_turn_by_[i] = std::remainder(to[i].angle - now[i].angle, M_PI);
+    switch_distance_ = std::max(switch_distance_, std::abs(switch_turn_by_[i]));
+  }
+  switch_duration_ = switch_turn_.duration(switch_distance_);
+  switch_elapsed_ = 0.0;
+  switch_phase_ = SwitchPhase::kTurning;
 }
 
 BodyTwist ChassisModel::twist_for(MotionMode mode, double steering, double speed) const {
@@ -140,12 +152,12 @@ BodyTwist ChassisModel::twist() const {
 
 WheelStates ChassisModel::wheels() const {
   if (switch_phase_ != SwitchPhase::kTurning) return wheels_for(mode_, steering_, speed_);
-  const WheelStates to = wheels_for(switch_target_, 0.0, 0.0);
   const double frac =
-      switch_duration_ <= 0.0 ? 1.0 : std::min(1.0, switch_elapsed_ / switch_duration_);
+      switch_duration_ <= 0.0 ? 1.0 : switch_turn_.fraction(switch_elapsed_, switch_distance_);
   WheelStates out{};
   for (int i = 0; i < kWheelCount; ++i) {
-    out[i].angle = switch_from_[i].angle + (to[i].angle - switch_from_[i].angle) * frac;
+    double sign = 1.0;
+    out[i].angle = fold_wheel_angle(switch_from_[i].angle + switch_turn_by_[i] * frac, sign);
     out[i].speed = 0.0;
   }
   return out;
@@ -164,13 +176,7 @@ void ChassisModel::advance(double dt) {
 }
 
 void ChassisModel::sub_step(double h) {
-  if (switch_phase_ == SwitchPhase::kStopping && speed_ == 0.0) {
-    const WheelStates now = wheels();
-    for (int i = 0; i < kWheelCount; ++i)
-      switch_from_[i] = {now[i].angle, 0.0};
-    switch_phase_ = SwitchPhase::kTurning;
-    switch_elapsed_ = 0.0;
-  }
+  if (switch_phase_ == SwitchPhase::kStopping && speed_ == 0.0) start_turning(wheels());
 
   const BodyTwist before = twist();
 

@@ -14,6 +14,7 @@
 #include "ranger_can/control/rearm.hpp"
 #include "ranger_can/json.hpp"
 #include "ranger_can/parse.hpp"
+#include "ranger_can/sim/bus_recording.hpp"
 #include "ranger_can/sim/sim_bus_source.hpp"
 #include "ranger_can/text.hpp"
 #include "ranger_can/wire/protocol.hpp"
@@ -723,6 +724,7 @@ struct ScenarioRunner::Impl {
   ManualClock clock{kEpoch};
   std::shared_ptr<SimBusSource> sim;  // before the driver: destroyed after it
   std::unique_ptr<Driver> driver;
+  std::unique_ptr<CandumpRecording> recording;  // --candump
   std::chrono::milliseconds t{0};
 
   std::optional<BodyTwist> publishing;  // the commander's twist
@@ -743,6 +745,7 @@ struct ScenarioRunner::Impl {
     }
     sim->step(clock.now());
     driver->step(clock.now());
+    if (recording) recording->drain();
     if (!pending.empty()) report_requests(output);
     if (output.event && driver->last_event_sequence() > events_seen) report_events(output);
   }
@@ -884,9 +887,15 @@ Result<std::unique_ptr<ScenarioRunner>> ScenarioRunner::create(const ScenarioOpt
   if (!source) return source.error();
   impl->sim = std::static_pointer_cast<SimBusSource>(*source);
   impl->driver = std::make_unique<Driver>(options.driver, *source, impl->clock);
+  if (options.candump) {
+    auto tap = impl->sim->open();
+    if (!tap) return tap.error();
+    impl->recording = std::make_unique<CandumpRecording>(std::move(*tap), *options.candump, kEpoch);
+  }
   // t = 0: the chassis has booted (in standby); the driver opens its bus.
   impl->sim->step(impl->clock.now());
   impl->driver->step(impl->clock.now());
+  if (impl->recording) impl->recording->drain();
   return std::unique_ptr<ScenarioRunner>(new ScenarioRunner(std::move(impl)));
 }
 

@@ -64,8 +64,12 @@ const std::vector<VariantInfo>& variants() {
        "--set steering_reference=inner_front"},
       {"mini_v1", "the RANGER MINI V1: geometry, limits and protocol of model ranger_mini_v1",
        "--model ranger_mini_v1"},
-      {"mini_v3", "the RANGER MINI 3.0: model ranger_mini_v3, drive modes, rear odometry",
+      {"mini_v3", "the RANGER MINI 3.0: model ranger_mini_v3, drive modes, the field's switch",
        "--model ranger_mini_v3"},
+      {"field_switch",
+       "the RANGER switching modes as a real MINI 3.0: new mode at once, 3.26 rad/s", ""},
+      {"mode_left", "a mode switch as the manual reads it: the mode left, switching=1 throughout",
+       ""},
       {"undecidable", "neither revision: the manual's IDs and lengths, agx_v2 values, no 0x271",
        "--protocol agx_v2 --set tx_dlc=0 --set mode_numbering=manual"},
   };
@@ -92,7 +96,24 @@ std::string variants_help() {
   return out;
 }
 
+namespace {
+
+// The models a real chassis has been observed of, and what the field showed (docs/FIELD_FACTS.md).
+struct FieldObservation {
+  std::string_view model;
+  SwitchModelConfig (*switch_model)();
+};
+constexpr FieldObservation kFieldObservations[] = {
+    {"ranger_mini_v3", field_switch_model},
+};
+
+}  // namespace
+
 VirtualChassisConfig chassis_for_model(const ModelPreset& model, VirtualChassisConfig config) {
+  config.switch_model = mode_left_switch_model();
+  for (const FieldObservation& f : kFieldObservations) {
+    if (f.model == model.name) config.switch_model = f.switch_model();
+  }
   config.geometry = model.geometry;
   config.limits.max_linear_speed = model.limits.max_linear_speed;
   config.limits.max_speed_at_large_steering = model.limits.max_speed_at_large_steering;
@@ -140,6 +161,10 @@ Result<VirtualChassisConfig> apply_variant(std::string_view variant, VirtualChas
     config = chassis_for_model(*model, config);
     config.vendor_frames = true;    // 0x231, 0x241 (its manual), 0x4A1 (the vendor's SDK)
     config.odometer_frames = true;  // 0x311, 0x312 in mm
+  } else if (variant == "field_switch") {
+    config.switch_model = field_switch_model();
+  } else if (variant == "mode_left") {
+    config.switch_model = mode_left_switch_model();
   } else if (variant == "undecidable") {
     // Built so that no passive evidence settles the revision, and the steering unit cannot be
     // read at rest: the vendor's units, signs, spin field, error word (byte 7 a counter), BMS

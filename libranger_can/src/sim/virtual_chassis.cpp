@@ -79,6 +79,7 @@ VirtualChassis::VirtualChassis(Bus& bus, const VirtualChassisConfig& config, Tim
       config_(config),
       motion_(config.geometry, config.limits),
       drivetrain_(config.drivetrain, config.initial_soc),
+      switch_(config.switch_model, seconds(config.mode_switch_duration)),
       now_(boot_time),
       ultrasonic_enabled_(config.ultrasonic_enabled),
       ultrasonic_(config.ultrasonic),
@@ -346,7 +347,7 @@ MotionTarget VirtualChassis::remote_target() const {
 void VirtualChassis::drive_by_remote() {
   const MotionMode want = remote_mode();
   const MotionMode heading = motion_.switching() ? motion_.switch_target() : motion_.mode();
-  if (want != heading && motion_.begin_mode_switch(want, seconds(config_.mode_switch_duration))) {
+  if (want != heading && begin_switch(want)) {
     event("remote control: switching motion mode " +
           std::string(protocol::to_string(motion_.mode())) + " -> " +
           std::string(protocol::to_string(want)));
@@ -534,11 +535,17 @@ void VirtualChassis::handle_motion_mode(const MotionModeCommand& cmd) {
     event("0x141 park ignored: the chassis is moving");
     return;
   }
-  if (motion_.begin_mode_switch(cmd.mode, seconds(config_.mode_switch_duration))) {
+  if (begin_switch(cmd.mode)) {
     commanded_ = MotionTarget{};
     event("switching motion mode " + std::string(protocol::to_string(motion_.mode())) + " -> " +
           std::string(protocol::to_string(cmd.mode)));
   }
+}
+
+bool VirtualChassis::begin_switch(MotionMode mode) {
+  if (!motion_.begin_mode_switch(mode, switch_.turn_profile())) return false;
+  switch_.on_switch_started();
+  return true;
 }
 
 void VirtualChassis::handle_control_mode(const ControlModeCommand& cmd) {
@@ -883,9 +890,11 @@ void VirtualChassis::send_due(ScheduleId which, Timestamp t) {
       if (config_.steering_angles_frame) send(angles, t);
       send(speeds, t);
       MotionModeFeedback mm;
-      mm.mode = motion_.mode();  // while switching: the mode being left
+      const SwitchReportValue r = switch_.report(
+          motion_.mode(), motion_.switching(), motion_.switch_target(), motion_.mode_switch_held());
+      mm.mode = r.mode;
       mm.mode_raw = protocol::motion_mode_to_wire(mm.mode, p.mode_numbering).value_or(0);
-      mm.switching = motion_.switching();
+      mm.switching = r.switching;
       mm.drive_mode = static_cast<std::uint8_t>(drive_mode_);  // where the layout has byte 2
       send(mm, t);
       if (config_.odometer_frames) send_odometers(t);

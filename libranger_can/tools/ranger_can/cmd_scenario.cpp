@@ -1,7 +1,9 @@
 // `ranger_can scenario [FILE]`: runs a script against the driver runtime and the virtual chassis
 // in lock-step, in simulated time, and prints the state as JSON lines. Everything it does lives in
 // libranger_can (sim/scenario.hpp): this file is only the command line around it.
+#include <fstream>
 #include <istream>
+#include <memory>
 #include <ostream>
 #include <string>
 
@@ -64,6 +66,15 @@ int scenario_main(const ParsedArgs& args, Io io) {
   if (Status st = sim::validate(options); !st) {
     return usage_error(scenario_command(), io, st.error().message);
   }
+  std::unique_ptr<std::ofstream> candump;  // --candump: every frame of the run
+  if (const auto path = args.get("--candump")) {
+    candump = std::make_unique<std::ofstream>(*path);
+    if (!*candump) {
+      io.err << "ranger_can " << kName << ": cannot write " << *path << "\n";
+      return 1;
+    }
+    options.candump = candump.get();
+  }
   return with_input(args.get("FILE"), kName, io, [&](std::istream& in) {
     auto script = sim::parse_scenario(in);
     if (!script) {
@@ -123,7 +134,8 @@ const CommandSpec& scenario_command() {
       "driver knows them (null: never reported); refusal: why the requested motion is not driven\n"
       "(\"none\" while it is); identification: its phase under --protocol auto (\"none\" when the\n"
       "protocol is given). A sample also carries \"events\":[...] when the driver had any since\n"
-      "the previous sample: each {\"seq\",\"t\",\"event\",\"severity\",\"text\",...} (the lines the\n"
+      "the previous sample: each {\"seq\",\"t\",\"event\",\"severity\",\"text\",...} (the lines "
+      "the\n"
       "ROS node logs; events after the last sample come on a line {\"t\":s,\"events\":[...]}).\n"
       "Numbers have fixed decimals (t 3, others 6): the same script gives the same bytes.",
       {optional_arg("FILE", "the script; standard input when absent or '-'", any_text())},
@@ -143,6 +155,9 @@ const CommandSpec& scenario_command() {
           model_option(),
           protocol_option(),
           set_option(),
+          option("--candump", "FILE",
+                 "write every frame of the run, both ways, to FILE as a candump -L log in "
+                 "simulated time (seconds since t = 0; `ranger_can decode FILE` reads it)"),
           option("--param", "NAME=VALUE",
                  "a driver setting, by the ROS node's parameter name (ranger_base/README.md): " +
                      param_help(),

@@ -31,6 +31,7 @@
 #include "ranger_can/parse.hpp"
 #include "ranger_can/sim/chassis_commands.hpp"
 #include "ranger_can/sim/sim_bus_source.hpp"
+#include "ranger_can/sim/switch_model.hpp"
 #include "ranger_can/sim/virtual_chassis_runner.hpp"
 #include "ranger_can/text.hpp"
 
@@ -125,6 +126,15 @@ Result<SimOptions> options_from(const ParsedArgs& args) {
   auto config = sim::apply_variant(o.variant, o.config);
   if (!config) return config.error();
   o.config = *config;
+  // The mode switch's settings (sim/switch_model.hpp), over the model's and the variant's.
+  sim::SwitchModelConfig& sw = o.config.switch_model;
+  if (const auto r = args.get("--switch-report")) sw.report = *sim::kSwitchReportNames.parse(*r);
+  sw.flag_share = args.number("--switch-flag-share", sw.flag_share);
+  sw.seed = static_cast<std::uint32_t>(args.integer("--switch-seed", sw.seed));
+  if (args.has("--switch-slew")) {
+    sw.turn = sim::SwitchTurn::kSlew;
+    sw.slew_rate = args.number("--switch-slew", sw.slew_rate);
+  }
   for (const auto& e : o.errors) {
     if (auto b = parse_error_bit(e, o.config.profile.error_word); !b) return b.error();
   }
@@ -502,6 +512,21 @@ const CommandSpec& sim_command() {
               checked_by([](const std::string& t) { return check_with(sim::check_error_bit, t); }))
               .repeated(),
           flag("--stuck-mode-switch", "motion-mode switches never complete"),
+          option("--switch-report", "REPORT",
+                 "what 0x291 says of a mode switch: mode_left (the mode being left, switching = 1 "
+                 "throughout; the RANGER's default) or at_once (the new mode at once, the flag on "
+                 "some switches: the field's, ranger_mini_v3's and field_switch's default)",
+                 one_of(sim::kSwitchReportNames.names())),
+          option("--switch-flag-share", "F",
+                 "share of switches whose 0x291 raises the flag under at_once (the field: 439/941)",
+                 number_in(0.0, 1.0)),
+          option("--switch-seed", "N", "seed of the per-switch draw of the flag (default 1)",
+                 integer_in(0, 0xFFFFFFFFLL)),
+          option(
+              "--switch-slew", "RAD/S",
+              "the wheels turn to the new mode's angles at this peak rate (the field: 3.26, with "
+              "t = d / rate + 0.064 s) instead of over --mode-switch-time",
+              number_in(0.1, 100.0)),
           option("--accel", "M/S2",
                  "acceleration limit (default " + number_text(defaults.limits.acceleration) + ")",
                  number_in(0.01, 20.0)),

@@ -200,7 +200,7 @@ struct ControllerConfig {
   // so a released e-stop would restart the robot without anyone deciding to. For teleop-only
   // robots whose operator sees the robot.
   bool rearm_on_zero_twist = false;
-  bool listen_only = false;                // never send anything (monitoring, log replay)
+  bool listen_only = false;  // never send anything (monitoring, log replay)
   std::chrono::nanoseconds link_timeout = std::chrono::milliseconds(100);
   std::chrono::nanoseconds control_mode_retry_period = std::chrono::milliseconds(100);
   std::chrono::nanoseconds keep_alive_period = std::chrono::milliseconds(20);
@@ -208,7 +208,14 @@ struct ControllerConfig {
   std::chrono::nanoseconds cmd_timeout = std::chrono::milliseconds(500);
   std::chrono::nanoseconds mode_switch_timeout = std::chrono::milliseconds(1500);
   int mode_switch_max_attempts = 3;
-  double standstill_speed = 0.02;  // m/s, every wheel slower than this = standstill
+  // A switch completes when the wheels (0x271) stand still (two frames within 0.005 rad) within
+  // this of the new mode's angles, or mode_switch_blind_time after its 0x141 (mode_switch.hpp:
+  // never on 0x291 alone).
+  double mode_switch_wheel_tolerance = deg_to_rad(2.0);
+  std::chrono::nanoseconds mode_switch_blind_time = std::chrono::milliseconds(580);
+  std::chrono::nanoseconds mode_switch_min_time =
+      std::chrono::milliseconds(100);  // at the earliest
+  double standstill_speed = 0.02;      // m/s, every wheel slower than this = standstill
   // rad: full speed while every wheel is within this of its commanded angle, zero beyond twice
   // it, linear in between (0 disables steer-first).
   double steer_first_threshold = deg_to_rad(10.0);
@@ -236,9 +243,9 @@ struct ControllerCounters {
   std::uint64_t error_clear_requests = 0;  // 0x441
   std::uint64_t ultrasonic_requests = 0;   // 0x451
   std::uint64_t rearms = 0;  // latch cleared by resume() (or a zero twist: rearm_on_zero_twist)
-  std::uint64_t invalid_commands = 0;      // set_command refused (NaN or inf in a component)
-  std::uint64_t light_commands = 0;        // 0x121
-  std::uint64_t version_requests = 0;      // 0x4A1
+  std::uint64_t invalid_commands = 0;  // set_command refused (NaN or inf in a component)
+  std::uint64_t light_commands = 0;    // 0x121
+  std::uint64_t version_requests = 0;  // 0x4A1
 };
 
 struct ControllerState {
@@ -286,7 +293,7 @@ struct ControllerState {
   BodyTwist limited;  // requested twist after the speed limiters (what is driven)
   // 1 = full speed; below 1 the speed is held back until the wheels reach the commanded angle.
   double steer_first_factor = 1.0;
-  std::optional<KinematicsSolution> last_solution;   // for the last motion 0x111
+  std::optional<KinematicsSolution> last_solution;  // for the last motion 0x111
   // KinematicsFlag bits of the command driven now (0 while nothing is driven): how it differs
   // from the request. A component dropped only until the mode switch the selector is about to
   // make (a rotation asked of Ackermann at standstill, on its way to spin) is left out.
@@ -489,6 +496,12 @@ class ChassisController {
   ChassisFeedback feedback_;
   ModeSelector selector_;
   ModeSwitchSequencer mode_switch_;
+  // Completes a confirmed switch once the wheels are at the new mode's angles (0x271), or after
+  // the chassis's switch time without 0x271.
+  void settle_switch(Timestamp now);
+  std::optional<bool> wheels_at_switch_target(Timestamp now) const;
+  std::optional<std::array<double, 4>> previous_wheel_angles_;  // the 0x271 before the last
+  bool wheels_still_ = false;  // the last two 0x271 within 0.005 rad of each other
   RearmLatch latch_;
   SpeedLimiter limiter_vx_, limiter_vy_, limiter_wz_;
   SendObserver observer_;

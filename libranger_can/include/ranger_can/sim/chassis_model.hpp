@@ -20,7 +20,8 @@
 // simulator is the independent oracle the controller's kinematics and odometry are tested against.
 //
 // A motion-mode switch first brings the body to rest, then turns the wheels from where they stand
-// to the new mode's neutral position over a set duration; only then is the new mode current.
+// to the new mode's neutral position along a TurnProfile (switch_model.hpp: a set duration, or the
+// field's slew); only then is the new mode current.
 #pragma once
 
 #include <array>
@@ -28,6 +29,7 @@
 #include "ranger_can/control/geometry.hpp"
 #include "ranger_can/control/kinematics.hpp"  // BodyTwist, WheelState(s)
 #include "ranger_can/control/odometry.hpp"    // Pose2D
+#include "ranger_can/sim/switch_model.hpp"
 #include "ranger_can/types.hpp"
 #include "ranger_can/wire/codec.hpp"
 #include "ranger_can/wire/interpretation.hpp"
@@ -69,10 +71,17 @@ class ChassisModel {
   void stop(bool emergency);
 
   // Starts switching to `mode` (no-op when already there and not switching; a new target mode
-  // during a switch restarts it). Returns true if a switch started.
-  bool begin_mode_switch(protocol::MotionMode mode, double turn_duration_s);
+  // during a switch restarts it, the wheels turning from where they stand). Returns true if a
+  // switch started.
+  bool begin_mode_switch(protocol::MotionMode mode, const TurnProfile& turn);
+  bool begin_mode_switch(protocol::MotionMode mode, double turn_duration_s) {
+    TurnProfile turn;
+    turn.fixed_duration = turn_duration_s;
+    return begin_mode_switch(mode, turn);
+  }
   // While held, a switch never completes (fault injection); releasing lets it finish.
   void hold_mode_switch(bool hold) { hold_switch_ = hold; }
+  bool mode_switch_held() const { return hold_switch_; }
 
   // Advances time by dt seconds (internally in sub-steps of at most 1 ms).
   void advance(double dt);
@@ -104,6 +113,7 @@ class ChassisModel {
   enum class SwitchPhase { kNone, kStopping, kTurning };
 
   void sub_step(double h);
+  void start_turning(const WheelStates& now);  // the wheels begin turning from `now`
   double clamp_steering(protocol::MotionMode mode, double steering) const;
   double clamp_speed(protocol::MotionMode mode, double speed) const;
 
@@ -117,10 +127,13 @@ class ChassisModel {
 
   SwitchPhase switch_phase_ = SwitchPhase::kNone;
   protocol::MotionMode switch_target_ = protocol::MotionMode::kAckermann;
+  TurnProfile switch_turn_;
+  double switch_distance_ = 0.0;  // rad, the largest wheel turn of the switch
   double switch_duration_ = 0.0;
   double switch_elapsed_ = 0.0;
   bool hold_switch_ = false;
-  WheelStates switch_from_{};  // wheel angles when the wheels began turning
+  WheelStates switch_from_{};                         // wheel angles when the wheels began turning
+  std::array<double, kWheelCount> switch_turn_by_{};  // rad each wheel turns, the short way
 
   Pose2D pose_;
   double distance_ = 0.0;

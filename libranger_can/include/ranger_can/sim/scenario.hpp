@@ -144,6 +144,9 @@ struct ScenarioOptions {
   DriverConfig driver;  // the library's defaults = the ROS node's defaults
   // The chassis before the variant applies (its model and profile: chassis_for_model).
   VirtualChassisConfig chassis;
+  // Where every frame of the run goes, both ways, as a candump -L log in simulated time
+  // (bus_recording.hpp); nullptr: not recorded. Must outlive the run.
+  std::ostream* candump = nullptr;
 };
 // Checks the options (variant known, every >= 1 ms, the driver config valid).
 Status validate(const ScenarioOptions& options);

@@ -33,9 +33,11 @@
 //    from bytes 4-5 with the spin sign (the MINI V1's negated field), and 0x221 reports it in
 //    bytes 0-1, left positive, with 90 deg as the angle (reading).
 //  * Lights: chassis_lights.hpp (0x121 in CAN mode, the remote's SWA while it has the chassis).
-//  * 0x141 starts a switch: the body brakes to rest, then the wheels turn for
-//    `mode_switch_duration`; meanwhile 0x291 reports the mode being left with switching = 1 and
-//    speed commands are ignored. A 0x141 naming the current mode changes nothing.
+//  * 0x141 starts a switch: the body brakes to rest, then the wheels turn to the new mode's angles
+//    (over `mode_switch_duration`, or at the field's slew rate); speed commands are ignored
+//    meanwhile. What 0x291 reports of it is the switch model's (switch_model.hpp: the mode being
+//    left with switching = 1 throughout, the manual's reading; or the new mode at once with the
+//    flag on some switches, the field's). A 0x141 naming the current mode changes nothing.
 //  * 0x111's linear speed is the body centre's (interpretation point 7).
 //  * 0x221: Ackermann — the front angle of the profile's steering_reference ((alpha+beta)/2 or the
 //    inner wheel's) and the speed of its feedback_speed (the mean of the four wheel speeds, point
@@ -93,6 +95,7 @@
 #include "ranger_can/sim/chassis_lights.hpp"
 #include "ranger_can/sim/chassis_model.hpp"
 #include "ranger_can/sim/drivetrain_model.hpp"
+#include "ranger_can/sim/switch_model.hpp"
 #include "ranger_can/transport/bus.hpp"
 #include "ranger_can/wire/codec.hpp"
 #include "ranger_can/wire/frame.hpp"
@@ -127,7 +130,10 @@ struct VirtualChassisConfig {
   bool odometer_frames = false;     // 0x311 / 0x312 front and rear wheel odometers every 20 ms
   bool spin_angle_reported = true;  // 0x221's angle in spin mode (false: 0, as at rest)
   DrivetrainConfig drivetrain;
-  std::chrono::nanoseconds mode_switch_duration = std::chrono::milliseconds(500);
+  std::chrono::nanoseconds mode_switch_duration = std::chrono::milliseconds(500);  // fixed_duration
+  // How a switch is reported and how the wheels turn (the manual's reading by default; the
+  // field's for the MINI 3.0: chassis_for_model, sim_bus_source.hpp).
+  SwitchModelConfig switch_model;
   std::chrono::nanoseconds command_timeout =
       std::chrono::milliseconds(protocol::kChassisCommandTimeoutMs);
   double initial_soc = 90.0;         // %
@@ -285,6 +291,8 @@ class VirtualChassis {
 
   void handle_motion_command(const MotionCommand& cmd);
   void handle_motion_mode(const MotionModeCommand& cmd);
+  // Starts a switch to `mode` (0x141 or the remote); true when one started.
+  bool begin_switch(protocol::MotionMode mode);
   void handle_control_mode(const ControlModeCommand& cmd);
   void handle_ultrasonic_setting(const UltrasonicSettingCommand& cmd);
   void handle_drive_mode(const DriveModeCommand& cmd);
@@ -306,6 +314,7 @@ class VirtualChassis {
   VirtualChassisConfig config_;
   ChassisModel motion_;
   DrivetrainModel drivetrain_;
+  SwitchModel switch_;
   Timestamp now_;
 
   protocol::ControlMode control_mode_ = protocol::ControlMode::kStandby;
