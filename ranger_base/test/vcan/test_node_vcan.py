@@ -69,7 +69,10 @@ class VcanNode(unittest.TestCase):
         cls.node_exe = roslib.packages.find_node("ranger_base", "ranger_base_node")[0]
         cls.candump_log = os.path.join(cls.tmp, "candump.log")
         cls.pose_log = os.path.join(cls.tmp, "pose.jsonl")
-        cls.candump = subprocess.Popen(["candump", "-L", IFACE],
+        # Line-buffered (stdbuf): candump writes through stdio, which holds up to 4 KB of lines
+        # back when its output is a file, and a test reading the log would miss the newest
+        # frames (the node's stop, seen missing once under load).
+        cls.candump = subprocess.Popen(["stdbuf", "-oL", "candump", "-L", IFACE],
                                        stdout=open(cls.candump_log, "w"))
         cls.sim = subprocess.Popen([cls.ranger_can, "sim", IFACE, "--no-stdin", "--quiet",
                                     "--pose-out", cls.pose_log, "--pose-rate", "50"])
@@ -146,6 +149,13 @@ class VcanNode(unittest.TestCase):
         """The last 0x111 is a stop that followed the driving commands without the chassis's
         watchdog tripping in between, and the chassis came to rest."""
         self.assertTrue(wait_for(lambda: abs(self.truth()["vx"]) < 1e-3), "chassis at rest")
+
+        def logged_stop():  # candump has written a zero 0x111 after the signal
+            commands = [f for f in self.frames() if f["name"] == "motion_command"]
+            return commands and commands[-1]["t"] >= t_signal - FRAME_PERIOD_S and (
+                commands[-1]["linear_speed"], commands[-1]["spin_speed"]) == (0.0, 0.0)
+
+        wait_for(logged_stop, timeout=10, interval=0.2)  # bounded: the assertions below judge
         frames = self.frames()
         commands = [i for i, f in enumerate(frames) if f["name"] == "motion_command"]
         self.assertTrue(commands, "the node sent 0x111")
