@@ -35,7 +35,7 @@ from ._ranger_can import (  # noqa: F401  (re-exported)
     driver_status_bit_names, error_clear_description, error_names, event_kinds, fault_names,
     light_modes, model_names, motion_mode_pinned, resume_answered, resume_refused_offline,
     clear_errors_answer,
-    unknown_motion_mode_number,
+    unknown_motion_mode_number, motion_mode_numbers, light_mode_numbers, drive_mode_numbers,
     motion_modes, parameters, protocol_names, refusal_names, steering_joint_names, variant_names,
     wheel_joint_names)
 
@@ -45,7 +45,8 @@ __all__ = [
     "diagnostic_group_names",
     "check_parameter",
     "decode", "replay_odometry", "parameters", "model_names", "variant_names", "protocol_names",
-    "motion_modes", "light_modes", "refusal_names", "fault_names", "steering_joint_names",
+    "motion_modes", "light_modes", "motion_mode_numbers", "light_mode_numbers",
+    "drive_mode_numbers", "refusal_names", "fault_names", "steering_joint_names",
     "wheel_joint_names", "__version__",
 ]
 

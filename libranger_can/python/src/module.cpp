@@ -889,6 +889,28 @@ PYBIND11_MODULE(_ranger_can, m) {
   });
   m.def("motion_modes", [] { return protocol::kMotionModeNames.names(); });
   m.def("light_modes", [] { return protocol::kLightModeNames.names(); });
+  // The front ends' numbers (ranger_msgs' constants): SetMotionMode's (None: automatic),
+  // SetLights', SetDriveMode's, each with the library's name.
+  m.def("motion_mode_numbers", [] {
+    std::vector<std::pair<int, std::optional<std::string>>> out;
+    for (const auto& [number, mode] : motion_mode_numbers()) {
+      out.emplace_back(number, mode ? std::optional<std::string>(protocol::to_string(*mode))
+                                    : std::nullopt);
+    }
+    return out;
+  });
+  m.def("light_mode_numbers", [] {
+    std::vector<std::pair<int, std::string>> out;
+    for (const auto& row : protocol::kLightModeNames)
+      out.emplace_back(static_cast<int>(row.value), std::string(row.name));
+    return out;
+  });
+  m.def("drive_mode_numbers", [] {
+    std::vector<std::pair<int, std::string>> out;
+    for (const auto& row : protocol::kDriveModeNames)
+      out.emplace_back(static_cast<int>(row.value), std::string(row.name));
+    return out;
+  });
   m.def("refusal_names", [] { return kMotionRefusalNames.names(); });
   m.def("event_kinds", [] { return kEventKindNames.names(); });
   m.def("fault_names", [] {

@@ -55,14 +55,17 @@ from ranger_can import RangerError, RequestFailed, RequestTimeout
 
 from . import conversions, parameters
 
-MOTION_MODES = {SetMotionMode.Request.ACKERMANN: "ackermann",
-                SetMotionMode.Request.OBLIQUE: "oblique", SetMotionMode.Request.SPIN: "spin",
-                SetMotionMode.Request.SIDE_SLIP: "side_slip",
-                SetMotionMode.Request.AUTOMATIC: None}
-DRIVE_MODES = {SetDriveMode.Request.CURRENT: "current", SetDriveMode.Request.VOLTAGE: "voltage"}
-LIGHT_MODES = {SetLights.Request.OFF: "off", SetLights.Request.ON: "on",
-               SetLights.Request.BREATHING: "breathing", SetLights.Request.CUSTOM: "custom"}
+# The services' numbers and what they mean: the library's (ranger_msgs' constants are the same
+# numbers, test/test_adapter.py), never re-typed here.
+MOTION_MODES = dict(ranger_can.motion_mode_numbers())  # None: automatic
+DRIVE_MODES = dict(ranger_can.drive_mode_numbers())
+LIGHT_MODES = dict(ranger_can.light_mode_numbers())
 LIGHT_CODES = {v: k for k, v in LIGHT_MODES.items()}
+
+
+def _numbered(modes):
+    """A service's valid numbers as its answers name them: 0 OFF, 1 ON, ..."""
+    return ", ".join(f"{n} {name.upper()}" for n, name in modes.items())
 
 
 # The driver's events that answer a call of the node's (a service's request settled, the motion
@@ -484,8 +487,7 @@ class RangerNode(Node):
                                                         ("rear", request.rear_mode))
                if mode not in LIGHT_MODES]
         if bad:
-            response.message = f"{', '.join(bad)} unknown (0 OFF, 1 ON, 2 BREATHING, 3 CUSTOM): " \
-                               "nothing sent"
+            response.message = f"{', '.join(bad)} unknown ({_numbered(LIGHT_MODES)}): nothing sent"
         else:
             custom = SetLights.Request.CUSTOM
             ok, message, _ = self._answer("set_lights", lambda: self.driver.set_lights(
@@ -515,8 +517,8 @@ class RangerNode(Node):
         mode = DRIVE_MODES.get(request.mode)
         if mode is None:
             response.success = False
-            response.message = (f"drive mode {request.mode} is not one of 0 (CURRENT), "
-                                "1 (VOLTAGE): nothing sent")
+            valid = ", ".join(f"{n} ({name.upper()})" for n, name in DRIVE_MODES.items())
+            response.message = f"drive mode {request.mode} is not one of {valid}: nothing sent"
         else:
             ok, message, _ = self._answer("set_drive_mode",
                                           lambda: self.driver.set_drive_mode(mode))
