@@ -64,7 +64,8 @@ if [ "$ros" = 1 ]; then
   run node "export PATH=/usr/bin:\$PATH; source install/setup.bash; /usr/bin/python3 \
 ranger_base/scripts/measure_performance.py --duration 20 --samples 400 --json $raw/node.json"
   # The ROS 2 node in the same run (the workspace scripts/test_ros2.sh builds), when it is there.
-  if [ -f build/ros2_ws/install/setup.bash ]; then
+  # Kilted's, unless RANGER_ROS2_DISTRO names another.
+  if [ -f "build/ros2_ws_${RANGER_ROS2_DISTRO:-kilted}/install/setup.bash" ]; then
     run node_ros2 "source scripts/ros2_env.sh 88; python -m ranger_base.measure_performance \
 --duration 20 --samples 400 --json $raw/node_ros2.json"
   fi

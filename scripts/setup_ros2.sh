@@ -1,9 +1,12 @@
 #!/usr/bin/env bash
 # Makes the ROS 2 environment of the `ros2` test stage, idempotently: a venv made with the
-# system's Python (/usr/bin/python3) holding ROS 2 Kilted from PyPI wheels, colcon, and what the
-# Python binding builds with (pybind11, scikit-build-core) and is tested with (pytest).
+# system's Python (/usr/bin/python3) holding one ROS 2 distribution (Jazzy or Kilted) from PyPI
+# wheels, colcon, and what the Python binding builds with (pybind11, scikit-build-core) and is
+# tested with (pytest).
 #
-#   scripts/setup_ros2.sh [VENV]      (default: $RANGER_ROS2_VENV, else .venv-ros2 in the checkout)
+#   RANGER_ROS2_DISTRO=jazzy|kilted scripts/setup_ros2.sh [VENV]
+#     distribution: default kilted; venv: default $RANGER_ROS2_VENV, else .venv-ros2-DISTRO in
+#     the checkout (each distribution a venv of its own)
 #
 # Two things the wheels lack are mended here, in the venv only (the packages in ros2/ build with
 # the standard ament, rosidl and rclpy APIs of any distribution and know nothing of this):
@@ -17,13 +20,23 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
-venv=${1:-${RANGER_ROS2_VENV:-$root/.venv-ros2}}
+distro=${RANGER_ROS2_DISTRO:-kilted}
+venv=${1:-${RANGER_ROS2_VENV:-$root/.venv-ros2-$distro}}
 python=/usr/bin/python3
-packages=(ros-kilted-rclpy ros-kilted-rmw-fastrtps-cpp ros-kilted-std-msgs ros-kilted-geometry-msgs
-  ros-kilted-nav-msgs ros-kilted-sensor-msgs ros-kilted-diagnostic-msgs ros-kilted-std-srvs
-  ros-kilted-rosidl-default-generators ros-kilted-rosidl-core-generators ros-kilted-ament-cmake
-  ros-kilted-ament-cmake-ros-core ros-kilted-ament-package ros-kilted-builtin-interfaces
-  catkin_pkg colcon-common-extensions pybind11 scikit-build-core pytest)
+# What both distributions have under the same names, then each one's own: Kilted gathers the
+# CMake support of ament_cmake_ros in ament-cmake-ros-core; Jazzy has no such package and needs
+# ament_cmake_ros and what it finds (gmock, gtest, pytest, python_cmake_module) by name.
+common=(rclpy rmw-fastrtps-cpp std-msgs geometry-msgs nav-msgs sensor-msgs diagnostic-msgs std-srvs
+  rosidl-default-generators rosidl-core-generators ament-cmake)
+case $distro in
+  kilted) own=(ament-cmake-ros-core ament-package builtin-interfaces) ;;
+  jazzy) own=(ament-cmake-ros ament-cmake-gmock ament-cmake-gtest ament-cmake-pytest
+    python-cmake-module ament-package builtin-interfaces) ;;
+  *) echo "setup_ros2: RANGER_ROS2_DISTRO=$distro: jazzy or kilted" >&2; exit 2 ;;
+esac
+packages=()
+for p in "${common[@]}" "${own[@]}"; do packages+=("ros-$distro-$p"); done
+packages+=(catkin_pkg colcon-common-extensions pybind11 scikit-build-core pytest)
 # Bump when the list above or the mending below changes: an older venv is then completed.
 stamp_text="ranger ros2 venv 1: ${packages[*]}"
 

@@ -1,16 +1,22 @@
 #!/usr/bin/env bash
-# The `ros2` stage of scripts/test.sh: the Python binding and the ROS 2 packages (ros2/), in the
-# venv of ROS 2 Kilted wheels that scripts/setup_ros2.sh makes.
-#   1. builds the ROS 2 packages the way the README tells an owner to, in a workspace whose src/
-#      holds this checkout: cd WS && colcon build --paths src/ranger_ros/ros2/*
-#   2. checks ros2/ranger_msgs against the ROS 1 ranger_msgs (sync_interfaces.py --check)
-#   3. runs the binding's tests (libranger_can/python/tests, `import ranger_can` from the
+# The `ros2` stage of scripts/test.sh: the Python binding and the ROS 2 packages (ros2/), on each
+# ROS 2 distribution tested here (Jazzy, Kilted), each in the venv of its PyPI wheels that
+# scripts/setup_ros2.sh makes. For each distribution:
+#   1. builds the ROS 2 packages the way the README tells an owner to, in a workspace of the
+#      distribution's own (build/ros2_ws_DISTRO) whose src/ holds this checkout:
+#      cd WS && colcon build --paths src/ranger_ros/ros2/*
+#   2. runs the binding's tests (libranger_can/python/tests, `import ranger_can` from the
 #      workspace) and the ROS 2 packages' tests (ros2/*/test), with discovery kept on this host
-#      (ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST) and a domain id of the stage's own
-#   4. `pip install ./libranger_can` into a fresh venv and the README's Python example with it
+#      (ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST) and a domain id of the distribution's own;
+#      JUnit reports ros2_DISTRO_binding.xml, ros2_DISTRO_PACKAGE.xml
+# and once: checks ros2/ranger_msgs against the ROS 1 ranger_msgs (sync_interfaces.py --check);
+# `pip install ./libranger_can` into a fresh venv and the README's Python example with it.
 # Usage: scripts/test_ros2.sh [RESULTS_DIR]   (JUnit reports go there; default build/test-results)
-# Environment: RANGER_ROS2_VENV (default .venv-ros2), RANGER_ROS2_DOMAIN_ID (default 87),
-# RANGER_JOBS, RANGER_ROS2_SKIP_PIP=1 to leave out step 4.
+# Environment: RANGER_ROS2_DISTRO=jazzy|kilted (one distribution; default both);
+# RANGER_ROS2_VENV_JAZZY, RANGER_ROS2_VENV_KILTED (a distribution's venv; default
+# .venv-ros2-DISTRO), RANGER_ROS2_VENV (the venv, when one distribution is selected);
+# RANGER_ROS2_DOMAIN_ID (default 86 for Jazzy, 87 for Kilted), RANGER_JOBS,
+# RANGER_ROS2_SKIP_PIP=1 to leave out the pip install.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 # shellcheck source=build_flags.sh
@@ -18,41 +24,63 @@ source scripts/build_flags.sh
 root=$(pwd)
 results=${1:-$root/build/test-results}
 mkdir -p "$results"
-venv=$(scripts/setup_ros2.sh | tail -1) || { echo "test_ros2: setup failed" >&2; exit 1; }
-ws=$root/build/ros2_ws
 jobs=${RANGER_JOBS:-$(nproc)}
 failed=0
+read -r -a distros <<<"${RANGER_ROS2_DISTRO:-jazzy kilted}"
+declare -A domain_of=([jazzy]=86 [kilted]=87)
 
-(
-  set -e
-  mkdir -p "$ws/src"
-  ln -sfn "$root" "$ws/src/ranger_ros"
-  touch "$root/build/COLCON_IGNORE" "$root/build/CATKIN_IGNORE"
-  # shellcheck disable=SC1091
-  source "$venv/bin/activate"
-  export AMENT_PREFIX_PATH=$venv CMAKE_PREFIX_PATH=$venv
-  cd "$ws"
-  colcon --log-base log build --paths src/ranger_ros/ros2/* \
-    --event-handlers console_cohesion- summary+ --parallel-workers "$jobs" \
-    --cmake-args -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=$ranger_relwithdebinfo_flags" \
-    -DBUILD_TESTING=OFF
-) || { echo "test_ros2: the colcon build failed" >&2; exit 1; }
+# One distribution: its venv, its workspace, its tests, its domain id. Returns non-zero when
+# anything failed.
+run_distro() {
+  local distro=$1 venv_var="RANGER_ROS2_VENV_${1^^}" venv ws started=$SECONDS
+  if [ -z "${!venv_var:-}" ] && [ ${#distros[@]} -gt 1 ] && [ -n "${RANGER_ROS2_VENV:-}" ]; then
+    echo "test_ros2: RANGER_ROS2_VENV names one venv for ${distros[*]}: set RANGER_ROS2_DISTRO," \
+      "or $venv_var" >&2
+    return 1
+  fi
+  venv=$(RANGER_ROS2_DISTRO=$distro RANGER_ROS2_VENV=${!venv_var:-${RANGER_ROS2_VENV:-}} \
+    scripts/setup_ros2.sh | tail -1) || { echo "test_ros2: $distro: setup failed" >&2; return 1; }
+  ws=$root/build/ros2_ws_$distro
+  echo "test_ros2: $distro: venv $venv, workspace $ws"
+  (
+    set -e
+    mkdir -p "$ws/src"
+    ln -sfn "$root" "$ws/src/ranger_ros"
+    touch "$root/build/COLCON_IGNORE" "$root/build/CATKIN_IGNORE"
+    # shellcheck disable=SC1091
+    source "$venv/bin/activate"
+    export AMENT_PREFIX_PATH=$venv CMAKE_PREFIX_PATH=$venv
+    cd "$ws"
+    colcon --log-base log build --paths src/ranger_ros/ros2/* \
+      --event-handlers console_cohesion- summary+ --parallel-workers "$jobs" \
+      --cmake-args -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=$ranger_relwithdebinfo_flags" \
+      -DBUILD_TESTING=OFF
+  ) || { echo "test_ros2: $distro: the colcon build failed" >&2; return 1; }
+  local built=$SECONDS
+  (
+    # shellcheck disable=SC1091
+    RANGER_ROS2_DISTRO=$distro RANGER_ROS2_VENV=$venv \
+      source scripts/ros2_env.sh "${RANGER_ROS2_DOMAIN_ID:-${domain_of[$distro]}}"
+    rc=0
+    python -m pytest -p no:cacheprovider -q libranger_can/python/tests \
+      --junitxml="$results/ros2_${distro}_binding.xml" || rc=1
+    for t in ros2/*/test; do
+      pkg=$(basename "$(dirname "$t")")
+      (cd "$t" && python -m pytest -p no:cacheprovider -q . \
+        --junitxml="$results/ros2_${distro}_$pkg.xml") || rc=1
+    done
+    exit $rc
+  ) || { echo "test_ros2: $distro: tests failed" >&2; return 1; }
+  echo "test_ros2: $distro passed (build $((built - started)) s, tests $((SECONDS - built)) s)"
+}
 
 /usr/bin/python3 ros2/ranger_msgs/sync_interfaces.py --check || failed=1
-
-(
-  # shellcheck disable=SC1091
-  RANGER_ROS2_VENV=$venv source scripts/ros2_env.sh "${RANGER_ROS2_DOMAIN_ID:-87}"
-  rc=0
-  python -m pytest -p no:cacheprovider -q libranger_can/python/tests \
-    --junitxml="$results/ros2_binding.xml" || rc=1
-  for t in ros2/*/test; do
-    pkg=$(basename "$(dirname "$t")")
-    (cd "$t" && python -m pytest -p no:cacheprovider -q . \
-      --junitxml="$results/ros2_$pkg.xml") || rc=1
-  done
-  exit $rc
-) || failed=1
+for distro in "${distros[@]}"; do
+  case $distro in
+    jazzy | kilted) run_distro "$distro" || failed=1 ;;
+    *) echo "test_ros2: RANGER_ROS2_DISTRO=$distro: jazzy or kilted" >&2; failed=1 ;;
+  esac
+done
 
 if [ "${RANGER_ROS2_SKIP_PIP:-0}" != 1 ]; then
   (

@@ -947,6 +947,35 @@ TEST(ControllerCommand, ANonFiniteComponentInAnyOfTheSixIsRefusedByNameWhileItLa
   }
 }
 
+// A stamped command older than cmd_timeout must not drive: refused, said (kStaleCommand), the
+// chassis stopped until a fresh one comes; one within cmd_timeout (or unstamped) drives.
+TEST(ControllerCommand, AStampedCommandOlderThanTheCommandTimeoutIsRefusedWhileItLasts) {
+  Rig rig;
+  rig.connect_in_can_mode();
+  MotionRequest fresh{BodyTwist{0.3, 0, 0}};
+  fresh.age = 100ms;
+  ASSERT_TRUE(rig.ctl->set_command(fresh, rig.now).ok());
+  rig.run(40ms);
+  ASSERT_TRUE(is_moving(rig.motion_frames().back()));
+  MotionRequest stale{BodyTwist{0.3, 0, 0}};
+  stale.age = 800ms;  // cmd_timeout: 500 ms
+  for (int i = 0; i < 20; ++i) {
+    const Status st = rig.ctl->set_command(stale, rig.now);
+    ASSERT_FALSE(st.ok());
+    EXPECT_EQ(st.error().code, Errc::kTimeout);
+    rig.run(50ms);
+    EXPECT_EQ(rig.state().refusal, MotionRefusal::kStaleCommand);
+    EXPECT_EQ(rig.state().stale_command, "stamped 0.8 s ago, older than cmd_vel_timeout 0.5 s");
+    EXPECT_TRUE(is_zero(motion_of(rig.motion_frames().back())));
+  }
+  EXPECT_EQ(to_string(MotionRefusal::kStaleCommand), "stale_command");
+  ASSERT_TRUE(rig.ctl->set_command(fresh, rig.now).ok());
+  rig.run(40ms);
+  EXPECT_EQ(rig.state().refusal, MotionRefusal::kNone);
+  EXPECT_TRUE(rig.state().stale_command.empty());
+  EXPECT_TRUE(is_moving(rig.motion_frames().back()));
+}
+
 TEST(ControllerCommand, TheModesADriverCanForceAreTheProfilesOwn) {
   using M = MotionMode;
   EXPECT_EQ(drivable_modes(manual_profile()),

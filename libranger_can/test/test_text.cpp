@@ -21,6 +21,7 @@
 #include "ranger_can/control/odometry.hpp"
 #include "ranger_can/control/parameters.hpp"
 #include "ranger_can/control/rearm.hpp"
+#include "ranger_can/frontend/node_parameters.hpp"
 #include "ranger_can/json.hpp"
 #include "ranger_can/sim/scenario.hpp"
 #include "ranger_can/text.hpp"
@@ -123,6 +124,7 @@ TEST(EnumNames, EveryTableHoldsEveryEnumerator) {
   expect_table_complete(kSeverityNames, "Severity");
   expect_table_complete(kEventKindNames, "EventKind");
   expect_table_complete(kDiagnosticLevelNames, "DiagnosticLevel");
+  expect_table_complete(kCmdVelStampedNames, "CmdVelStamped");
 }
 
 // The finder itself: it sees a missing enumerator.

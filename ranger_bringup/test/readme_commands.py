@@ -654,9 +654,10 @@ def ros2_workspace_build(session, cmd, match):
     script = read("scripts/test_ros2.sh")
     assert 'ln -sfn "$root" "$ws/src/ranger_ros"' in script
     assert "build --paths src/ranger_ros/ros2/*" in script
-    assert "ws=$root/build/ros2_ws" in script
+    assert "ws=$root/build/ros2_ws_$distro" in script  # a workspace per distribution
     assert "source scripts/ros2_env.sh" in script  # the tests run in that workspace's setup
-    assert 'source "$ranger_root/build/ros2_ws/install/setup.bash"' in read("scripts/ros2_env.sh")
+    assert 'source "$ranger_root/build/ros2_ws_$ranger_distro/install/setup.bash"' in \
+        read("scripts/ros2_env.sh")
 
 
 def ros2_launch_checked(session, cmd, match):

@@ -35,7 +35,7 @@ from ._ranger_can import (  # noqa: F401  (re-exported)
     driver_status_bit_names, error_clear_description, error_names, event_kinds, fault_names,
     light_modes, model_names, motion_mode_pinned, resume_answered, resume_refused_offline,
     clear_errors_answer,
-    unknown_motion_mode_number,
+    unknown_motion_mode_number, motion_mode_numbers, light_mode_numbers, drive_mode_numbers,
     motion_modes, parameters, protocol_names, refusal_names, steering_joint_names, variant_names,
     wheel_joint_names)
 
@@ -45,7 +45,8 @@ __all__ = [
     "diagnostic_group_names",
     "check_parameter",
     "decode", "replay_odometry", "parameters", "model_names", "variant_names", "protocol_names",
-    "motion_modes", "light_modes", "refusal_names", "fault_names", "steering_joint_names",
+    "motion_modes", "light_modes", "motion_mode_numbers", "light_mode_numbers",
+    "drive_mode_numbers", "refusal_names", "fault_names", "steering_joint_names",
     "wheel_joint_names", "__version__",
 ]
 
@@ -242,15 +243,19 @@ class Driver:
     # ---- commands (the driver's mailbox: never waits for the bus) ----
     def command(self, vx: float = 0.0, vy: float = 0.0, wz: float = 0.0,
                 mode: Optional[str] = None, vz: float = 0.0, wx: float = 0.0,
-                wy: float = 0.0) -> None:
+                wy: float = 0.0, age: Optional[float] = None) -> None:
         """The motion wanted from now on (REP-103: m/s, rad/s), optionally in a forced mode.
         Repeat it at least every cmd_vel_timeout (0.5 s), or the driver stops the chassis.
         vz, wx, wy (a twist's linear.z, angular.x, angular.y) are not driven, only checked.
+        age: how old a stamped command is (s; None: unstamped, or a zero stamp): older than
+        cmd_vel_timeout, it is not obeyed (the chassis is commanded to stop and the snapshot's
+        refusal is "stale_command", saying how old, until a fresh command).
         RangerError for NaN/inf in any of the six (the chassis is then commanded to stop, and the
         snapshot's refusal is "invalid_command" naming it until a valid command) or a bus never
         opened."""
         self._check_open()
-        self._s.command(float(vx), float(vy), float(wz), mode, float(vz), float(wx), float(wy))
+        self._s.command(float(vx), float(vy), float(wz), mode, float(vz), float(wx), float(wy),
+                        None if age is None else float(age))
 
     def set_motion_mode(self, mode: Optional[str]) -> None:
         """Pins every later command to "ackermann", "oblique", "spin" or "side_slip" (where the

@@ -11,6 +11,7 @@
 
 #include <array>
 #include <chrono>
+#include <cmath>
 #include <sstream>
 #include <string>
 
@@ -168,6 +169,7 @@ py::dict node_values(const NodeParameters& n) {
   d["publish_rate"] = n.publish_rate;
   d["state_publish_rate"] = n.state_publish_rate;
   d["publish_cmd"] = n.publish_cmd;
+  d["cmd_vel_stamped"] = std::string(to_string(n.cmd_vel_stamped));
   d["pose_covariance_diagonal"] =
       std::vector<double>(n.pose_covariance_diagonal.begin(), n.pose_covariance_diagonal.end());
   d["twist_covariance_diagonal"] =
@@ -748,14 +750,21 @@ PYBIND11_MODULE(_ranger_can, m) {
       .def(
           "command",
           [](PySession& p, double vx, double vy, double wz, std::optional<std::string> mode,
-             double vz, double wx, double wy) {
+             double vz, double wx, double wy, std::optional<double> age) {
             // All six components: the driver refuses NaN/inf in any of them (naming it).
             MotionRequest r{BodyTwist{vx, vy, wz}, std::nullopt, OutOfPlaneTwist{vz, wx, wy}};
             if (mode) r.mode = parse_mode(*mode);
+            // A stamped twist's age (s): older than cmd_vel_timeout, the driver refuses it
+            // (stale_command in the snapshot); NaN is no age.
+            if (age && std::isfinite(*age)) {
+              r.age = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                  std::chrono::duration<double>(*age));
+            }
             check(p.s().driver().command(r));
           },
           py::arg("vx"), py::arg("vy"), py::arg("wz"), py::arg("mode") = py::none(),
-          py::arg("vz") = 0.0, py::arg("wx") = 0.0, py::arg("wy") = 0.0)
+          py::arg("vz") = 0.0, py::arg("wx") = 0.0, py::arg("wy") = 0.0,
+          py::arg("age") = py::none())
       .def(
           "set_motion_mode",
           [](PySession& p, std::optional<std::string> mode) {
@@ -880,6 +889,28 @@ PYBIND11_MODULE(_ranger_can, m) {
   });
   m.def("motion_modes", [] { return protocol::kMotionModeNames.names(); });
   m.def("light_modes", [] { return protocol::kLightModeNames.names(); });
+  // The front ends' numbers (ranger_msgs' constants): SetMotionMode's (None: automatic),
+  // SetLights', SetDriveMode's, each with the library's name.
+  m.def("motion_mode_numbers", [] {
+    std::vector<std::pair<int, std::optional<std::string>>> out;
+    for (const auto& [number, mode] : motion_mode_numbers()) {
+      out.emplace_back(number, mode ? std::optional<std::string>(protocol::to_string(*mode))
+                                    : std::nullopt);
+    }
+    return out;
+  });
+  m.def("light_mode_numbers", [] {
+    std::vector<std::pair<int, std::string>> out;
+    for (const auto& row : protocol::kLightModeNames)
+      out.emplace_back(static_cast<int>(row.value), std::string(row.name));
+    return out;
+  });
+  m.def("drive_mode_numbers", [] {
+    std::vector<std::pair<int, std::string>> out;
+    for (const auto& row : protocol::kDriveModeNames)
+      out.emplace_back(static_cast<int>(row.value), std::string(row.name));
+    return out;
+  });
   m.def("refusal_names", [] { return kMotionRefusalNames.names(); });
   m.def("event_kinds", [] { return kEventKindNames.names(); });
   m.def("fault_names", [] {

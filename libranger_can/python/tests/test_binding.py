@@ -119,6 +119,25 @@ def test_no_fresh_command_stops_the_chassis(sim):
     sim.wait_until(lambda s: s.refusal == "none" and sim.ground_truth().vx > 0.1, timeout=10)
 
 
+def test_a_command_older_than_the_timeout_is_not_obeyed(sim):
+    """A stamped command's age: within cmd_vel_timeout (or None: unstamped, a zero stamp) it
+    drives; older, the driver refuses it ("stale_command", saying how old) and stops."""
+    sim.command(vx=0.4, age=0.1)
+    sim.wait_until(lambda s: sim.ground_truth().vx > 0.3, timeout=10)
+
+    def stale(s):
+        sim.command(vx=0.4, age=2.0)
+        return s.refusal == "stale_command" and abs(sim.ground_truth().vx) < 1e-3
+    s = sim.wait_until(stale, timeout=10)
+    assert "stamped 2 s ago, older than cmd_vel_timeout 0.5 s" in s.refusal_detail, \
+        s.refusal_detail
+
+    def fresh(s):
+        sim.command(vx=0.4, age=None)
+        return s.refusal == "none" and sim.ground_truth().vx > 0.3
+    sim.wait_until(fresh, timeout=10)
+
+
 def test_estop_latches_until_resume(sim):
     sim.events()  # what happened before
     assert sim.inject("estop on") is not None

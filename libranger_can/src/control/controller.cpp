@@ -294,9 +294,26 @@ Status ChassisController::set_command(const MotionRequest& request, Timestamp no
     state_.last_command_time = now;
     state_.cmd_timed_out = false;
     state_.invalid_command = st.error().message;
+    state_.stale_command.clear();
     ++state_.counters.invalid_commands;
     command_changed_ = true;
     return Error{Errc::kNotFinite, "controller: command " + st.error().message + "; stopping"};
+  }
+  state_.stale_command.clear();
+  if (request.age && *request.age > config_.cmd_timeout) {
+    // A command older than the command timeout would have timed out already: stop, and say so
+    // (kStaleCommand) until a fresh request comes.
+    using Seconds = std::chrono::duration<double>;
+    state_.requested = MotionRequest{};
+    state_.has_command = true;
+    state_.last_command_time = now;
+    state_.cmd_timed_out = false;
+    state_.invalid_command.clear();
+    state_.stale_command = "stamped " + text::number_text(Seconds(*request.age).count()) +
+                           " s ago, older than cmd_vel_timeout " +
+                           text::number_text(Seconds(config_.cmd_timeout).count()) + " s";
+    command_changed_ = true;
+    return Error{Errc::kTimeout, "controller: command " + state_.stale_command + "; stopping"};
   }
   if (request.mode) {
     if (Status st = check_drivable(*request.mode, config_.profile); !st) {
@@ -648,6 +665,7 @@ MotionRefusal ChassisController::evaluate_refusal() const {
   if (identifying) return MotionRefusal::kIdentifying;
   if (state_.cmd_timed_out) return MotionRefusal::kCmdTimeout;
   if (!state_.invalid_command.empty()) return MotionRefusal::kInvalidCommand;
+  if (!state_.stale_command.empty()) return MotionRefusal::kStaleCommand;
   if (selector_.below_minimum(state_.requested.twist)) return MotionRefusal::kBelowMinimum;
   return MotionRefusal::kNone;
 }
@@ -738,9 +756,10 @@ ChassisController::MotionGate ChassisController::gate_motion() const {
               state_.motion_mode.has_value() && !state_.quiet;
   g.parking = r == MotionRefusal::kParked && state_.chassis_mode.has_value();
   const bool drivable = r == MotionRefusal::kNone || r == MotionRefusal::kModeSwitchFailed;
-  g.leaving_park = leave_park_ && state_.parked() &&
-                   (drivable || r == MotionRefusal::kCmdTimeout ||
-                    r == MotionRefusal::kBelowMinimum || r == MotionRefusal::kInvalidCommand);
+  g.leaving_park =
+      leave_park_ && state_.parked() &&
+      (drivable || r == MotionRefusal::kCmdTimeout || r == MotionRefusal::kBelowMinimum ||
+       r == MotionRefusal::kInvalidCommand || r == MotionRefusal::kStaleCommand);
   g.may_drive = (drivable && state_.has_command) || (g.probing && probe_mode_.has_value()) ||
                 g.parking || g.leaving_park;
   return g;

@@ -361,6 +361,10 @@ std::string describe_refusal(const ControllerState& c, const IdentificationStatu
       return "invalid_command: cmd_vel refused, " + c.invalid_command +
              " (a NaN or an infinity in any of its six fields refuses the whole twist): chassis "
              "commanded to stop until a valid cmd_vel comes";
+    case MotionRefusal::kStaleCommand:
+      return "stale_command: cmd_vel refused, " + c.stale_command +
+             " (a stamped cmd_vel older than cmd_vel_timeout must not drive; a zero stamp means "
+             "now): chassis commanded to stop until a fresh cmd_vel comes";
     case MotionRefusal::kBelowMinimum:
       return "below_minimum: cmd_vel is below what the chassis can express (mode_selection/"
              "min_linear_speed, min_yaw_rate): not driven";

@@ -245,6 +245,19 @@ void add_connection(std::vector<Binding>& out) {
                     .apply(RANGER_SET(state_publish_rate, v.number)));
   out.push_back(Row("publish_cmd", T::kBool, "", {}, d.publish_cmd, "publish `cmd_vel_out`")
                     .apply(RANGER_SET(publish_cmd, v.boolean)));
+  out.push_back(
+      Row("cmd_vel_stamped", T::kChoice, "", {}, std::string(to_string(d.cmd_vel_stamped)),
+          "the ROS 2 node: `cmd_vel` as geometry_msgs/TwistStamped (`true`: Nav2's "
+          "`enable_stamped_cmd_vel`, ros2_control's drive controllers, twist_mux and the teleops' "
+          "`stamped`) or Twist (`false`); `auto`: the type of the topic's publishers, once the "
+          "first appears and whenever they all use the other (said in the log). A stamp older than "
+          "`cmd_vel_timeout` is not obeyed (`stale_command`); a zero stamp means now. The ROS 1 "
+          "node takes Twist")
+          .choices(kCmdVelStampedNames.names())
+          .apply([](NodeParameters& p, const ParameterValue& v) {
+            p.cmd_vel_stamped = kCmdVelStampedNames.parse(v.text).value_or(CmdVelStamped::kAuto);
+            return ok_status();
+          }));
 }
 
 void add_control(std::vector<Binding>& out) {

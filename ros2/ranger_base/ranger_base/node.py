@@ -55,15 +55,22 @@ from ranger_can import RangerError, RequestFailed, RequestTimeout
 
 from . import conversions, parameters
 
-MOTION_MODES = {SetMotionMode.Request.ACKERMANN: "ackermann",
-                SetMotionMode.Request.OBLIQUE: "oblique", SetMotionMode.Request.SPIN: "spin",
-                SetMotionMode.Request.SIDE_SLIP: "side_slip",
-                SetMotionMode.Request.AUTOMATIC: None}
-DRIVE_MODES = {SetDriveMode.Request.CURRENT: "current", SetDriveMode.Request.VOLTAGE: "voltage"}
-LIGHT_MODES = {SetLights.Request.OFF: "off", SetLights.Request.ON: "on",
-               SetLights.Request.BREATHING: "breathing", SetLights.Request.CUSTOM: "custom"}
+# The services' numbers and what they mean: the library's (ranger_msgs' constants are the same
+# numbers, test/test_adapter.py), never re-typed here.
+MOTION_MODES = dict(ranger_can.motion_mode_numbers())  # None: automatic
+DRIVE_MODES = dict(ranger_can.drive_mode_numbers())
+LIGHT_MODES = dict(ranger_can.light_mode_numbers())
 LIGHT_CODES = {v: k for k, v in LIGHT_MODES.items()}
 
+
+def _numbered(modes):
+    """A service's valid numbers as its answers name them: 0 OFF, 1 ON, ..."""
+    return ", ".join(f"{n} {name.upper()}" for n, name in modes.items())
+
+
+# The driver's events that answer a call of the node's (a service's request settled, the motion
+# mode pinned): each is the service's answer, logged once as the answer (_log_answer).
+ANSWER_EVENTS = {"request_settled", "motion_mode_requested"}
 
 # s: Python's thread switch interval in the node (sys.setswitchinterval; main() says why).
 GIL_SWITCH_INTERVAL = 0.0005
@@ -208,12 +215,20 @@ class RangerNode(Node):
         # The bytes, read in C++, where this rmw serialises a Twist as the binding reads it;
         # else messages. Either way _twist_values gives (linear x, y, z, angular x, y, z).
         read_twist = conversions.twist_reader()
+        self._read_raw = read_twist is not None
         self._twist_values = read_twist or conversions.twist_values
-        self.cmd_sub = self.create_subscription(
-            Twist, "cmd_vel", self._on_cmd_vel, 1, callback_group=OwnThreadGroup(),
-            event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False),
-            raw=read_twist is not None)
-        self._cmd_thread = SubscriptionThread(self, self.cmd_sub, "ranger_cmd_vel")
+        # Twist or TwistStamped (cmd_vel_stamped; auto: the publishers' type, looked at again
+        # while the publication thread runs, whenever every publisher uses the other type).
+        self._cmd_lock = threading.Lock()
+        self._cmd_choice = self.params["cmd_vel_stamped"]
+        self._cmd_topic = self.resolve_topic_name("cmd_vel")
+        self.cmd_sub = self._cmd_thread = None
+        want = self._publishers_want_stamped() if self._cmd_choice == "auto" else None
+        self._cmd_seen_publishers = want is not None
+        self._subscribe_cmd_vel(self._cmd_choice == "true" or bool(want))
+        self._say_cmd_vel_type(self._cmd_choice if self._cmd_choice != "auto" else
+                               "auto: the type of its publishers" if want is not None else
+                               "auto: no publisher yet; looked at again when one appears")
         joint_names = ranger_can.steering_joint_names() + ranger_can.wheel_joint_names()
         self.motion_messages = conversions.MotionMessages(self.params, joint_names)
         # odom, /tf and joint_states serialised in C++ where this rmw reads the bytes as the
@@ -248,6 +263,55 @@ class RangerNode(Node):
         self._thread = threading.Thread(target=self._publication_loop, name="ranger_publish",
                                         daemon=True)
 
+    # ---- cmd_vel: Twist or TwistStamped ----
+    def _publishers_want_stamped(self):
+        """True/False when cmd_vel's publishers all use TwistStamped/Twist; None when there are
+        none, or of both types (the rmw matches only those of the subscription's type)."""
+        types = {i.topic_type for i in self.get_publishers_info_by_topic(self._cmd_topic)}
+        if types == {conversions.TWIST_STAMPED_TYPE}:
+            return True
+        if types == {conversions.TWIST_TYPE}:
+            return False
+        return None
+
+    def _subscribe_cmd_vel(self, stamped):
+        """(Re)subscribes cmd_vel with the type asked, on a thread of its own (started when the
+        node runs)."""
+        with self._cmd_lock:
+            if self._stopped:
+                return
+            old_sub, old_thread = self.cmd_sub, self._cmd_thread
+            if old_thread is not None:
+                old_thread.stop()
+            if old_sub is not None:
+                self.destroy_subscription(old_sub)
+            msg_type, callback, raw = ((TwistStamped, self._on_cmd_vel_stamped, False) if stamped
+                                       else (Twist, self._on_cmd_vel, self._read_raw))
+            self.cmd_sub = self.create_subscription(
+                msg_type, "cmd_vel", callback, 1, callback_group=OwnThreadGroup(),
+                event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False), raw=raw)
+            self._cmd_thread = SubscriptionThread(self, self.cmd_sub, "ranger_cmd_vel")
+            self._cmd_stamped = stamped
+            if old_thread is not None:  # the node runs
+                self._cmd_thread.start()
+
+    def _say_cmd_vel_type(self, why):
+        kind = conversions.TWIST_STAMPED_TYPE if self._cmd_stamped else conversions.TWIST_TYPE
+        self.get_logger().info(f"cmd_vel: taken as {kind} (cmd_vel_stamped {why})")
+
+    def _recheck_cmd_vel_type(self):
+        """cmd_vel_stamped auto: the publishers' type once the first appears, and again whenever
+        they all use the other type; said in the log."""
+        if self._cmd_choice != "auto":
+            return
+        want = self._publishers_want_stamped()
+        if want is None or (want == self._cmd_stamped and self._cmd_seen_publishers):
+            return
+        self._cmd_seen_publishers = True
+        if want != self._cmd_stamped:
+            self._subscribe_cmd_vel(want)
+        self._say_cmd_vel_type("auto: the type of its publishers")
+
     def _publisher(self, msg_type, topic, depth):
         # No QoS event handlers: each one is Python work in every executor wake-up.
         return self.create_publisher(
@@ -258,7 +322,8 @@ class RangerNode(Node):
     def start(self):
         self.driver.start()
         self._thread.start()
-        self._cmd_thread.start()
+        with self._cmd_lock:
+            self._cmd_thread.start()
         kind = ("the in-process virtual chassis" if self.driver.is_sim else
                 "a replayed log: nothing is sent" if self.port.startswith("replay:") else
                 "SocketCAN")
@@ -273,11 +338,12 @@ class RangerNode(Node):
         """Stops the chassis first (the driver's zero motion command), then publication."""
         if self._stopped:
             return
-        self._stopped = True
-        self._cmd_thread.stop()
-        if self.cmd_sub is not None:
-            self.destroy_subscription(self.cmd_sub)
-            self.cmd_sub = None
+        with self._cmd_lock:
+            self._stopped = True
+            self._cmd_thread.stop()
+            if self.cmd_sub is not None:
+                self.destroy_subscription(self.cmd_sub)
+                self.cmd_sub = None
         self.driver.close()  # the stop; its event ("stop sent to the chassis ...") logged here
         self._log_events()
         self._stop.set()
@@ -303,18 +369,29 @@ class RangerNode(Node):
     def _on_cmd_vel(self, msg):
         """cmd_vel: its bytes (a raw subscription, read by conversions.twist_reader) or a
         Twist."""
-        vx, vy, vz, wx, wy, wz = self._twist_values(msg)
+        self._drive(self._twist_values(msg))
+
+    def _on_cmd_vel_stamped(self, msg):
+        """cmd_vel as a TwistStamped: its age by the node's clock goes with it (the driver refuses
+        one older than cmd_vel_timeout: stale_command); a zero stamp means now."""
+        stamp = msg.header.stamp
+        age = None
+        if stamp.sec or stamp.nanosec:
+            age = (self.get_clock().now().nanoseconds - (stamp.sec * 10**9 + stamp.nanosec)) * 1e-9
+        self._drive(conversions.twist_values(msg.twist), age)
+
+    def _drive(self, values, age=None):
+        vx, vy, vz, wx, wy, wz = values
+        stamped = {} if age is None else {"age": age}
         try:  # all six fields: the driver refuses NaN/inf in any of them, naming it
-            self.driver.command(vx, vy, wz, vz=vz, wx=wx, wy=wy)
+            self.driver.command(vx, vy, wz, vz=vz, wx=wx, wy=wy, **stamped)
             if vz or wx or wy:
                 self.get_logger().warning("cmd_vel: linear.z, angular.x and angular.y are "
                                           "ignored (planar base)", throttle_duration_sec=5.0)
-        except RangerError as e:
-            if e.code == "not_finite":
-                self.get_logger().error(f"cmd_vel refused, chassis stopped: {e}",
-                                        throttle_duration_sec=1.0)
-            else:
-                self.get_logger().warning(f"cmd_vel not applied: {e}", throttle_duration_sec=5.0)
+        except RangerError:
+            # Logged once, as the driver's command_refused event (its reports spaced) and the
+            # refusal in system_state: not again here.
+            pass
 
     def _on_inject(self, msg: String):
         try:
@@ -336,7 +413,12 @@ class RangerNode(Node):
             return False, str(e), None
 
     def _log_answer(self, what, ok, message):
-        (self.get_logger().info if ok else self.get_logger().warn)(f"{what}: {message}")
+        """Every service answer, one line at its severity (info, or warn for a refusal or a
+        failure), in the library's words (the answer's message); the driver's events that are
+        the same answer (ANSWER_EVENTS) are not logged again. Every answer has its line: the
+        driver's request_settled events leave out an answer alike to the one before it."""
+        line = message if message.startswith((f"{what}:", f"{what} ")) else f"{what}: {message}"
+        self._log_at("info" if ok else "warn", line)
 
     def _on_resume(self, request, response):
         refused = ranger_can.resume_refused_offline(self.driver.snapshot(), self.port)
@@ -376,6 +458,7 @@ class RangerNode(Node):
             response.success = ok
             response.message = message
         response.enabled = bool(self.driver.snapshot().ultrasonic_enabled)
+        self._log_answer("set_ultrasonic", response.success, response.message)
         return response
 
     def _on_set_motion_mode(self, request, response):
@@ -404,8 +487,7 @@ class RangerNode(Node):
                                                         ("rear", request.rear_mode))
                if mode not in LIGHT_MODES]
         if bad:
-            response.message = f"{', '.join(bad)} unknown (0 OFF, 1 ON, 2 BREATHING, 3 CUSTOM): " \
-                               "nothing sent"
+            response.message = f"{', '.join(bad)} unknown ({_numbered(LIGHT_MODES)}): nothing sent"
         else:
             custom = SetLights.Request.CUSTOM
             ok, message, _ = self._answer("set_lights", lambda: self.driver.set_lights(
@@ -435,8 +517,8 @@ class RangerNode(Node):
         mode = DRIVE_MODES.get(request.mode)
         if mode is None:
             response.success = False
-            response.message = (f"drive mode {request.mode} is not one of 0 (CURRENT), "
-                                "1 (VOLTAGE): nothing sent")
+            valid = ", ".join(f"{n} ({name.upper()})" for n, name in DRIVE_MODES.items())
+            response.message = f"drive mode {request.mode} is not one of {valid}: nothing sent"
         else:
             ok, message, _ = self._answer("set_drive_mode",
                                           lambda: self.driver.set_drive_mode(mode))
@@ -444,8 +526,7 @@ class RangerNode(Node):
             response.message = message
         reported = self.driver.snapshot().drive_mode_raw
         response.drive_mode = SystemState.DRIVE_MODE_NONE if reported is None else reported
-        if not response.success:
-            self.get_logger().warning(f"set_drive_mode: {response.message}")
+        self._log_answer("set_drive_mode", response.success, response.message)
         return response
 
     # ---- publication (a thread of the node's own) ----
@@ -469,6 +550,7 @@ class RangerNode(Node):
                     next_diag = _advance(next_diag, self.params["diagnostic_period"], now)
                 if now >= next_audience:
                     self._motion_audience = self._ask_motion_audience()
+                    self._recheck_cmd_vel_type()
                     next_audience = now + AUDIENCE_PERIOD
                 wait = max(0.0, min(next_state, next_diag, next_audience) - time.monotonic())
                 if any(self._motion_audience):
@@ -562,7 +644,8 @@ class RangerNode(Node):
         """The driver's events, each at its severity (the library decides what is a transition
         and words it; the ROS 1 node logs the same)."""
         for event in self.driver.events():
-            self._log_at(event.severity, event.text)
+            if event.kind not in ANSWER_EVENTS:
+                self._log_at(event.severity, event.text)
 
     def _log_at(self, severity, text):
         """A line of the library's at its severity (debug, info, warn, error). A call site of its

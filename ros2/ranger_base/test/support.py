@@ -126,7 +126,8 @@ class Client:
 class Robot:
     """One ranger_base_node under `ns` with a client listening to it."""
 
-    def __init__(self, client, ns, log_dir, **params):
+    def __init__(self, client, ns, log_dir, cmd_type=Twist, **params):
+        """cmd_type: the type of the test's cmd_vel publisher (`cmd`; None: none)."""
         self.client, self.ns = client, ns
         params.setdefault("port_name", "sim")
         self.process = NodeProcess(ns, params, log_dir)
@@ -135,7 +136,8 @@ class Robot:
         c.listen(f"{ns}/odom", Odometry)
         c.listen(f"{ns}/sim/ground_truth", Odometry, keep=True)
         c.listen(f"{ns}/cmd_vel_out", TwistStamped, keep=True)
-        self.cmd = c.node.create_publisher(Twist, f"{ns}/cmd_vel", 10)
+        self.cmd = (c.node.create_publisher(cmd_type, f"{ns}/cmd_vel", 10) if cmd_type
+                    else None)
         self.inject_pub = c.node.create_publisher(String, f"{ns}/sim/inject", 10)
 
     def state(self):

@@ -26,6 +26,7 @@ def node_stub():
         get_logger=lambda: logger, _twist_values=conversions.twist_values,
         driver=types.SimpleNamespace(command=lambda *a, **k: commands.append((a, k))),
         commands=commands)
+    stub._drive = lambda values, age=None: RangerNode._drive(stub, values, age)
     yield stub
     rclpy.try_shutdown()
 

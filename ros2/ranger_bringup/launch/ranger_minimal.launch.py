@@ -6,6 +6,8 @@
     ros2 launch ranger_bringup ranger_minimal.launch.py model:=ranger_mini_v2 protocol:=agx_v2
     ros2 launch ranger_bringup ranger_minimal.launch.py ns:=robot1        under /robot1, TF frames
                                                                            prefixed robot1/
+    ros2 launch ranger_bringup ranger_minimal.launch.py cmd_vel_stamped:=true   cmd_vel as
+                                                                           TwistStamped
 """
 
 import os
@@ -26,6 +28,8 @@ ARGUMENTS = [
     ("ns", "", "the robot's namespace, e.g. robot1"),
     ("publish_odom_tf", "true", "publish the odom -> base_footprint transform"),
     ("robot_state_publisher", "true", "publish the URDF's TF from joint_states"),
+    ("cmd_vel_stamped", "auto", "cmd_vel as TwistStamped (true), Twist (false) or the type of its "
+     "publishers (auto)"),
 ]
 
 
@@ -45,7 +49,8 @@ def setup(context):
     params = {"port_name": port, "model": arg["model"], "protocol": arg["protocol"],
               "odom_frame": prefix + "odom", "base_frame": prefix + "base_footprint",
               "frame_prefix": prefix,
-              "publish_odom_tf": arg["publish_odom_tf"].lower() == "true"}
+              "publish_odom_tf": arg["publish_odom_tf"].lower() == "true",
+              "cmd_vel_stamped": arg["cmd_vel_stamped"].lower()}
     if arg["commissioning_file"]:
         params["commissioning_file"] = arg["commissioning_file"]
     actions = [Node(package="ranger_base", executable="ranger_base_node",

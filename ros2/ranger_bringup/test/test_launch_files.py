@@ -133,6 +133,9 @@ def test_the_minimal_launch_maps_its_arguments(monkeypatch):
     assert driver.kwargs["namespace"] == "robot1" == rsp.kwargs["namespace"]
     assert rsp.kwargs["parameters"][0]["frame_prefix"] == "robot1/"
     assert 'robot name="ranger"' in rsp.kwargs["parameters"][0]["robot_description"]
+    assert params["cmd_vel_stamped"] == "auto"  # the node's default
+    driver, _ = run(entities, cmd_vel_stamped="true")
+    assert driver.kwargs["parameters"][0]["cmd_vel_stamped"] == "true"
 
 
 def test_every_model_has_its_urdf():

@@ -85,6 +85,10 @@ struct MotionRequest {
   BodyTwist twist;
   std::optional<protocol::MotionMode> mode;  // nullopt: automatic (ModeSelector)
   OutOfPlaneTwist out_of_plane;              // checked for NaN/inf only
+  // How old the command was when it was handed over (a stamped twist: the front end's clock now
+  // minus its stamp); nullopt: unstamped, or a zero stamp ("now"). Older than cmd_timeout: not
+  // obeyed (MotionRefusal::kStaleCommand), as a command that old must not drive.
+  std::optional<std::chrono::nanoseconds> age;
 };
 
 // kNotFinite naming the first component (by its twist name, "linear.z", "angular.x", ...) that
@@ -110,6 +114,10 @@ enum class MotionRefusal {
   // The latest request was refused (ControllerState::invalid_command says why: a NaN or an
   // infinity in a component): the chassis is commanded to stop until a valid one comes.
   kInvalidCommand,
+  // The latest request was stamped longer ago than cmd_timeout (MotionRequest::age;
+  // ControllerState::stale_command says how old): the chassis is commanded to stop until a fresh
+  // one comes.
+  kStaleCommand,
   kBelowMinimum,  // the twist is below what the chassis can express (1 mm/s)
   // The driver holds motion for a purpose of its own: the protocol settings are not decided yet
   // (DriverConfig::identification: `auto`; ControllerState::identifying gives the phase), or the
@@ -138,6 +146,7 @@ inline constexpr auto kMotionRefusalNames = text::enum_names<MotionRefusal>({
     {MotionRefusal::kSwitching, "switching"},
     {MotionRefusal::kCmdTimeout, "cmd_timeout"},
     {MotionRefusal::kInvalidCommand, "invalid_command"},
+    {MotionRefusal::kStaleCommand, "stale_command"},
     {MotionRefusal::kBelowMinimum, "below_minimum"},
     {MotionRefusal::kIdentifying, "identifying"},
     {MotionRefusal::kParked, "parked"},
@@ -289,6 +298,9 @@ struct ControllerState {
   // Why the latest request was refused ("linear.z is NaN"), "" once a valid one came: the
   // refusal kInvalidCommand while it lasts.
   std::string invalid_command;
+  // How old the latest request was and the limit ("stamped 0.8 s ago, older than cmd_vel_timeout
+  // 0.5 s"), "" once a fresh one came: the refusal kStaleCommand while it lasts.
+  std::string stale_command;
   Timestamp last_command_time{0};
   BodyTwist limited;  // requested twist after the speed limiters (what is driven)
   // 1 = full speed; below 1 the speed is held back until the wheels reach the commanded angle.
@@ -383,8 +395,10 @@ class ChassisController {
   // The motion wanted from now on; refreshes the command timeout. A non-finite component (any of
   // the six: check_finite) is refused with kNotFinite, the controller stops and says so
   // (kInvalidCommand, state().invalid_command) until a valid request comes (a NaN is a caller
-  // bug, not a command to keep driving). A zero twist re-arms after an involuntary stop whose
-  // cause has cleared only with rearm_on_zero_twist. Sent at the next tick().
+  // bug, not a command to keep driving). A request older than cmd_timeout (MotionRequest::age) is
+  // refused with kTimeout the same way (kStaleCommand, state().stale_command). A zero twist re-arms
+  // after an involuntary stop whose cause has cleared only with rearm_on_zero_twist. Sent at the
+  // next tick().
   Status set_command(const MotionRequest& request, Timestamp now);
   Status set_command(const BodyTwist& twist, Timestamp now) {
     return set_command(MotionRequest{twist, std::nullopt}, now);
