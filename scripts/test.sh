@@ -193,7 +193,7 @@ prepare_pid=
 start_prepare() {
   (
     rc=0
-    if wants ros2; then scripts/setup_ros2.sh >/dev/null || rc=1; fi
+    if wants ros2; then scripts/test_ros2.sh --setup-only || rc=1; fi
     if wants workspaces; then scripts/test_workspaces.sh prepare || rc=1; fi
     if wants unit; then
       /usr/bin/python3 tests/dbc/check_dbc.py --venv "$root/build/lib/dbc-venv" --venv-only || rc=1

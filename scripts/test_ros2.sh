@@ -12,6 +12,8 @@
 # and once: checks ros2/ranger_msgs against the ROS 1 ranger_msgs (sync_interfaces.py --check);
 # `pip install ./libranger_can` into a fresh venv and the README's Python example with it.
 # Usage: scripts/test_ros2.sh [RESULTS_DIR]   (JUnit reports go there; default build/test-results)
+#        scripts/test_ros2.sh --setup-only   (only each selected distribution's venv: what
+#                                             scripts/test.sh makes beside its first build)
 # Environment: RANGER_ROS2_DISTRO=jazzy|kilted (one distribution; default both);
 # RANGER_ROS2_VENV_JAZZY, RANGER_ROS2_VENV_KILTED (a distribution's venv; default
 # .venv-ros2-DISTRO), RANGER_ROS2_VENV (the venv, when one distribution is selected);
@@ -22,6 +24,8 @@ cd "$(dirname "$0")/.."
 # shellcheck source=build_flags.sh
 source scripts/build_flags.sh
 root=$(pwd)
+setup_only=0
+[ "${1:-}" = --setup-only ] && { setup_only=1; shift; }
 results=${1:-$root/build/test-results}
 mkdir -p "$results"
 jobs=${RANGER_JOBS:-$(nproc)}
@@ -29,10 +33,9 @@ failed=0
 read -r -a distros <<<"${RANGER_ROS2_DISTRO:-jazzy kilted}"
 declare -A domain_of=([jazzy]=86 [kilted]=87)
 
-# One distribution: its venv, its workspace, its tests, its domain id. Returns non-zero when
-# anything failed.
-run_distro() {
-  local distro=$1 venv_var="RANGER_ROS2_VENV_${1^^}" venv ws started=$SECONDS
+# A distribution's venv, made or completed (scripts/setup_ros2.sh); its path in $venv.
+setup_distro() {
+  local distro=$1 venv_var="RANGER_ROS2_VENV_${1^^}"
   if [ -z "${!venv_var:-}" ] && [ ${#distros[@]} -gt 1 ] && [ -n "${RANGER_ROS2_VENV:-}" ]; then
     echo "test_ros2: RANGER_ROS2_VENV names one venv for ${distros[*]}: set RANGER_ROS2_DISTRO," \
       "or $venv_var" >&2
@@ -40,6 +43,18 @@ run_distro() {
   fi
   venv=$(RANGER_ROS2_DISTRO=$distro RANGER_ROS2_VENV=${!venv_var:-${RANGER_ROS2_VENV:-}} \
     scripts/setup_ros2.sh | tail -1) || { echo "test_ros2: $distro: setup failed" >&2; return 1; }
+}
+
+if [ "$setup_only" = 1 ]; then
+  for distro in "${distros[@]}"; do setup_distro "$distro" || failed=1; done
+  exit $failed
+fi
+
+# One distribution: its venv, its workspace, its tests, its domain id. Returns non-zero when
+# anything failed.
+run_distro() {
+  local distro=$1 venv ws started=$SECONDS
+  setup_distro "$distro" || return 1
   ws=$root/build/ros2_ws_$distro
   echo "test_ros2: $distro: venv $venv, workspace $ws"
   (
@@ -51,7 +66,9 @@ run_distro() {
     source "$venv/bin/activate"
     export AMENT_PREFIX_PATH=$venv CMAKE_PREFIX_PATH=$venv
     cd "$ws"
-    colcon --log-base log build --paths src/ranger_ros/ros2/* \
+    # Without make's load limit (colcon's default -l<cores>): beside the other lanes it would
+    # build one file at a time.
+    MAKEFLAGS=${MAKEFLAGS:--j$jobs} colcon --log-base log build --paths src/ranger_ros/ros2/* \
       --event-handlers console_cohesion- summary+ --parallel-workers "$jobs" \
       --cmake-args -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=$ranger_relwithdebinfo_flags" \
       -DBUILD_TESTING=OFF
@@ -91,7 +108,10 @@ if [ "${RANGER_ROS2_SKIP_PIP:-0}" != 1 ]; then
     # Built without optimisation (scikit-build-core's SKBUILD_CMAKE_BUILD_TYPE; the package's own
     # default is Release): this step proves the install and the README's example, and the
     # optimised library is the one every other stage tests; about half the compile time.
-    SKBUILD_CMAKE_BUILD_TYPE=${RANGER_PIP_BUILD_TYPE:-Debug} \
+    # The build directory at a fixed path of the checkout's (emptied first): the compiler cache
+    # (scripts/ccache_env.sh) knows its files by their paths, and pip's own is new every time.
+    rm -rf "$root/build/pip_build"
+    SKBUILD_CMAKE_BUILD_TYPE=${RANGER_PIP_BUILD_TYPE:-Debug} SKBUILD_BUILD_DIR=$root/build/pip_build \
       "$fresh/bin/pip" install -q --disable-pip-version-check ./libranger_can pytest
     cd /tmp  # not the source tree: the installed package is what is imported
     RANGER_PIP_PYTHON=$fresh/bin/python "$fresh/bin/python" -m pytest -p no:cacheprovider -q \
