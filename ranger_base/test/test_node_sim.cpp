@@ -158,9 +158,13 @@ class NodeSim : public ::testing::Test {
   }
 
   void SetUp() override {
-    ASSERT_TRUE(wait_for([] {
+    // On a system_state published a while (ten chassis frames) after this test began: what the
+    // test before left (a latch its last injection caused) is in it.
+    const ros::Time begun = ros::Time::now() + ros::Duration(0.2);
+    ASSERT_TRUE(wait_for([begun] {
       const auto s = state_.get();
-      return s && s->link_up && s->control_mode == SystemState::CONTROL_MODE_CAN &&
+      return s && s->header.stamp >= begun && s->link_up &&
+             s->control_mode == SystemState::CONTROL_MODE_CAN &&
              settings_decided(*s) && cmd_pub_.getNumSubscribers() > 0 &&
              inject_pub_.getNumSubscribers() > 0 && truth_.get() && odom_.get();
     })) << "the node never reached CAN command mode with its protocol settings decided";
@@ -933,12 +937,18 @@ TEST_F(MiniV3, TheBmsAlarmsReachSystemStateAndDiagnostics) {
 class Safety : public NodeSim {
  protected:
   // Undoes a fault injection however the test ends, so the next test starts from a normal
-  // chassis.
+  // chassis: it returns once the node has applied the last line (its log says so), so that no
+  // injection lands in the next test, however slowly the topic delivers it on a busy host.
   struct Injected {
     std::vector<std::string> undo;
     ~Injected() {
+      const ros::Time t = ros::Time::now();
       for (const auto& line : undo)
         inject(line);
+      if (!undo.empty()) {
+        EXPECT_TRUE(logged("sim/inject \"" + undo.back() + "\" applied", t))
+            << "the undo '" << undo.back() << "' was never applied";
+      }
     }
   };
 };
@@ -1340,9 +1350,13 @@ TEST_F(Adversarial, OdometryAcrossASilenceSaysTheGapAndGrowsTheCovariance) {
 class Faults : public NodeSim {
  protected:
   void SetUp() override {
-    ASSERT_TRUE(wait_for([] {
+    // On a system_state published a while (ten chassis frames) after this test began: what the
+    // test before left (a latch its last injection caused) is in it.
+    const ros::Time begun = ros::Time::now() + ros::Duration(0.2);
+    ASSERT_TRUE(wait_for([begun] {
       const auto s = state_.get();
-      return s && s->link_up && s->control_mode == SystemState::CONTROL_MODE_CAN &&
+      return s && s->header.stamp >= begun && s->link_up &&
+             s->control_mode == SystemState::CONTROL_MODE_CAN &&
              cmd_pub_.getNumSubscribers() > 0 && truth_.get();
     }));
   }
