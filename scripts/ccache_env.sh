@@ -8,8 +8,7 @@
 # (hash_dir off: only debug information names it).
 #   RANGER_CCACHE=0            no compiler cache
 #   RANGER_CCACHE_DIR=DIR      the cache (default ~/.cache/ranger_ros/ccache)
-#   RANGER_CCACHE_MAXSIZE=SIZE (default 8G: a run's objects are about 3 GB, the sanitizer
-#                              builds' at -O0 -g the largest)
+#   RANGER_CCACHE_MAXSIZE=SIZE (default 8G; a whole run's objects took 0.3 GB compressed)
 # ranger_ccache_summary prints the run's hit rate (the statistics are zeroed when sourced).
 ranger_ccache_root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 ranger_ccache_on=0

@@ -12,8 +12,9 @@
 #   workspaces  the repository in the src/ of fresh ROS 1 workspaces (scripts/test_workspaces.sh):
 #             catkin_make (and the driver run from its devel space), catkin build, colcon; the
 #             plain build with CMake 3.16; catkin_lint -W1
-#   sanitize  ASan+UBSan build of the library and its tests, TSan build of the suites labelled
-#             `threads`, ASan build of the ROS node
+#   sanitize  three stages (scripts/test_sanitizers.sh): asan (ASan+UBSan build of the library
+#             and its tests), tsan (TSan build of the suites labelled `threads`), asan_ros (ASan
+#             build of the ROS node and its tests)
 #   fuzz      every libFuzzer target for a bounded time (RANGER_FUZZ_SECONDS, default 60)
 #   ros2      the Python binding and the ROS 2 packages (scripts/test_ros2.sh): the venv of ROS 2
 #             wheels (scripts/setup_ros2.sh), the colcon build of ros2/ as the README has it, the
@@ -23,14 +24,15 @@
 # unit vcan ros_vcan ros ros2 workspaces sanitize fuzz).
 #
 # Lanes. ros and ros2 mostly wait on nodes, clocks and DDS; workspaces, sanitize and fuzz mostly
-# compile. Once no stage that runs the qemu VM (vcan, ros_vcan) is left, the stages among
-# workspaces, sanitize and fuzz run one after the other in a background lane at a lower CPU and
-# I/O priority (nice 10: about a tenth of the CPU against a busy foreground, never starved;
-# ionice best-effort 7), so that they take mostly what the stages in the foreground leave, and
-# ros2 runs in a lane of its own beside ros (ROS 1's master and ROS 2's DDS domain do not meet);
-# their output is printed when they are done, each stage's as a whole, and they count as any
-# other stage. RANGER_LANES=2 keeps ros2 in the foreground after ros; RANGER_LANES=1 runs every
-# stage in the foreground, in turn.
+# compile. Once no stage that runs the qemu VM (vcan, ros_vcan) is left, workspaces, sanitize and
+# fuzz form a queue that a background lane works through at a lower CPU and I/O priority (nice
+# 10: about a tenth of the CPU against a busy foreground, never starved; ionice best-effort 7),
+# taking mostly what the waiting stages leave (whoever runs a queued stage runs it so); ros2 runs in a lane of its own beside ros (ROS 1's
+# master and ROS 2's DDS domain do not meet); whichever lane, the foreground included, is done
+# with its own stages takes the next queued stage, so that both cores work to the end. Their
+# output is printed at the end, each stage's as a whole, and they count as any other stage.
+# RANGER_LANES=2 keeps ros2 in the foreground after ros; RANGER_LANES=1 runs every stage in the
+# foreground, in turn.
 #
 # Every build goes through one compiler cache kept between runs (scripts/ccache_env.sh); the
 # Python environments of the later stages (ROS 2 wheels, CMake 3.16, cantools) are made beside
@@ -98,25 +100,38 @@ stage_ros() {
   )
 }
 stage_workspaces() { scripts/test_workspaces.sh; }
-stage_sanitize() { scripts/test_sanitizers.sh; }
+# sanitize is three stages, so that lanes can share them: asan, tsan, asan_ros.
+stage_asan() { scripts/test_sanitizers.sh address; }
+stage_tsan() { scripts/test_sanitizers.sh thread; }
+stage_asan_ros() { scripts/test_sanitizers.sh ros; }
 stage_fuzz() { scripts/fuzz.sh "${RANGER_FUZZ_SECONDS:-60}"; }
 stage_ros2() { scripts/test_ros2.sh "$results"; }
 
 # ---- the lanes ----
-# A stage in a lane runs in the background, the lane's stages one after the other, once no stage
-# that boots the VM is left; its output is printed when the lane is done, each stage's as a
-# whole, and it counts as any other stage.
-declare -A lane_of=()  # stage -> its lane (none: the foreground)
+# Once no stage that boots the VM is left, the stages that mostly compile (workspaces, asan,
+# asan_ros, fuzz, tsan: the longest first) form a queue: a background lane at nice 10 works through it, and every
+# other lane joins it when its own stages are done, the foreground too (each queued stage is
+# claimed once: mkdir is atomic). ros2 runs in a lane of its own beside ros. A stage run in a lane
+# or from the queue writes its output to build/lane/<stage>.log, printed whole at the end; it
+# counts as any other stage.
+queued=()    # the compile queue, in order (RANGER_LANES >= 2)
+own_lane=()  # stages in a background lane of their own (RANGER_LANES >= 3)
 case ${RANGER_LANES:-3} in
   1) ;;
-  2) lane_of=([workspaces]=compile [sanitize]=compile [fuzz]=compile) ;;
-  *) lane_of=([workspaces]=compile [sanitize]=compile [fuzz]=compile [ros2]=ros2) ;;
+  2) queued=(workspaces asan asan_ros fuzz tsan) ;;
+  *) queued=(workspaces asan asan_ros fuzz tsan) own_lane=(ros2) ;;
 esac
-declare -A lane_nice=([compile]=10 [ros2]=0)
-lane_names=(ros2 compile)  # the order their output is printed in
-declare -A lane_pid=() lane_stages=()
+selected_queue=()  # the queued stages of this run
+logged_stages=()   # every stage whose output is in build/lane/, in the order printed
+lane_pids=()
 lanes_started=0
 lane_dir=$root/build/lane
+in_list() {  # word words...
+  local w=$1 x
+  shift
+  for x in "$@"; do [ "$x" = "$w" ] && return 0; done
+  return 1
+}
 vm_left() {  # stages...: is vcan or ros_vcan among them?
   local s
   for s in "$@"; do
@@ -124,59 +139,85 @@ vm_left() {  # stages...: is vcan or ros_vcan among them?
   done
   return 1
 }
-start_lane() {  # lane stages...: run them in turn in the background, each into lane/<stage>.log
-  local lane=$1 nice=${lane_nice[$1]}
+run_to_log() {  # runner stage: the stage into lane/<stage>.log; "rc seconds runner" into .status
+  local start=$SECONDS rc
+  if "stage_$2" >"$lane_dir/$2.log" 2>&1; then rc=0; else rc=$?; fi
+  echo "$rc $((SECONDS - start)) $1" >"$lane_dir/$2.status"
+}
+# Claims and runs, in order, each queued stage nobody has claimed yet, at a lower CPU and I/O
+# priority whoever runs it (nice 10: about a tenth of the CPU against a busy stage that waits on
+# clocks, never starved; ionice best-effort 7).
+work_queue() {  # runner
+  (
+    renice -n 10 -p "$BASHPID" >/dev/null
+    ionice -c 2 -n 7 -p "$BASHPID" 2>/dev/null
+    for s in "${selected_queue[@]}"; do
+      mkdir "$lane_dir/claim.$s" 2>/dev/null || continue
+      run_to_log "$1" "$s"
+    done
+  )
+}
+start_lane() {  # name stages...: in the background: its stages in turn, then the queue
+  local name=$1
   shift
-  [ $# -gt 0 ] || return 0
-  echo "== background lane $lane (nice $nice): $* (logs: build/lane/)"
+  echo "== background lane $name: ${*:+$* then }the compile queue (logs: build/lane/)"
   set -m  # a process group of its own, which the trap below can stop whole
   (
-    if [ "$nice" != 0 ]; then
-      renice -n "$nice" -p "$BASHPID" >/dev/null
-      ionice -c 2 -n 7 -p "$BASHPID" 2>/dev/null
-    fi
-    for s in "$@"; do
-      start=$SECONDS
-      if "stage_$s" >"$lane_dir/$s.log" 2>&1; then rc=0; else rc=$?; fi
-      echo "$rc $((SECONDS - start))" >"$lane_dir/$s.status"
-    done
+    for s in "$@"; do run_to_log "$name" "$s"; done
+    work_queue "$name"
   ) </dev/null &
-  lane_pid[$lane]=$!
-  lane_stages[$lane]="$*"
+  lane_pids+=($!)
   set +m
 }
+start_lanes() {  # stages...: the rest of the run; starts the lanes with their part of it
+  local s own=()
+  lanes_started=1
+  for s in "${own_lane[@]}"; do
+    if in_list "$s" "$@" && [ "$(type -t "stage_$s")" = function ]; then own+=("$s"); fi
+  done
+  for s in "${queued[@]}"; do  # in the queue's order
+    if in_list "$s" "$@" && [ "$(type -t "stage_$s")" = function ]; then selected_queue+=("$s"); fi
+  done
+  logged_stages=("${own[@]}" "${selected_queue[@]}")
+  [ ${#own[@]} -eq 0 ] || start_lane ros2 "${own[@]}"
+  [ ${#selected_queue[@]} -eq 0 ] || start_lane compile
+}
+in_a_lane() {  # stage: is it run by a lane (or the queue) rather than in the foreground here?
+  [ "$lanes_started" = 1 ] && in_list "$1" "${logged_stages[@]}"
+}
 stop_lanes() {
-  local lane
-  for lane in "${!lane_pid[@]}"; do kill -TERM -- "-${lane_pid[$lane]}" 2>/dev/null; done
+  local pid
+  for pid in "${lane_pids[@]}"; do kill -TERM -- "-$pid" 2>/dev/null; done
   [ -z "${prepare_pid:-}" ] || kill -TERM "$prepare_pid" 2>/dev/null
 }
 trap stop_lanes EXIT
 trap 'stop_lanes; exit 130' INT TERM
-finish_lanes() {  # wait for every lane, then print and count each of its stages
-  local lane start s rc seconds
-  for lane in "${lane_names[@]}"; do
-    [ -n "${lane_pid[$lane]:-}" ] || continue
-    start=$SECONDS
+finish_lanes() {  # the foreground joins the queue, waits for the lanes, prints and counts
+  local start=$SECONDS s rc seconds runner pid
+  [ ${#logged_stages[@]} -gt 0 ] || return 0
+  if [ ${#selected_queue[@]} -gt 0 ]; then
     echo
-    echo "== waiting for the background lane $lane"
-    wait "${lane_pid[$lane]}"
-    unset "lane_pid[$lane]"
-    echo "== background lane $lane done (waited $((SECONDS - start)) s)"
-    for s in ${lane_stages[$lane]}; do
-      echo
-      echo "==================== stage: $s (background lane $lane) ===================="
-      cat "$lane_dir/$s.log" 2>/dev/null
-      rc=1 seconds=
-      read -r rc seconds 2>/dev/null <"$lane_dir/$s.status"
-      if [ "$rc" = 0 ]; then
-        passed+=("$s")
-        echo "== stage $s: ok ($seconds s, in the background)"
-      else
-        failed+=("$s")
-        echo "== stage $s: FAILED (${seconds:-?} s, in the background)"
-      fi
-      note_time "$s" "${seconds:-?}" "background, lane $lane"
-    done
+    echo "== the foreground joins the compile queue"
+    work_queue foreground
+  fi
+  echo "== waiting for the background lanes"
+  for pid in "${lane_pids[@]}"; do wait "$pid"; done
+  lane_pids=()
+  echo "== background lanes done (waited $((SECONDS - start)) s)"
+  for s in "${logged_stages[@]}"; do
+    rc=1 seconds= runner=
+    read -r rc seconds runner 2>/dev/null <"$lane_dir/$s.status"
+    echo
+    echo "==================== stage: $s (lane ${runner:-none}) ===================="
+    cat "$lane_dir/$s.log" 2>/dev/null
+    if [ "$rc" = 0 ]; then
+      passed+=("$s")
+      echo "== stage $s: ok ($seconds s, lane $runner)"
+    else
+      failed+=("$s")
+      echo "== stage $s: FAILED (${seconds:-not run} s, lane ${runner:-none})"
+    fi
+    note_time "$s" "${seconds:-?}" "lane ${runner:-none}"
   done
 }
 
@@ -228,7 +269,7 @@ scripts/build.sh all || { echo "build failed" >&2; exit 1; }
 note_time build $((SECONDS - build_start))
 finish_prepare
 
-read -r -a stage_list <<<"$stages"
+read -r -a stage_list <<<"${stages//sanitize/asan tsan asan_ros}"
 for i in "${!stage_list[@]}"; do
   s=${stage_list[$i]}
   if [ "$(type -t "stage_$s")" != function ]; then
@@ -236,23 +277,11 @@ for i in "${!stage_list[@]}"; do
     failed+=("$s")
     continue
   fi
-  case $s in
-    sanitize) [ -x scripts/test_sanitizers.sh ] || { echo "(no sanitizer script yet)"; continue; } ;;
-    fuzz) [ -x scripts/fuzz.sh ] || { echo "(no fuzz script yet)"; continue; } ;;
-  esac
   if [ "$lanes_started" = 0 ] && ! vm_left "${stage_list[@]:$i}"; then
-    # From here on no VM stage is left: each lane takes its stages from the rest.
-    lanes_started=1
-    for lane in "${lane_names[@]}"; do
-      mine=()
-      for rest in "${stage_list[@]:$i}"; do
-        [ "${lane_of[$rest]:-}" = "$lane" ] && [ "$(type -t "stage_$rest")" = function ] &&
-          mine+=("$rest")
-      done
-      start_lane "$lane" "${mine[@]}"
-    done
+    # From here on no VM stage is left: the lanes take their part of the rest.
+    start_lanes "${stage_list[@]:$i}"
   fi
-  [ "$lanes_started" = 1 ] && [ -n "${lane_of[$s]:-}" ] && continue
+  in_a_lane "$s" && continue
   run_stage "$s" "stage_$s"
 done
 finish_lanes
@@ -261,7 +290,7 @@ echo
 echo "==================== summary ===================="
 echo "stages passed: ${passed[*]:-none}"
 echo "stages failed: ${failed[*]:-none}"
-echo "wall time per stage (the background lanes' beside the foreground's):"
+echo "wall time per stage (a lane's beside the foreground's):"
 for s in "${timing_order[@]}"; do printf '  %-11s %s\n' "$s" "${stage_time[$s]}"; done
 printf '  %-11s %s s\n' total $((SECONDS - run_start))
 ranger_ccache_summary
