@@ -196,6 +196,7 @@ TEST(SocketCanVcan, ReceiveTimestampsComeFromTheKernelNotFromTheReader) {
 
 // More frames than one recvmmsg() takes: every one arrives, in order, whatever the batches.
 TEST(SocketCanVcan, ABurstLongerThanOneBatchArrivesWholeAndInOrder) {
+  const StayOnOneCpu ordered_stream;  // see StayOnOneCpu (bus_behaviour.hpp)
   auto a = SocketCanBus::open("vcan0");
   auto b = SocketCanBus::open("vcan0");
   ASSERT_TRUE(a.ok() && b.ok()) << (a ? b.error().message : a.error().message);

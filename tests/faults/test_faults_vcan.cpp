@@ -186,9 +186,24 @@ class VcanFaultRig {
     if (state().refusal != MotionRefusal::kRearmRequired) {
       return ::testing::AssertionFailure() << "re-armed without resume";
     }
-    audit_.on_rearm_attempt(clock_.now());
-    if (Status st = controller_->resume(clock_.now()); !st) {
-      return ::testing::AssertionFailure() << "resume refused: " << st.error().message;
+    // The re-arm, asked while the chassis is heard. In the VM on a loaded host the chassis's
+    // thread can go unscheduled past link_timeout: the driver then refuses the resume, rightly
+    // ("not connected (stale)"), and latches the silence; the caller asks again once the chassis
+    // is heard (each refusal is reported by the retry that follows it, up to five).
+    std::string refusals;
+    for (int attempt = 1;; ++attempt) {
+      if (!run_until([&] { return state().link == LinkState::kConnected; }, 2s)) {
+        return ::testing::AssertionFailure() << "chassis not heard again" << refusals;
+      }
+      audit_.on_rearm_attempt(clock_.now());
+      const Status st = controller_->resume(clock_.now());
+      if (st) break;
+      refusals += "; resume " + std::to_string(attempt) + " refused: " + st.error().message;
+      if (state().link == LinkState::kConnected || attempt == 5) {
+        return ::testing::AssertionFailure() << "resume refused" << refusals;
+      }
+      std::printf("[ retry    ] resume %d refused while the chassis was silent: %s\n", attempt,
+                  st.error().message.c_str());
     }
     return drive(twist, min_speed);
   }

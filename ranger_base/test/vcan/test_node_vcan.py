@@ -18,6 +18,8 @@ import math
 import os
 import shutil
 import signal
+import socket
+import struct
 import subprocess
 import tempfile
 import time
@@ -36,6 +38,7 @@ WATCHDOG_S = 0.5          # the chassis stops 500 ms after the last 0x111 (manua
 FRAME_PERIOD_S = 0.02     # 0x211 / 0x221 period
 # Allowance for scheduling (the VM emulates its CPU): added to protocol times, never the subject.
 SLACK_S = 0.3
+MARKER_ID = 0x7FE         # the test's own frames in the log (no RANGER frame has this id)
 
 
 def wait_for(condition, timeout=60.0, interval=0.02):
@@ -110,6 +113,24 @@ class VcanNode(unittest.TestCase):
                                 capture_output=True, text=True, timeout=120)
         return [json.loads(line) for line in result.stdout.splitlines() if line.strip()]
 
+    def sync_log(self):
+        """Returns once candump has logged everything sent on the bus before this call: a marker
+        frame of the test's own goes out after it, and candump reads one socket, in order. (A
+        fixed wait is not enough: the VM emulates its CPU, and on a loaded host candump has been
+        seen more than 10 s behind.)"""
+        VcanNode.markers = getattr(VcanNode, "markers", 0) + 1
+        payload = struct.pack("<I", VcanNode.markers)
+        with socket.socket(socket.AF_CAN, socket.SOCK_RAW, socket.CAN_RAW) as s:
+            s.bind((IFACE,))
+            s.send(struct.pack("=IB3x8s", MARKER_ID, len(payload), payload))
+        text = f" {IFACE} {MARKER_ID:03X}#{payload.hex().upper()}"
+
+        def logged():
+            with open(self.candump_log) as f:
+                return text in f.read()
+        self.assertTrue(wait_for(logged, timeout=300, interval=0.1),
+                        f"candump logged the marker{text}")
+
     def start_node(self, ns):
         # link_timeout: the emulated VM can starve a process for longer than the default 0.1 s.
         # protocol manual: these tests are about stopping the chassis, not the identification
@@ -155,7 +176,8 @@ class VcanNode(unittest.TestCase):
             return commands and commands[-1]["t"] >= t_signal - FRAME_PERIOD_S and (
                 commands[-1]["linear_speed"], commands[-1]["spin_speed"]) == (0.0, 0.0)
 
-        wait_for(logged_stop, timeout=10, interval=0.2)  # bounded: the assertions below judge
+        wait_for(logged_stop, timeout=10, interval=0.2)  # mostly there by now
+        self.sync_log()  # and now certainly: the log holds whatever the node sent
         frames = self.frames()
         commands = [i for i, f in enumerate(frames) if f["name"] == "motion_command"]
         self.assertTrue(commands, "the node sent 0x111")
@@ -206,6 +228,7 @@ class VcanNode(unittest.TestCase):
         node.kill()
         node.wait(timeout=30)
         self.assertTrue(wait_for(lambda: abs(self.truth()["vx"]) < 1e-3), "chassis at rest")
+        self.sync_log()
         frames = self.frames()
         commands = [f for f in frames if f["name"] == "motion_command"]
         last = commands[-1]
