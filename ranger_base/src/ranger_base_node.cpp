@@ -18,6 +18,7 @@
 #include <ros/xmlrpc_manager.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
 #include <chrono>
 #include <condition_variable>
@@ -66,8 +67,12 @@ void ros_shutdown_promptly() {
 }
 
 int g_wake[2] = {-1, -1};  // self-pipe: [0] read by the main thread, [1] written on a request
-volatile std::sig_atomic_t g_signal = 0;
-volatile std::sig_atomic_t g_kill_requested = 0;
+// Set by a signal handler (any thread) and by the XML-RPC thread, read by the main thread:
+// atomics, lock-free (so async-signal-safe). A volatile flag raced with the XML-RPC thread
+// (ThreadSanitizer on the node, scripts/test_sanitizers.sh ros_thread).
+std::atomic<int> g_signal{0};
+std::atomic<bool> g_kill_requested{false};
+static_assert(std::atomic<int>::is_always_lock_free && std::atomic<bool>::is_always_lock_free);
 
 void wake_main() {
   const char byte = 1;
@@ -85,7 +90,7 @@ void on_shutdown_request(XmlRpc::XmlRpcValue& params, XmlRpc::XmlRpcValue& resul
     ROS_INFO("shutdown requested (%s): stopping the chassis",
              static_cast<std::string>(params[1]).c_str());
   }
-  g_kill_requested = 1;
+  g_kill_requested = true;
   wake_main();
   result = ros::xmlrpc::responseInt(1, "", 0);
 }
@@ -93,7 +98,7 @@ void on_shutdown_request(XmlRpc::XmlRpcValue& params, XmlRpc::XmlRpcValue& resul
 // Waits until a signal or shutdown request arrives, or ROS stops by itself.
 void wait_for_stop_request() {
   pollfd fd{g_wake[0], POLLIN, 0};
-  while (g_signal == 0 && g_kill_requested == 0 && ros::ok()) {
+  while (g_signal == 0 && !g_kill_requested && ros::ok()) {
     // The timeout only notices ros::ok() turning false some other way.
     if (::poll(&fd, 1, 500) > 0) {
       char buf[16];
@@ -136,9 +141,8 @@ int main(int argc, char** argv) {
 
   (*node)->start();
   wait_for_stop_request();
-  if (g_signal != 0) {
-    ROS_INFO("signal %d (%s): stopping the chassis", static_cast<int>(g_signal),
-             g_signal == SIGINT ? "SIGINT" : "SIGTERM");
+  if (const int sig = g_signal; sig != 0) {
+    ROS_INFO("signal %d (%s): stopping the chassis", sig, sig == SIGINT ? "SIGINT" : "SIGTERM");
   }
   (*node)->shutdown();  // the stop goes out (and is logged) before anything else goes away
   node->reset();
