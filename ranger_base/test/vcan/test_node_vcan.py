@@ -75,8 +75,12 @@ class VcanNode(unittest.TestCase):
         # Line-buffered (stdbuf): candump writes through stdio, which holds up to 4 KB of lines
         # back when its output is a file, and a test reading the log would miss the newest
         # frames (the node's stop, seen missing once under load).
-        cls.candump = subprocess.Popen(["stdbuf", "-oL", "candump", "-L", IFACE],
-                                       stdout=open(cls.candump_log, "w"))
+        # A receive buffer of 8 MB (-r; root sets it past rmem_max): with the default one a
+        # candump that the loaded VM did not run for a moment dropped frames, once the node's
+        # stop, which the chassis had received (it decelerated at once). -d prints a DROPCOUNT
+        # line for any frame still dropped, which frames() refuses to judge.
+        cls.candump = subprocess.Popen(["stdbuf", "-oL", "candump", "-L", "-d", "-r", "8388608",
+                                        IFACE], stdout=open(cls.candump_log, "w"))
         cls.sim = subprocess.Popen([cls.ranger_can, "sim", IFACE, "--no-stdin", "--quiet",
                                     "--pose-out", cls.pose_log, "--pose-rate", "50"])
         assert wait_for(lambda: cls.truth() is not None), "ranger_can sim wrote no pose"
@@ -109,6 +113,9 @@ class VcanNode(unittest.TestCase):
 
     def frames(self):
         """Every frame recorded so far, decoded by ranger_can (JSON objects, in bus order)."""
+        with open(self.candump_log) as f:
+            drops = [line.strip() for line in f if "DROPCOUNT" in line]
+        self.assertFalse(drops, "candump dropped frames: the log is not the bus")
         result = subprocess.run([self.ranger_can, "decode", "--json", self.candump_log],
                                 capture_output=True, text=True, timeout=120)
         return [json.loads(line) for line in result.stdout.splitlines() if line.strip()]
