@@ -18,12 +18,13 @@
 #   prepare               only CMake 3.16's venv (below), nothing built
 #   cmake316              CMake 3.16 (pip, in a venv cached under build/cmake-3.16): the top-level
 #                         build configured (library, tool, unit tests, system suites) and the tool
-#                         and two test executables built and run; RANGER_CMAKE316_FULL=1 builds and
-#                         runs everything
+#                         and two test executables built and run, in the plain build's type and
+#                         flags (RelWithDebInfo: its compilations are the compiler cache's hits of
+#                         build/lib); RANGER_CMAKE316_FULL=1 builds and runs everything
 #
 # Every build must print no CMake warning (nor "Manually-specified variables were not used").
 # The workspaces are fresh copies of the tracked files (with their working-tree contents).
-# The builds are the commands of the README as they are, in the build type RANGER_WORKSPACE_BUILD_TYPE
+# The ROS builds are the commands of the README as they are, in the build type RANGER_WORKSPACE_BUILD_TYPE
 # (default Debug), given to them the way an owner can, through CMake's CMAKE_BUILD_TYPE environment
 # variable: what these steps prove is that the packages configure, build, install and run in each
 # kind of workspace, which the build type does not change, and a file compiles without
@@ -33,6 +34,8 @@
 # free port of its own.
 set -uo pipefail
 cd "$(dirname "$0")/.."
+# shellcheck source=build_flags.sh
+source scripts/build_flags.sh
 root=$(pwd)
 work=$root/build/workspaces
 jobs=${RANGER_JOBS:-$(nproc)}
@@ -191,9 +194,12 @@ step_cmake316() {
   rm -rf "$build"
   local generator=()
   command -v ninja >/dev/null && generator=(-G Ninja)
-  # CMake 3.16 reads no CMAKE_BUILD_TYPE from the environment (3.22 does).
+  # The plain build's type and flags (scripts/build.sh's build/lib, at the same depth under the
+  # checkout): with the compiler cache, what CMake 3.16 compiles was compiled there, so its
+  # compilations are hits and the step costs its configure and links.
   checked_build "$build.configure.log" "$tools/cmake" -S . -B "$build" "${generator[@]}" \
-    -DCMAKE_BUILD_TYPE="${build_type:-RelWithDebInfo}" "${launcher_args[@]}" || return 1
+    -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=$ranger_relwithdebinfo_flags" \
+    "${launcher_args[@]}" || return 1
   if [ "${RANGER_CMAKE316_FULL:-0}" = 1 ]; then
     checked_build "$build.build.log" "$tools/cmake" --build "$build" -j "$jobs" || return 1
     (cd "$build" && "$tools/ctest" -LE vcan -j "$jobs" --output-on-failure)
