@@ -12,9 +12,9 @@
 #   workspaces  the repository in the src/ of fresh ROS 1 workspaces (scripts/test_workspaces.sh):
 #             catkin_make (and the driver run from its devel space), catkin build, colcon; the
 #             plain build with CMake 3.16; catkin_lint -W1
-#   sanitize  three stages (scripts/test_sanitizers.sh): asan (ASan+UBSan build of the library
+#   sanitize  four stages (scripts/test_sanitizers.sh): asan (ASan+UBSan build of the library
 #             and its tests), tsan (TSan build of the suites labelled `threads`), asan_ros (ASan
-#             build of the ROS node and its tests)
+#             build of the ROS node and its tests), tsan_ros (the same with TSan)
 #   fuzz      every libFuzzer target for a bounded time (RANGER_FUZZ_SECONDS, default 60)
 #   ros2      the Python binding and the ROS 2 packages (scripts/test_ros2.sh): the venv of ROS 2
 #             wheels (scripts/setup_ros2.sh), the colcon build of ros2/ as the README has it, the
@@ -23,16 +23,18 @@
 # RANGER_STAGES="unit ros" runs a subset (default: all of the above, in the order
 # unit vcan ros_vcan ros ros2 workspaces sanitize fuzz).
 #
-# Lanes. ros and ros2 mostly wait on nodes, clocks and DDS; workspaces, sanitize and fuzz mostly
-# compile. Once no stage that runs the qemu VM (vcan, ros_vcan) is left, workspaces, sanitize and
-# fuzz form a queue that a background lane works through at a lower CPU and I/O priority (nice
-# 10: about a tenth of the CPU against a busy foreground, never starved; ionice best-effort 7),
-# taking mostly what the waiting stages leave (whoever runs a queued stage runs it so); ros2 runs in a lane of its own beside ros (ROS 1's
-# master and ROS 2's DDS domain do not meet); whichever lane, the foreground included, is done
-# with its own stages takes the next queued stage, so that both cores work to the end. Their
-# output is printed at the end, each stage's as a whole, and they count as any other stage.
-# RANGER_LANES=2 keeps ros2 in the foreground after ros; RANGER_LANES=1 runs every stage in the
-# foreground, in turn.
+# Lanes. unit, the VM stages, ros and ros2 mostly wait on nodes, clocks, the VM and DDS;
+# workspaces, sanitize and fuzz mostly compile. Right after the first build, workspaces, sanitize
+# and fuzz form a queue (asan_ros, asan, tsan_ros, workspaces, fuzz, tsan: the longest first)
+# that a background lane works through at a lower CPU and I/O priority (nice 10: about a tenth
+# of the CPU against a busy stage, never starved; ionice best-effort 7), beside the unit and VM
+# stages and then beside ros; once no VM stage is left, ros2 runs in a lane of its own beside ros (ROS
+# 1's master and ROS 2's DDS domain do not meet). Whichever lane, the foreground included, is done
+# with its own stages takes the next queued stage (whoever runs a queued stage runs it at nice
+# 10), so that both cores work to the end. The vcan and ros_vcan stages share one boot of the VM.
+# The lanes' output is printed at the end, each stage's as a whole, and they count as any other
+# stage. RANGER_LANES=2 keeps ros2 in the foreground after ros; RANGER_LANES=1 runs every stage in
+# the foreground, in turn.
 #
 # Every build goes through one compiler cache kept between runs (scripts/ccache_env.sh); the
 # Python environments of the later stages (ROS 2 wheels, CMake 3.16, cantools) are made beside
@@ -78,7 +80,24 @@ stage_unit() {
   ctest --test-dir build/lib -LE vcan --output-on-failure -j "$(nproc)" \
     --output-junit "$results/unit.xml"
 }
-stage_vcan() { scripts/run_vcan_tests.sh build/lib "$results/vcan.xml"; }
+# vcan and ros_vcan share one boot of the VM (scripts/run_vcan_tests.sh --and): when both are
+# selected, the vcan stage runs ros_vcan's suite after its own, and ros_vcan reports what it found
+# (each tree's status and time in build/lib/vcan-status/).
+stage_vcan() {
+  if wants ros_vcan && [ "${ros_vcan_done:-0}" = 0 ]; then
+    vcan_vm_shared=1
+    (ros_env && scripts/run_vcan_tests.sh build/lib "$results/vcan.xml" \
+      --and build/ws/ranger_base "$results/ros_vcan.xml")
+    tree_status 0
+  else
+    scripts/run_vcan_tests.sh build/lib "$results/vcan.xml"
+  fi
+}
+tree_status() {  # index: the status of that tree of the shared VM run (1 when it did not run)
+  local rc=1 seconds
+  read -r rc seconds 2>/dev/null <"build/lib/vcan-status/$1"
+  return "$rc"
+}
 ros_env() {  # the environment every ROS stage runs in (system Python first, our workspace)
   export PATH=/usr/bin:$PATH
   if [ -f /opt/ros/noetic/setup.bash ]; then set +u; source /opt/ros/noetic/setup.bash; set -u; fi
@@ -86,7 +105,17 @@ ros_env() {  # the environment every ROS stage runs in (system Python first, our
   export ROS_HOME=${ROS_HOME:-$root/build/ros_home} ROS_HOSTNAME=localhost
   export ROS_MASTER_URI=${ROS_MASTER_URI:-http://localhost:11311}
 }
-stage_ros_vcan() { (ros_env && scripts/run_vcan_tests.sh build/ws/ranger_base "$results/ros_vcan.xml"); }
+stage_ros_vcan() {
+  ros_vcan_done=1
+  (ros_env && scripts/run_vcan_tests.sh build/ws/ranger_base "$results/ros_vcan.xml")
+}
+# ros_vcan after the vcan stage ran its suite in the same VM boot: that run's verdict.
+ros_vcan_in_vcan_vm() {
+  local rc=1 seconds=?
+  read -r rc seconds 2>/dev/null <build/lib/vcan-status/1
+  echo "ros_vcan: run in the vcan stage's VM boot: status $rc in $seconds s (output above, in stage vcan)"
+  [ "$rc" = 0 ]
+}
 stage_ros() {
   (
     ros_env
@@ -100,26 +129,27 @@ stage_ros() {
   )
 }
 stage_workspaces() { scripts/test_workspaces.sh; }
-# sanitize is three stages, so that lanes can share them: asan, tsan, asan_ros.
+# sanitize is four stages, so that lanes can share them: asan, tsan, asan_ros, tsan_ros.
 stage_asan() { scripts/test_sanitizers.sh address; }
 stage_tsan() { scripts/test_sanitizers.sh thread; }
 stage_asan_ros() { scripts/test_sanitizers.sh ros; }
+stage_tsan_ros() { scripts/test_sanitizers.sh ros_thread; }
 stage_fuzz() { scripts/fuzz.sh "${RANGER_FUZZ_SECONDS:-60}"; }
 stage_ros2() { scripts/test_ros2.sh "$results"; }
 
 # ---- the lanes ----
-# Once no stage that boots the VM is left, the stages that mostly compile (workspaces, asan,
-# asan_ros, fuzz, tsan: the longest first) form a queue: a background lane at nice 10 works through it, and every
-# other lane joins it when its own stages are done, the foreground too (each queued stage is
-# claimed once: mkdir is atomic). ros2 runs in a lane of its own beside ros. A stage run in a lane
-# or from the queue writes its output to build/lane/<stage>.log, printed whole at the end; it
-# counts as any other stage.
+# The stages that mostly compile (asan_ros, asan, tsan_ros, workspaces, fuzz, tsan: the longest
+# first) form a queue from the start of the run: a background lane at nice 10 works through it,
+# and every other lane joins it when its own stages are done, the foreground too (each queued
+# stage is claimed once: mkdir is atomic). ros2 runs in a lane of its own beside ros, once the VM stages
+# are done. A stage run in a lane or from the queue writes its output to
+# build/lane/<stage>.log, printed whole at the end; it counts as any other stage.
 queued=()    # the compile queue, in order (RANGER_LANES >= 2)
 own_lane=()  # stages in a background lane of their own (RANGER_LANES >= 3)
 case ${RANGER_LANES:-3} in
   1) ;;
-  2) queued=(workspaces asan asan_ros fuzz tsan) ;;
-  *) queued=(workspaces asan asan_ros fuzz tsan) own_lane=(ros2) ;;
+  2) queued=(asan_ros asan tsan_ros workspaces fuzz tsan) ;;
+  *) queued=(asan_ros asan tsan_ros workspaces fuzz tsan) own_lane=(ros2) ;;
 esac
 selected_queue=()  # the queued stages of this run
 logged_stages=()   # every stage whose output is in build/lane/, in the order printed
@@ -169,21 +199,25 @@ start_lane() {  # name stages...: in the background: its stages in turn, then th
   lane_pids+=($!)
   set +m
 }
-start_lanes() {  # stages...: the rest of the run; starts the lanes with their part of it
+start_queue() {  # stages...: the run's stages; the compile lane starts with the queued ones
+  local s
+  for s in "${queued[@]}"; do  # in the queue's order
+    if in_list "$s" "$@" && [ "$(type -t "stage_$s")" = function ]; then selected_queue+=("$s"); fi
+  done
+  logged_stages+=("${selected_queue[@]}")
+  [ ${#selected_queue[@]} -eq 0 ] || start_lane compile
+}
+start_lanes() {  # stages...: the rest of the run; starts the lanes of their own with their part
   local s own=()
   lanes_started=1
   for s in "${own_lane[@]}"; do
     if in_list "$s" "$@" && [ "$(type -t "stage_$s")" = function ]; then own+=("$s"); fi
   done
-  for s in "${queued[@]}"; do  # in the queue's order
-    if in_list "$s" "$@" && [ "$(type -t "stage_$s")" = function ]; then selected_queue+=("$s"); fi
-  done
-  logged_stages=("${own[@]}" "${selected_queue[@]}")
+  logged_stages=("${own[@]}" "${logged_stages[@]}")
   [ ${#own[@]} -eq 0 ] || start_lane ros2 "${own[@]}"
-  [ ${#selected_queue[@]} -eq 0 ] || start_lane compile
 }
 in_a_lane() {  # stage: is it run by a lane (or the queue) rather than in the foreground here?
-  [ "$lanes_started" = 1 ] && in_list "$1" "${logged_stages[@]}"
+  in_list "$1" "${logged_stages[@]}"
 }
 stop_lanes() {
   local pid
@@ -269,7 +303,11 @@ scripts/build.sh all || { echo "build failed" >&2; exit 1; }
 note_time build $((SECONDS - build_start))
 finish_prepare
 
-read -r -a stage_list <<<"${stages//sanitize/asan tsan asan_ros}"
+read -r -a stage_list <<<"${stages//sanitize/asan tsan asan_ros tsan_ros}"
+# The compile queue starts at once, beside the unit and VM stages (the VM takes about half a core
+# while its suites run: 169 of 346 s measured; the queue runs at nice 10, so the VM's threads
+# come first whenever they want a core).
+start_queue "${stage_list[@]}"
 for i in "${!stage_list[@]}"; do
   s=${stage_list[$i]}
   if [ "$(type -t "stage_$s")" != function ]; then
@@ -278,10 +316,14 @@ for i in "${!stage_list[@]}"; do
     continue
   fi
   if [ "$lanes_started" = 0 ] && ! vm_left "${stage_list[@]:$i}"; then
-    # From here on no VM stage is left: the lanes take their part of the rest.
+    # From here on no VM stage is left: ros2's lane takes its part of the rest.
     start_lanes "${stage_list[@]:$i}"
   fi
   in_a_lane "$s" && continue
+  if [ "$s" = ros_vcan ] && [ "${vcan_vm_shared:-0}" = 1 ]; then
+    run_stage ros_vcan ros_vcan_in_vcan_vm
+    continue
+  fi
   run_stage "$s" "stage_$s"
 done
 finish_lanes

@@ -17,8 +17,10 @@
 # Environment: RANGER_ROS2_DISTRO=jazzy|kilted (one distribution; default both);
 # RANGER_ROS2_VENV_JAZZY, RANGER_ROS2_VENV_KILTED (a distribution's venv; default
 # .venv-ros2-DISTRO), RANGER_ROS2_VENV (the venv, when one distribution is selected);
-# RANGER_ROS2_DOMAIN_ID (default 86 for Jazzy, 87 for Kilted), RANGER_JOBS,
-# RANGER_ROS2_SKIP_PIP=1 to leave out the pip install.
+# RANGER_ROS2_DOMAIN_ID (the first distribution's, the next one's one more; default 86 for
+# Jazzy, 87 for Kilted), RANGER_JOBS,
+# RANGER_ROS2_SKIP_PIP=1 to leave out the pip install; RANGER_ROS2_PARALLEL=0 runs the
+# distributions one after the other (default: side by side).
 set -uo pipefail
 cd "$(dirname "$0")/.."
 # shellcheck source=build_flags.sh
@@ -52,8 +54,8 @@ fi
 
 # One distribution: its venv, its workspace, its tests, its domain id. Returns non-zero when
 # anything failed.
-run_distro() {
-  local distro=$1 venv ws started=$SECONDS
+run_distro() {  # distro domain_id
+  local distro=$1 domain=$2 venv ws started=$SECONDS
   setup_distro "$distro" || return 1
   ws=$root/build/ros2_ws_$distro
   echo "test_ros2: $distro: venv $venv, workspace $ws"
@@ -77,7 +79,7 @@ run_distro() {
   (
     # shellcheck disable=SC1091
     RANGER_ROS2_DISTRO=$distro RANGER_ROS2_VENV=$venv \
-      source scripts/ros2_env.sh "${RANGER_ROS2_DOMAIN_ID:-${domain_of[$distro]}}"
+      source scripts/ros2_env.sh "$domain"
     rc=0
     python -m pytest -p no:cacheprovider -q libranger_can/python/tests \
       --junitxml="$results/ros2_${distro}_binding.xml" || rc=1
@@ -92,11 +94,32 @@ run_distro() {
 }
 
 /usr/bin/python3 ros2/ranger_msgs/sync_interfaces.py --check || failed=1
-for distro in "${distros[@]}"; do
+# The distributions side by side (RANGER_ROS2_PARALLEL=0: one after the other): each has its own
+# venv, workspace and domain id, and their suites mostly wait on nodes and DDS. The first ones run
+# in the background, their output in build/ros2_DISTRO.log, printed whole when they are done.
+parallel=${RANGER_ROS2_PARALLEL:-1}
+background=()
+for i in "${!distros[@]}"; do
+  distro=${distros[$i]}
   case $distro in
-    jazzy | kilted) run_distro "$distro" || failed=1 ;;
-    *) echo "test_ros2: RANGER_ROS2_DISTRO=$distro: jazzy or kilted" >&2; failed=1 ;;
+    jazzy | kilted) ;;
+    *) echo "test_ros2: RANGER_ROS2_DISTRO=$distro: jazzy or kilted" >&2; failed=1; continue ;;
   esac
+  # RANGER_ROS2_DOMAIN_ID: the first distribution's; the next ones count up from it.
+  domain=${domain_of[$distro]}
+  [ -z "${RANGER_ROS2_DOMAIN_ID:-}" ] || domain=$((RANGER_ROS2_DOMAIN_ID + i))
+  if [ "$parallel" = 1 ] && [ "$i" -lt $((${#distros[@]} - 1)) ]; then
+    run_distro "$distro" "$domain" >"$root/build/ros2_$distro.log" 2>&1 </dev/null &
+    background+=("$distro:$!")
+  else
+    run_distro "$distro" "$domain" || failed=1
+  fi
+done
+for entry in "${background[@]}"; do
+  distro=${entry%%:*}
+  wait "${entry#*:}" || failed=1
+  echo "---- test_ros2: $distro (run beside the others; build/ros2_$distro.log):"
+  cat "$root/build/ros2_$distro.log"
 done
 
 if [ "${RANGER_ROS2_SKIP_PIP:-0}" != 1 ]; then

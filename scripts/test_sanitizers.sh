@@ -13,10 +13,14 @@
 #   ros      the ROS packages up to ranger_base (libranger_can, ranger_msgs, ranger_base) with
 #            ASan + UBSan in a colcon workspace of their own (build/asan-ws, build/asan-install),
 #            then ranger_base's gtests and rostests (the node itself runs instrumented).
+#   ros_thread  the same with ThreadSanitizer (build/tsan-ws, build/tsan-install): the node's
+#            threads (roscpp's spinners, the XML-RPC thread, the driver's) around our code, which
+#            is instrumented; roscpp and Boost are not (see scripts/tsan_roscpp.supp).
 #
-# Usage: scripts/test_sanitizers.sh [address|thread|ros]...     (default: all three)
+# Usage: scripts/test_sanitizers.sh [address|thread|ros|ros_thread]...  (default: all four)
 # Environment: RANGER_JOBS (default 2), CXX (default: the system compiler), RANGER_RESULTS
-#   (directory for the JUnit reports asan.xml, tsan.xml, asan-ros/; default build/test-results).
+#   (directory for the JUnit reports asan.xml, tsan.xml, asan-ros/, tsan-ros/; default
+#   build/test-results).
 #   RANGER_SANITIZE_VCAN=1 also runs the `vcan` suites of the ASan build, natively or in the qemu
 #   VM (scripts/run_vcan_tests.sh; it adds several minutes).
 #
@@ -24,15 +28,13 @@
 # -fno-sanitize-recover=all), and every instrumented process also writes its reports to
 # <build dir>/sanitizer-reports/, so that a report raised in a child process (the CLI run by the
 # CLI tests, the node run by rostest) fails the run even when whatever started it ignored its exit
-# status. No suppressions are used.
-#
-# ThreadSanitizer is not applied to the ROS node: roscpp and Boost are not instrumented, and TSan
-# needs every thread's code instrumented to report anything meaningful.
+# status. No suppressions are used, but in ros_thread for roscpp's own internals
+# (scripts/tsan_roscpp.supp: roscpp comes uninstrumented, so TSan misses its atomics).
 set -uo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
 kinds=("$@")
-[ ${#kinds[@]} -gt 0 ] || kinds=(address thread ros)
+[ ${#kinds[@]} -gt 0 ] || kinds=(address thread ros ros_thread)
 jobs=${RANGER_JOBS:-2}
 results=${RANGER_RESULTS:-$root/build/test-results}
 generator=()
@@ -113,50 +115,55 @@ run_cmake_build() {  # name dir RANGER_SANITIZE common_flags flags SELECT [ctest
   return $rc
 }
 
-# ranger_base (and what it needs) with ASan + UBSan in a colcon workspace, then its tests.
-run_ros_build() {
-  local ws=build/asan-ws install=build/asan-install reports=$root/build/asan-ws/sanitizer-reports
-  local start=$SECONDS rc=0
-  echo "== asan-ros: colcon build up to ranger_base ($ws)"
+# ranger_base (and what it needs) with one sanitizer in a colcon workspace of its own, then its
+# tests: the gtests and every rostest but the nodelet's (the node itself runs instrumented).
+run_ros_build() {  # name workspace common_flags flags
+  local name=$1 ws=build/$2 install=build/${2%-ws}-install common_flags=$3 flags=$4
+  local reports=$root/build/$2/sanitizer-reports start=$SECONDS rc=0
+  echo "== $name: colcon build up to ranger_base ($ws)"
   (
     # ROS's Python tools need the system interpreter (python3 on PATH may be a pyenv).
     export PATH=/usr/bin:$PATH
     if [ -f /opt/ros/noetic/setup.bash ]; then set +u; source /opt/ros/noetic/setup.bash; set -u; fi
     # Without make's load limit (colcon's default -l<cores>): beside the foreground's stages it
     # would build one file at a time.
-    MAKEFLAGS=-j$jobs colcon --log-base build/log-asan build --base-paths . \
+    MAKEFLAGS=-j$jobs colcon --log-base "build/log-${2%-ws}" build --base-paths . \
       --packages-up-to ranger_base --build-base "$ws" --install-base "$install" \
       --event-handlers console_cohesion- summary+ --parallel-workers 1 \
       --cmake-args -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=Debug \
-      "-DCMAKE_CXX_FLAGS=$asan_common_flags $asan_flags" \
-      "-DCMAKE_EXE_LINKER_FLAGS=$asan_flags" "-DCMAKE_SHARED_LINKER_FLAGS=$asan_flags" \
+      "-DCMAKE_CXX_FLAGS=$common_flags $flags" \
+      "-DCMAKE_EXE_LINKER_FLAGS=$flags" "-DCMAKE_SHARED_LINKER_FLAGS=$flags" \
       -DCATKIN_ENABLE_TESTING=ON
-  ) || { echo "== asan-ros: BUILD FAILED"; return 1; }
-  echo "== asan-ros: built in $((SECONDS - start)) s"
+  ) || { echo "== $name: BUILD FAILED"; return 1; }
+  echo "== $name: built in $((SECONDS - start)) s"
 
   start=$SECONDS
   (
     export PATH=/usr/bin:$PATH
     if [ -f /opt/ros/noetic/setup.bash ]; then set +u; source /opt/ros/noetic/setup.bash; set -u; fi
     set +u; source "$install/setup.bash"; set -u
-    export ROS_HOME=$root/build/asan-ws/ros_home ROS_HOSTNAME=localhost
+    export ROS_HOME=$root/$ws/ros_home ROS_HOSTNAME=localhost
     export ROS_MASTER_URI=http://localhost:11311
     set_sanitizer_env "$reports"
+    # roscpp's own internals only (the file says which and why); what roscpp and rosconsole
+    # (uninstrumented) do through the intercepted functions (memcpy, delete) is theirs, not ours
+    # (ignore_noninstrumented_modules: TSan's setting for libraries built without it).
+    [ "$name" != tsan-ros ] || export TSAN_OPTIONS="$TSAN_OPTIONS:ignore_noninstrumented_modules=1:suppressions=$root/scripts/tsan_roscpp.supp"
     # Every rostest but the nodelet's: that one loads the plugin into the system's nodelet
-    # manager, which is not instrumented (the ASan runtime must come first in a process), and
-    # uses ranger_bringup's launch file, which this workspace does not build. The nodelet and the
-    # node are one class, which the other rostests run under ASan.
-    colcon --log-base build/log-asan test --base-paths . --packages-select ranger_base \
+    # manager, which is not instrumented (the sanitizer's runtime must come first in a process),
+    # and uses ranger_bringup's launch file, which this workspace does not build. The nodelet and
+    # the node are one class, which the other rostests run instrumented.
+    colcon --log-base "build/log-${2%-ws}" test --base-paths . --packages-select ranger_base \
       --build-base "$ws" --install-base "$install" --event-handlers console_cohesion- \
       --executor sequential --return-code-on-test-failure --ctest-args -E node_nodelet
     test_rc=$?
     colcon test-result --test-result-base "$ws" --verbose
-    rm -rf "$results/asan-ros" && mkdir -p "$results/asan-ros"
-    find "$ws" -path '*test_results*' -name '*.xml' -exec cp {} "$results/asan-ros/" \;
+    rm -rf "${results:?}/$name" && mkdir -p "$results/$name"
+    find "$ws" -path '*test_results*' -name '*.xml' -exec cp {} "$results/$name/" \;
     exit $test_rc
   ) || rc=1
-  echo "== asan-ros: tests ran in $((SECONDS - start)) s"
-  check_reports asan-ros "$reports" || rc=1
+  echo "== $name: tests ran in $((SECONDS - start)) s"
+  check_reports "$name" "$reports" || rc=1
   return $rc
 }
 
@@ -176,9 +183,16 @@ for kind in "${kinds[@]}"; do
       name=tsan
       run=(run_cmake_build tsan build/tsan thread "$tsan_common_flags" "$tsan_flags" threads)
       ;;
-    ros) name=asan-ros; run=(run_ros_build) ;;
+    ros)
+      name=asan-ros
+      run=(run_ros_build asan-ros asan-ws "$asan_common_flags" "$asan_flags")
+      ;;
+    ros_thread)
+      name=tsan-ros
+      run=(run_ros_build tsan-ros tsan-ws "$tsan_common_flags" "$tsan_flags")
+      ;;
     *)
-      echo "test_sanitizers.sh: unknown build '$kind' (expected address, thread or ros)" >&2
+      echo "test_sanitizers.sh: unknown build '$kind' (expected address, thread, ros or ros_thread)" >&2
       exit 2
       ;;
   esac
