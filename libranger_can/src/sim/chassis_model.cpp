@@ -182,9 +182,27 @@ void ChassisModel::sub_step(double h) {
 
   if (switch_phase_ == SwitchPhase::kNone && mode_ != MotionMode::kSpin) {
     const double delta = target_.steering - steering_;
-    const double max_step = limits_.steering_rate * h;
-    steering_ =
-        std::abs(delta) <= max_step ? target_.steering : steering_ + std::copysign(max_step, delta);
+    const double a = limits_.steering_acceleration;
+    if (a > 0.0) {
+      // Trapezoidal: toward the fastest speed that still stops at the target, by at most a * h.
+      const double wanted = std::copysign(
+          std::min(limits_.steering_rate, std::sqrt(2.0 * a * std::abs(delta))), delta);
+      const double dv = std::clamp(wanted - steering_velocity_, -a * h, a * h);
+      const double v = steering_velocity_ + dv;
+      const double step = (steering_velocity_ + v) / 2.0 * h;
+      const bool arrives = (step > 0) == (delta > 0) && std::abs(step) >= std::abs(delta);
+      if (std::abs(delta) < 1e-9 || arrives) {
+        steering_ = target_.steering;
+        steering_velocity_ = 0.0;
+      } else {
+        steering_ += step;
+        steering_velocity_ = v;
+      }
+    } else {
+      const double max_step = limits_.steering_rate * h;
+      steering_ = std::abs(delta) <= max_step ? target_.steering
+                                              : steering_ + std::copysign(max_step, delta);
+    }
   }
 
   const double goal = switching() ? 0.0 : target_.speed;
@@ -230,6 +248,7 @@ void ChassisModel::sub_step(double h) {
       switch_elapsed_ = switch_duration_;
       mode_ = switch_target_;
       steering_ = 0.0;
+      steering_velocity_ = 0.0;
       target_ = MotionTarget{};
       emergency_ = false;
       switch_phase_ = SwitchPhase::kNone;
