@@ -490,11 +490,12 @@ TEST(FieldFacts, ControlModeIsZeroStandbyOneCanThreeRemote) {
 }
 
 TEST(FieldFacts, EstopIsFaultBit7AndBodyStatusTwoAsTheFieldReportsIt) {
-  // The field's body status (vehicle_status_1_is_estop = false: 0 normal, 2 abnormal).
+  // The field's body status, the MINI 3.0's default (vehicle_status_1_is_estop = false: 0 normal,
+  // 2 abnormal).
   auto model = model_preset("ranger_mini_v3");
   ASSERT_TRUE(model.ok());
-  sim::VirtualChassisConfig field = sim::chassis_for_model(*model);
-  field.profile.vehicle_status_1_is_estop = false;
+  const sim::VirtualChassisConfig field = sim::chassis_for_model(*model);
+  EXPECT_FALSE(field.profile.vehicle_status_1_is_estop);
   test::FakeBus bus;
   sim::VirtualChassis chassis(bus, field, Timestamp{0});
   chassis.step(Timestamp{40ms});
@@ -504,12 +505,15 @@ TEST(FieldFacts, EstopIsFaultBit7AndBodyStatusTwoAsTheFieldReportsIt) {
   const CanFrame f = last_frame(bus, protocol::kSystemStatusId);
   EXPECT_EQ(f.data[0], 2) << "0 normal / 2 abnormal: 1 does not exist on this model";
   EXPECT_EQ(bytes(f, 4, 8), (std::vector<int>{0, 0, 0, 0x80})) << "error_code_full 0x00000080";
-  // Our transcription's reading (the preset) reports 1 with the same bit.
-  Chassis c("mini_v3");
-  c.chassis.set_emergency_stop(true);
-  c.advance(40ms);
-  EXPECT_EQ(last_frame(c.bus, protocol::kSystemStatusId).data[0], 1);
-  EXPECT_EQ(bytes(last_frame(c.bus, protocol::kSystemStatusId), 4, 8),
+  // The vendor SDK's reading (`--set vehicle_status_1_is_estop=true`) reports 1 with the same bit.
+  sim::VirtualChassisConfig sdk = field;
+  sdk.profile.vehicle_status_1_is_estop = true;
+  test::FakeBus sdk_bus;
+  sim::VirtualChassis sdk_chassis(sdk_bus, sdk, Timestamp{0});
+  sdk_chassis.set_emergency_stop(true);
+  sdk_chassis.step(Timestamp{40ms});
+  EXPECT_EQ(last_frame(sdk_bus, protocol::kSystemStatusId).data[0], 1);
+  EXPECT_EQ(bytes(last_frame(sdk_bus, protocol::kSystemStatusId), 4, 8),
             (std::vector<int>{0, 0, 0, 0x80}));
 }
 
@@ -524,7 +528,7 @@ TEST(FieldFacts, TheDriverStopsOnTheEstopBitWhicheverTheBodyStatus) {
     auto source = sim::open_bus_source("sim", clock, options);
     ASSERT_TRUE(source.ok());
     auto sim = std::static_pointer_cast<sim::SimBusSource>(*source);
-    // The driver reads the preset (status 1 = e-stop) either way.
+    // The driver reads the preset (the field's: status 2, no 1) either way.
     Driver driver(driver_for("mini_v3"), *source, clock);
     // The commander publishes 0.3 m/s every 50 ms.
     auto step = [&](std::chrono::nanoseconds d) {
@@ -565,9 +569,9 @@ TEST(FieldFacts, BmsPayloadOfTheNotesDecodesUnderTheFieldsScale) {
   f.id = protocol::kBmsBaseId;
   f.dlc = 8;
   f.data = {0x64, 0x64, 0x14, 0xB4, 0x00, 0x00, 0x01, 0x24};
-  // The field's reading: 0.01 V (`--set bms_voltage_scale=0.01`).
-  ProtocolProfile field = *protocol_preset("mini_v3");
-  field.bms_voltage_scale = 0.01;
+  // The field's reading, the MINI 3.0's preset: 0.01 V.
+  const ProtocolProfile field = *protocol_preset("mini_v3");
+  EXPECT_EQ(field.bms_voltage_scale, 0.01);
   auto m = decode(f, field);
   ASSERT_TRUE(m.ok());
   const auto& b = std::get<BmsData>(*m);
@@ -576,10 +580,13 @@ TEST(FieldFacts, BmsPayloadOfTheNotesDecodesUnderTheFieldsScale) {
   EXPECT_NEAR(b.voltage, 53.0, 1e-9) << "0.01 V";
   EXPECT_DOUBLE_EQ(b.current, 0.0);
   EXPECT_NEAR(b.temperature, 29.2, 1e-9);
-  // Our transcription of the manual (the preset) reads 530 V: the disagreement, kept.
-  auto preset = decode(f, *protocol_preset("mini_v3"));
-  ASSERT_TRUE(preset.ok());
-  EXPECT_NEAR(std::get<BmsData>(*preset).voltage, 530.0, 1e-9);
+  // Our transcription of the manual (`--set bms_voltage_scale=0.1`, sim:mini_v3_manual) reads
+  // 530 V: the disagreement, kept selectable.
+  ProtocolProfile transcribed = field;
+  transcribed.bms_voltage_scale = 0.1;
+  auto manual = decode(f, transcribed);
+  ASSERT_TRUE(manual.ok());
+  EXPECT_NEAR(std::get<BmsData>(*manual).voltage, 530.0, 1e-9);
   // Charging is positive on the wire (+19 A while the SOC rose): a negative discharge.
   EXPECT_LT(interpretation::bms_discharge_current(19.0, field), 0.0);
 }
