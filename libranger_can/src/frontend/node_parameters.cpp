@@ -264,6 +264,7 @@ void add_control(std::vector<Binding>& out) {
   for (const char* name :
        {"cmd_vel_timeout", "auto_command_mode", "auto_reclaim_after_remote", "rearm_on_zero_twist",
         "link_timeout", "min_command_interval", "mode_switch_timeout", "mode_switch_max_attempts",
+        "mode_switch_blind_time", "mode_switch_min_time", "mode_switch_wheel_tolerance",
         "standstill_speed", "steer_first_threshold", "low_battery_soc"}) {
     out.push_back(driver_row(name));
   }
