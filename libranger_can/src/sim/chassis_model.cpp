@@ -184,19 +184,21 @@ void ChassisModel::sub_step(double h) {
     const double delta = target_.steering - steering_;
     const double a = limits_.steering_acceleration;
     if (a > 0.0) {
-      // Trapezoidal: toward the fastest speed that still stops at the target, by at most a * h.
-      const double wanted = std::copysign(
-          std::min(limits_.steering_rate, std::sqrt(2.0 * a * std::abs(delta))), delta);
-      const double dv = std::clamp(wanted - steering_velocity_, -a * h, a * h);
-      const double v = steering_velocity_ + dv;
-      const double step = (steering_velocity_ + v) / 2.0 * h;
-      const bool arrives = (step > 0) == (delta > 0) && std::abs(step) >= std::abs(delta);
-      if (std::abs(delta) < 1e-9 || arrives) {
+      // Trapezoidal: as fast as the rate and the acceleration allow while the speed at the end of
+      // the sub-step still stops at the target (v_end^2 = 2 a (dist - (v + v_end) h / 2), solved).
+      const double dir = delta > 0.0 ? 1.0 : -1.0;
+      const double dist = std::abs(delta);
+      const double v = steering_velocity_ * dir;  // toward the target
+      const double disc = a * a * h * h + 4.0 * (2.0 * a * dist - a * h * v);
+      const double v_brake = std::max(0.0, (-a * h + std::sqrt(std::max(0.0, disc))) / 2.0);
+      const double vn = std::max(std::min({limits_.steering_rate, v + a * h, v_brake}), v - a * h);
+      const double step = (v + vn) / 2.0 * h;
+      if (dist < 1e-9 || step >= dist - 1e-12) {
         steering_ = target_.steering;
         steering_velocity_ = 0.0;
       } else {
-        steering_ += step;
-        steering_velocity_ = v;
+        steering_ += dir * step;
+        steering_velocity_ = dir * vn;
       }
     } else {
       const double max_step = limits_.steering_rate * h;

@@ -102,16 +102,17 @@ std::string variants_help() {
 namespace {
 
 // The models a real chassis has been observed of, and what the field showed (docs/FIELD_FACTS.md):
-// its switch, and the lag of its steering's profile (t = d / rate + lag, the rate the model's
-// steering_rate; 0: a pure rate).
+// its switch, the lag of its steering's profile (t = d / rate + lag, the rate the model's
+// steering_rate; 0: a pure rate), its frame rates and its pack's state of health.
 struct FieldObservation {
   std::string_view model;
   SwitchModelConfig (*switch_model)();
   double steering_lag;          // s
   FrameRates (*frame_rates)();  // frame_schedule.hpp's column
+  double battery_soh;           // %, 0x361 byte 1
 };
 constexpr FieldObservation kFieldObservations[] = {
-    {"ranger_mini_v3", field_switch_model, kFieldSlewLag, field_frame_rates},
+    {"ranger_mini_v3", field_switch_model, kFieldSlewLag, field_frame_rates, 100.0},
 };
 
 }  // namespace
@@ -126,6 +127,7 @@ VirtualChassisConfig chassis_for_model(const ModelPreset& model, VirtualChassisC
     config.switch_model = f.switch_model();
     config.limits.steering_acceleration = model.limits.steering_rate / f.steering_lag;
     config.frame_rates = f.frame_rates();
+    config.drivetrain.battery_soh = f.battery_soh;
   }
   config.geometry = model.geometry;
   config.limits.max_linear_speed = model.limits.max_linear_speed;
