@@ -31,6 +31,7 @@
 #include "ranger_can/wire/codec.hpp"
 #include "ranger_can/wire/interpretation.hpp"
 #include "support/cli_run.hpp"
+#include "support/driver_sim_rig.hpp"
 #include "support/fake_bus.hpp"
 
 namespace ranger {
@@ -212,113 +213,70 @@ TEST(FieldChassis, TheManualsReportStaysReachableByName) {
 
 // ---- the driver on the field's switch ----------------------------------------------------------
 
-DriverConfig driver_for(const std::string& variant) {
-  DriverConfig c;
-  if (variant == "mini_v3") {
-    const auto model = model_preset("ranger_mini_v3");
-    EXPECT_TRUE(model.ok());
-    c.controller.geometry = model->geometry;
-    c.controller.limits = model->limits;
-    c.controller.profile = model->profile;
-  }
-  return c;
-}
-
 bool moving(const CanFrame& f) {
   return std::any_of(f.data.begin(), f.data.begin() + f.dlc, [](std::uint8_t b) { return b != 0; });
 }
 
-// The driver and the virtual chassis in lock-step, 1 ms a step, watching both sides.
-class SwitchRig {
+// The shared lock-step rig (support/driver_sim_rig.hpp), watching both sides at every step.
+class SwitchRig : public test::DriverSimRig {
  public:
-  explicit SwitchRig(const std::string& variant) {
-    sim::SimSourceOptions options;
-    options.lock_step = true;
-    auto source =
-        sim::open_bus_source(variant == "manual" ? "sim" : "sim:" + variant, clock_, options);
-    EXPECT_TRUE(source.ok());
-    sim_ = std::static_pointer_cast<sim::SimBusSource>(*source);
-    driver_ = std::make_unique<Driver>(driver_for(variant), *source, clock_);
-    driver_->set_sent_observer([this](const SentEvent& e) {
-      if (e.sent.frame.id == protocol::kMotionCommandId && moving(e.sent.frame))
-        moving_sent_ = true;
-    });
-  }
-  ~SwitchRig() { driver_.reset(); }
+  explicit SwitchRig(const std::string& variant)
+      : DriverSimRig(variant, test::driver_config_for(variant)) {}
 
-  void step() {
-    const bool moving_in_flight = moving_sent_;
-    moving_sent_ = false;
-    clock_.advance(1ms);
-    const std::uint64_t ignored_before = counters().frames_ignored;
-    sim_->step(clock_.now());
-    const sim::ChassisSnapshot s = sim_->snapshot();
-    if (moving_in_flight && counters().frames_ignored > ignored_before) {
-      ++lost_;
-      std::cout << "lost at " << seconds(clock_.now()) << " switching " << s.switching << " mode "
-                << protocol::to_string(s.motion_mode) << " -> "
-                << protocol::to_string(s.switch_target) << " refused " << s.motion_refused_reason
-                << "\n";
-    }
-    if (!was_switching_ && s.switching) switch_end_.reset();  // the next switch began
-    if (was_switching_ && !s.switching) {
-      switch_end_ = clock_.now();
-      ++switches_;
-    }
-    was_switching_ = s.switching;
-    const bool obeyed = s.target.speed != 0.0 || s.target.steering != 0.0;
-    if (switch_end_ && obeyed) {
-      added_.push_back(seconds(clock_.now() - *switch_end_));
-      switch_end_.reset();
-    }
-    driver_->step(clock_.now());
-    const auto snap = driver_->snapshot();
-    if (has(snap->controller.latched_causes, StopCause::kImplausible) ||
-        !snap->controller.implausible_reason.empty()) {
-      implausible_ = snap->controller.implausible_reason;
-    }
-  }
-  bool run_until(const std::function<bool()>& done, std::chrono::nanoseconds timeout) {
-    const Timestamp end = clock_.now() + timeout;
-    while (!done()) {
-      if (clock_.now() >= end) return false;
-      step();
-    }
-    return true;
-  }
-  // The caller publishes `request` every 50 ms for `d`.
+  // The caller publishes `request` every 50 ms for `d`; every command accepted.
   void drive(const MotionRequest& request, std::chrono::nanoseconds d) {
-    const Timestamp end = clock_.now() + d;
-    while (clock_.now() < end) {
-      EXPECT_TRUE(driver_->command(request).ok());
-      for (int i = 0; i < 50 && clock_.now() < end; ++i)
-        step();
-    }
+    EXPECT_EQ(DriverSimRig::drive(request, d), 0) << "a command refused";
   }
-  bool ready() {
-    return run_until(
-        [&] {
-          const auto s = driver_->snapshot();
-          return s->controller.control_mode == ControlMode::kCan && s->controller.motion_mode;
-        },
-        3s);
-  }
-  sim::ChassisSnapshot chassis() { return sim_->snapshot(); }
-  sim::VirtualChassisCounters counters() {
-    return sim_->with_chassis([](sim::VirtualChassis& c) { return c.counters(); });
-  }
-  std::shared_ptr<const DriverSnapshot> snap() const { return driver_->snapshot(); }
+  std::shared_ptr<const DriverSnapshot> snap() const { return snapshot(); }
 
   int switches_ = 0;
   int lost_ = 0;               // moving 0x111 the chassis ignored
   std::vector<double> added_;  // s from the chassis's switch end to the first obeyed command
   std::string implausible_;
 
+ protected:
+  void on_sent(const SentEvent& e) override {
+    if (e.sent.frame.id == protocol::kMotionCommandId && moving(e.sent.frame)) moving_sent_ = true;
+  }
+  void chassis_stepping() override {
+    moving_in_flight_ = moving_sent_;
+    moving_sent_ = false;
+    ignored_before_ = counters().frames_ignored;
+  }
+  void chassis_stepped() override {
+    const sim::ChassisSnapshot s = chassis();
+    const Timestamp now = clock().now();
+    if (moving_in_flight_ && counters().frames_ignored > ignored_before_) {
+      ++lost_;
+      std::cout << "lost at " << seconds(now) << " switching " << s.switching << " mode "
+                << protocol::to_string(s.motion_mode) << " -> "
+                << protocol::to_string(s.switch_target) << " refused " << s.motion_refused_reason
+                << "\n";
+    }
+    if (!was_switching_ && s.switching) switch_end_.reset();  // the next switch began
+    if (was_switching_ && !s.switching) {
+      switch_end_ = now;
+      ++switches_;
+    }
+    was_switching_ = s.switching;
+    const bool obeyed = s.target.speed != 0.0 || s.target.steering != 0.0;
+    if (switch_end_ && obeyed) {
+      added_.push_back(seconds(now - *switch_end_));
+      switch_end_.reset();
+    }
+  }
+  void driver_stepped() override {
+    const auto snap = snapshot();
+    if (has(snap->controller.latched_causes, StopCause::kImplausible) ||
+        !snap->controller.implausible_reason.empty()) {
+      implausible_ = snap->controller.implausible_reason;
+    }
+  }
+
  private:
-  ManualClock clock_{Timestamp(1000s)};
-  std::shared_ptr<sim::SimBusSource> sim_;
-  std::unique_ptr<Driver> driver_;
   bool moving_sent_ = false;
+  bool moving_in_flight_ = false;
+  std::uint64_t ignored_before_ = 0;
   bool was_switching_ = false;
   std::optional<Timestamp> switch_end_;
 };
@@ -533,7 +491,7 @@ TEST(FieldFacts, TheDriverStopsOnTheEstopBitWhicheverTheBodyStatus) {
     ASSERT_TRUE(source.ok());
     auto sim = std::static_pointer_cast<sim::SimBusSource>(*source);
     // The driver reads the preset (the field's: status 2, no 1) either way.
-    Driver driver(driver_for("mini_v3"), *source, clock);
+    Driver driver(test::driver_config_for("mini_v3"), *source, clock);
     // The commander publishes 0.3 m/s every 50 ms.
     auto step = [&](std::chrono::nanoseconds d) {
       for (auto e = 0ns; e < d; e += 1ms) {
