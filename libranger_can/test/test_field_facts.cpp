@@ -4,15 +4,18 @@
 // on some switches only, the wheels at about 3.26 rad/s (t = d / 3.26 + 0.064 s, triangular below
 // 0.21 rad), speed commands ignored until they are there (sim:mini_v3 and the RANGER's variant
 // sim:field_switch); then the driver on them: 100 switches at field timing in lock-step with a
-// ManualClock, no sleeping; then the run as a candump record; then the other facts of the table.
+// ManualClock, no sleeping; then the run as a candump record; then the other facts of the table,
+// and the table itself: every row names tests that exist.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <iostream>
+#include <iterator>
 #include <memory>
 #include <optional>
 #include <random>
@@ -671,6 +674,48 @@ TEST(FieldFacts, AReleasedEstopClearsItsBitWithout0x441) {
   EXPECT_EQ(bytes(last_frame(c.bus, protocol::kSystemStatusId), 4, 8),
             (std::vector<int>{0, 0, 0, 0}));
   EXPECT_EQ(last_frame(c.bus, protocol::kSystemStatusId).data[0], 0);
+}
+
+// ---- the table itself ---------------------------------------------------------------------------
+
+// Every row of docs/FIELD_FACTS.md names at least one test, and every test it names exists in the
+// library's tests (TEST, TEST_P or TEST_F of that suite and name; a bare suite name: the suite).
+TEST(FieldFactsTable, EveryRowNamesTestsThatExist) {
+  std::ifstream doc(std::string(RANGER_SOURCE_DIR) + "/../docs/FIELD_FACTS.md");
+  ASSERT_TRUE(doc.good());
+  std::string sources;
+  for (const auto& entry :
+       std::filesystem::directory_iterator(std::string(RANGER_SOURCE_DIR) + "/test")) {
+    if (entry.path().extension() != ".cpp") continue;
+    std::ifstream in(entry.path());
+    sources += std::string(std::istreambuf_iterator<char>(in), {});
+  }
+  int rows = 0;
+  for (std::string line; std::getline(doc, line);) {
+    if (line.rfind("| ", 0) != 0 || line.rfind("| fact ", 0) == 0) continue;
+    ++rows;
+    SCOPED_TRACE(line.substr(0, 80));
+    const std::size_t last = line.rfind('|', line.size() - 2);
+    ASSERT_NE(last, std::string::npos);
+    const std::string cell = line.substr(last);
+    int named = 0;
+    for (std::size_t b = cell.find('`'); b != std::string::npos; b = cell.find('`', b + 1)) {
+      const std::size_t e = cell.find('`', b + 1);
+      if (e == std::string::npos) break;
+      const std::string name = cell.substr(b + 1, e - b - 1);
+      b = e;
+      const std::size_t dot = name.find('.');
+      // A file named beside its tests, or a pattern (`Field*`).
+      if (name.rfind("test_", 0) == 0 || name.find('*') != std::string::npos) continue;
+      ++named;
+      const std::string wanted =
+          dot == std::string::npos ? "(" + name + ", "
+                                   : "(" + name.substr(0, dot) + ", " + name.substr(dot + 1) + ")";
+      EXPECT_NE(sources.find(wanted), std::string::npos) << name << " is no test";
+    }
+    EXPECT_GT(named, 0) << "a row without a test";
+  }
+  EXPECT_GE(rows, 20);
 }
 
 }  // namespace
