@@ -1,6 +1,8 @@
 // The adversarial trial (issue 28) as lock-step tests: the driver runtime (protocol auto, as the
-// node runs it) against the virtual chassis on the manual's reading (`sim`) and the vendor's
-// (`sim:agx_v2`), each attack judged by the chassis's ground truth, never by a log line:
+// node runs it) against the virtual chassis on the manual's reading (`sim`), the vendor's
+// (`sim:agx_v2`) and the manual's with the field's report of a mode switch (`sim:field_switch`:
+// the mode-switch thrash on both reports), each attack judged by the chassis's ground truth, never
+// by a log line:
 //  * after an e-stop, a remote takeover and link loss, a zero twist and then 0.5 m/s for 4 s move
 //    nothing; resume drives;
 //  * NaN and infinities in every one of the twist's six components move nothing and are named
@@ -241,7 +243,8 @@ TEST_P(Adversarial, ModeThrashEveryHundredMillisecondsNeverDrivesWhileSwitching)
 
 TEST_P(Adversarial, BadRequestsAreRefusedByNameAndChangeNothing) {
   auto rig = ready_rig();
-  const bool manual = std::string(GetParam()) == "sim";
+  // The manual's reading (sim:field_switch differs in its report of a switch only).
+  const bool manual = std::string(GetParam()) != "sim:agx_v2";
   const Pose2D at = rig->truth().pose;
   const std::size_t sent_before = rig->sent().size();
   EXPECT_EQ(rig->driver().clear_errors(0x11).error().code, Errc::kInvalidArgument);
@@ -374,9 +377,11 @@ TEST(AdversarialMiniV3, TheChassissOwnOdometerCarriesThePoseThroughASilence) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Chassis, Adversarial, ::testing::Values("sim", "sim:agx_v2"),
+INSTANTIATE_TEST_SUITE_P(Chassis, Adversarial,
+                         ::testing::Values("sim", "sim:agx_v2", "sim:field_switch"),
                          [](const ::testing::TestParamInfo<const char*>& info) {
-                           return std::string(info.param) == "sim" ? "manual" : "agx_v2";
+                           const std::string spec = info.param;
+                           return spec == "sim" ? std::string("manual") : spec.substr(4);
                          });
 
 }  // namespace
