@@ -105,8 +105,9 @@ MotionCommand ackermann(double v, double rep103_steering) {
 
 TEST(ChassisVariants, TableNamesEveryVariantWithADescriptionAndTheDriverOptions) {
   const std::vector<std::string> expected = {
-      "manual",      "agx_v2",  "padded",  "spin_cw",      "steer_left_positive", "speed221_body",
-      "inner_angle", "mini_v1", "mini_v3", "field_switch", "mode_left",           "undecidable"};
+      "manual",        "agx_v2",      "padded",     "spin_cw", "steer_left_positive",
+      "speed221_body", "inner_angle", "mini_v1",    "mini_v3", "mini_v3_manual",
+      "field_switch",  "mode_left",   "undecidable"};
   EXPECT_EQ(variant_names(), expected);
   for (const VariantInfo& v : variants()) {
     SCOPED_TRACE(v.name);
@@ -122,8 +123,8 @@ TEST(ChassisVariants, UnknownVariantListsTheValidOnes) {
   EXPECT_EQ(c.error().code, Errc::kInvalidArgument);
   EXPECT_EQ(c.error().message,
             "unknown virtual chassis variant 'ranger_xl' (valid: manual, agx_v2, padded, spin_cw, "
-            "steer_left_positive, speed221_body, inner_angle, mini_v1, mini_v3, field_switch, "
-            "mode_left, undecidable)");
+            "steer_left_positive, speed221_body, inner_angle, mini_v1, mini_v3, mini_v3_manual, "
+            "field_switch, mode_left, undecidable)");
 }
 
 TEST(ChassisVariants, EachSettingVariantChangesOneReadingOfTheManual) {
@@ -451,7 +452,7 @@ TEST(ChassisVariantMiniV3, IsTheModelsChassisSpeakingItsManual) {
   EXPECT_EQ(m.config.profile, *protocol_preset("mini_v3"));
   EXPECT_EQ(m.config.geometry.wheelbase, model.geometry.wheelbase);
   EXPECT_EQ(m.config.limits.max_linear_speed, 2.0);
-  EXPECT_EQ(m.config.limits.max_speed_at_large_steering, 0.7);
+  EXPECT_EQ(m.config.limits.max_speed_at_large_steering, 1.0);  // the field's reading
   EXPECT_TRUE(m.config.vendor_frames);
   EXPECT_TRUE(m.config.odometer_frames);
 }
@@ -487,7 +488,8 @@ TEST(ChassisVariantMiniV3, FaultsByMeaningInItsFaultWord) {
   m.chassis.set_emergency_stop(true);
   m.advance(40ms);
   const auto s = m.last<SystemStatus>(protocol::kSystemStatusId);
-  EXPECT_EQ(s.vehicle_status, protocol::VehicleStatus::kEmergencyStop);
+  // Body status 2 (abnormal) with the fault word's e-stop bit, as a real one reports it.
+  EXPECT_EQ(s.vehicle_status, protocol::VehicleStatus::kAbnormal);
   EXPECT_EQ(protocol::error_bit_names(s.error_bits, ErrorWordLayout::kMini32),
             (std::vector<std::string>{"battery_over_voltage", "emergency_stop", "over_current"}));
   // 0x441 0x0F clears the over-current, 0x00 the rest once the e-stop is released.
@@ -571,12 +573,12 @@ TEST(ChassisVariantMiniV3, ItsLimitsBound0x111) {
   fast.linear_speed = 2.5;  // beyond the MINI 3.0's 2.0 m/s
   m.drive(fast, 4s);
   EXPECT_NEAR(m.chassis.snapshot().twist.vx, 2.0, 1e-9);
-  // Beyond 20 deg of steering: 0.7 m/s.
+  // Beyond 20 deg of steering: 1.0 m/s (the field's reading of its manual).
   MotionCommand turning;
   turning.linear_speed = 1.5;
   turning.steering_angle = interpretation::manual_from_rep103_command_steering(0.5);  // inner
   m.drive(turning, 4s);
-  EXPECT_NEAR(m.chassis.snapshot().target.speed, 0.7, 1e-9);
+  EXPECT_NEAR(m.chassis.snapshot().target.speed, 1.0, 1e-9);
   // Spin: 3.259 rad/s at most.
   m.switch_mode(MotionMode::kSpin);
   MotionCommand spin;

@@ -1,9 +1,11 @@
 // The driver runtime in lock-step with the virtual chassis (sim::SimBusSource, lock_step) under a
 // ManualClock: the mailbox, the snapshot, the sent-frame events (the shutdown stop included),
 // request outcomes, "motion known" only while the chassis is heard, and the bus sources
-// (replay:FILE, a missing interface). No threads of the driver's, no sleeping.
+// (replay:FILE, a missing interface); every motion mode on either report of a switch (the
+// manual's, the field's). No threads of the driver's, no sleeping.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <memory>
@@ -13,69 +15,60 @@
 #include "ranger_can/control/driver.hpp"
 #include "ranger_can/sim/sim_bus_source.hpp"
 #include "ranger_can/wire/candump_log.hpp"
+#include "support/driver_sim_rig.hpp"
 
 namespace ranger {
 namespace {
 
 using namespace std::chrono_literals;
 
-class DriverRig {
+// The shared lock-step rig (support/driver_sim_rig.hpp) on the plain `sim`; the commander's every
+// command is accepted.
+class DriverRig : public test::DriverSimRig {
  public:
-  explicit DriverRig(DriverConfig config = {}) {
-    sim::SimSourceOptions options;
-    options.lock_step = true;
-    auto source = sim::open_bus_source("sim", clock_, options);
-    EXPECT_TRUE(source.ok());
-    sim_ = std::static_pointer_cast<sim::SimBusSource>(*source);
-    driver_ = std::make_unique<Driver>(config, *source, clock_);
-    driver_->set_sent_observer([this](const SentEvent& e) { sent_.push_back(e); });
-  }
-  ~DriverRig() { driver_.reset(); }
-
-  void step() {
-    clock_.advance(1ms);
-    sim_->step(clock_.now());
-    driver_->step(clock_.now());
-  }
-  void run_for(std::chrono::nanoseconds d) {
-    const Timestamp end = clock_.now() + d;
-    while (clock_.now() < end)
-      step();
-  }
-  bool run_until(const std::function<bool()>& done, std::chrono::nanoseconds timeout) {
-    const Timestamp end = clock_.now() + timeout;
-    while (!done()) {
-      if (clock_.now() >= end) return false;
-      step();
-    }
-    return true;
-  }
-  // The caller keeps publishing `twist` every 50 ms for `d`.
+  explicit DriverRig(const DriverConfig& config = {},
+                     test::SwitchReportUnderTest report = test::SwitchReportUnderTest::kVariants)
+      : DriverSimRig("manual", config, {}, report) {}
   void drive(const BodyTwist& twist, std::chrono::nanoseconds d) {
-    const Timestamp end = clock_.now() + d;
-    while (clock_.now() < end) {
-      EXPECT_TRUE(driver_->command(MotionRequest{twist, std::nullopt}).ok());
-      run_for(50ms);
-    }
+    EXPECT_EQ(DriverSimRig::drive(twist, d), 0) << "a command refused";
   }
-
-  Driver& driver() { return *driver_; }
-  std::shared_ptr<const DriverSnapshot> snapshot() const { return driver_->snapshot(); }
-  sim::SimBusSource& sim() { return *sim_; }
-  const std::vector<SentEvent>& sent() const { return sent_; }
-  ManualClock& clock() { return clock_; }
-
- private:
-  ManualClock clock_{Timestamp(1000s)};
-  std::shared_ptr<sim::SimBusSource> sim_;
-  std::unique_ptr<Driver> driver_;
-  std::vector<SentEvent> sent_;
 };
 
 bool ready(const DriverSnapshot& s) {
   return s.controller.control_mode == protocol::ControlMode::kCan && s.controller.motion_mode &&
          s.controller.refusal == MotionRefusal::kNone;
 }
+
+// Every motion mode by the twist, on either report of a switch (the manual's and the field's,
+// test::kBothSwitchReports): each switch completes and the chassis obeys again, nothing refused,
+// the chassis ends in the mode the twist asks for and moves.
+class DriverModeSwitch : public ::testing::TestWithParam<test::SwitchReportUnderTest> {};
+
+TEST_P(DriverModeSwitch, EveryModeByTheTwistOnEitherReport) {
+  DriverRig rig({}, GetParam());
+  ASSERT_TRUE(rig.ready());
+  const struct {
+    BodyTwist twist;
+    protocol::MotionMode mode;
+  } legs[] = {{{0.4, 0.0, 0.2}, protocol::MotionMode::kAckermann},
+              {{0.2, 0.2, 0.0}, protocol::MotionMode::kOblique},
+              {{0.0, 0.0, 0.5}, protocol::MotionMode::kSpin},
+              {{0.4, 0.0, 0.0}, protocol::MotionMode::kAckermann}};
+  for (const auto& leg : legs) {
+    SCOPED_TRACE(protocol::to_string(leg.mode));
+    rig.drive(leg.twist, 3s);
+    const sim::ChassisSnapshot c = rig.chassis();
+    EXPECT_EQ(c.motion_mode, leg.mode);
+    EXPECT_FALSE(c.switching);
+    EXPECT_EQ(rig.snapshot()->controller.refusal, MotionRefusal::kNone);
+    EXPECT_GT(std::hypot(c.twist.vx, c.twist.vy) + std::fabs(c.twist.wz), 0.15) << "it moves";
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Reports, DriverModeSwitch, ::testing::ValuesIn(test::kBothSwitchReports),
+                         [](const ::testing::TestParamInfo<test::SwitchReportUnderTest>& info) {
+                           return test::to_string(info.param);
+                         });
 
 TEST(Driver, BeforeTheFirstOpenCommandsSayWhy) {
   ManualClock clock;

@@ -1,7 +1,8 @@
 // What the vendor's revisions add, through the driver runtime in lock-step with the virtual
 // chassis (sim:agx_v2, sim:mini_v1, sim:mini_v3, sim): park, lights, the remote state, the
 // firmware version, the MINI 3.0's drive mode, rear odometry and BMS alarms, and their refusals by
-// name where the revision or the model lacks them.
+// name where the revision or the model lacks them. The tests of a mode switch (park) run against
+// both reports of it, the manual's and the field's.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -14,103 +15,62 @@
 #include "ranger_can/control/model.hpp"
 #include "ranger_can/sim/chassis_commands.hpp"
 #include "ranger_can/sim/sim_bus_source.hpp"
+#include "support/driver_sim_rig.hpp"
 
 namespace ranger {
 namespace {
 
 using namespace std::chrono_literals;
 
-// The driver configured for a variant the way its `driver` options say.
-DriverConfig config_for(const std::string& variant) {
-  DriverConfig c;
-  if (variant == "agx_v2") c.controller.profile = *protocol_preset("agx_v2");
-  if (variant == "mini_v1" || variant == "mini_v3") {  // the model's geometry and profile
-    const auto model = model_preset("ranger_" + variant);
-    EXPECT_TRUE(model.ok());
-    c.controller.geometry = model->geometry;
-    c.controller.limits = model->limits;
-    c.controller.profile = model->profile;
-  }
-  return c;
-}
-
-class Rig {
+// The shared lock-step rig (support/driver_sim_rig.hpp) with the driver the variant's `driver`
+// options give (or `config`), the chassis answering 0x4A1 with `firmware`, and a switch report.
+class Rig : public test::DriverSimRig {
  public:
-  // `config`: the driver's, instead of the one the variant's `driver` options give.
   explicit Rig(const std::string& variant, const std::string& firmware = "",
-               std::optional<DriverConfig> config = std::nullopt) {
-    sim::SimSourceOptions options;
-    options.lock_step = true;
-    if (!firmware.empty()) options.chassis.version = firmware;
-    auto source =
-        sim::open_bus_source(variant == "manual" ? "sim" : "sim:" + variant, clock_, options);
-    EXPECT_TRUE(source.ok());
-    sim_ = std::static_pointer_cast<sim::SimBusSource>(*source);
-    driver_ = std::make_unique<Driver>(config.value_or(config_for(variant)), *source, clock_);
-    driver_->set_sent_observer([this](const SentEvent& e) { sent_.push_back(e.sent.frame.id); });
-  }
-  ~Rig() { driver_.reset(); }  // its shutdown stop is still observed
+               std::optional<DriverConfig> config = std::nullopt,
+               test::SwitchReportUnderTest report = test::SwitchReportUnderTest::kVariants)
+      : DriverSimRig(variant, config.value_or(test::driver_config_for(variant)),
+                     options_with(firmware), report) {}
 
-  void step() {
-    clock_.advance(1ms);
-    sim_->step(clock_.now());
-    driver_->step(clock_.now());
-  }
-  bool run_until(const std::function<bool()>& done, std::chrono::nanoseconds timeout) {
-    const Timestamp end = clock_.now() + timeout;
-    while (!done()) {
-      if (clock_.now() >= end) return false;
-      step();
-    }
-    return true;
-  }
-  void drive(const BodyTwist& twist, std::chrono::nanoseconds d) {
-    const Timestamp end = clock_.now() + d;
-    while (clock_.now() < end) {
-      driver_->command(MotionRequest{twist, std::nullopt});
-      for (int i = 0; i < 50; ++i)
-        step();
-    }
-  }
+  // CAN mode, a known motion mode, and whether the chassis sends the vendor's frames decided.
   bool ready() {
-    return run_until(
-        [&] {
-          const auto s = driver_->snapshot();
-          return s->controller.control_mode == protocol::ControlMode::kCan &&
-                 s->controller.motion_mode && s->vendor_frames != VendorFrames::kUnknown;
-        },
-        3s);
+    return DriverSimRig::ready(
+        [](const DriverSnapshot& s) { return s.vendor_frames != VendorFrames::kUnknown; });
   }
   // Waits for request `id` to end (answered or failed).
   RequestOutcome outcome(std::uint64_t id, std::chrono::nanoseconds timeout = 8s) {
     run_until(
         [&] {
-          const RequestOutcome* r = driver_->snapshot()->request(id);
+          const RequestOutcome* r = driver().snapshot()->request(id);
           return r && (r->state == RequestOutcome::State::kAnswered ||
                        r->state == RequestOutcome::State::kFailed);
         },
         timeout);
-    const RequestOutcome* r = driver_->snapshot()->request(id);
+    const RequestOutcome* r = driver().snapshot()->request(id);
     return r ? *r : RequestOutcome{};
   }
-
-  Driver& driver() { return *driver_; }
-  std::shared_ptr<const DriverSnapshot> snap() const { return driver_->snapshot(); }
-  sim::ChassisSnapshot chassis() { return sim_->snapshot(); }
-  sim::SimBusSource& sim() { return *sim_; }
+  std::shared_ptr<const DriverSnapshot> snap() const { return snapshot(); }
   bool sent(std::uint32_t id) const {
-    return std::find(sent_.begin(), sent_.end(), id) != sent_.end();
+    const auto& all = DriverSimRig::sent();
+    return std::any_of(all.begin(), all.end(),
+                       [id](const SentEvent& e) { return e.sent.frame.id == id; });
   }
 
  private:
-  ManualClock clock_{Timestamp(1000s)};
-  std::shared_ptr<sim::SimBusSource> sim_;
-  std::unique_ptr<Driver> driver_;
-  std::vector<std::uint32_t> sent_;
+  static sim::SimSourceOptions options_with(const std::string& firmware) {
+    sim::SimSourceOptions options;
+    if (!firmware.empty()) options.chassis.version = firmware;
+    return options;
+  }
 };
 
-TEST(DriverPark, RefusesMotionByNameUntilReleased) {
-  Rig rig("agx_v2");
+// The driver's tests of a mode switch (park is one) run against both reports of it: the
+// manual's (0x291 the mode being left, switching = 1 throughout) and the field's (the new mode
+// at once, the flag on some switches, the wheels at 3.26 rad/s).
+class DriverPark : public ::testing::TestWithParam<test::SwitchReportUnderTest> {};
+
+TEST_P(DriverPark, RefusesMotionByNameUntilReleased) {
+  Rig rig("agx_v2", "", std::nullopt, GetParam());
   ASSERT_TRUE(rig.ready());
   rig.drive({0.5, 0, 0}, 1s);
   ASSERT_GT(rig.chassis().speed, 0.3);
@@ -134,8 +94,8 @@ TEST(DriverPark, RefusesMotionByNameUntilReleased) {
   EXPECT_GT(rig.chassis().pose.x, parked_at.x + 0.3);
 }
 
-TEST(DriverPark, ParkReleasedWithoutATwistLeavesParkAtOnce) {
-  Rig rig("agx_v2");
+TEST_P(DriverPark, ParkReleasedWithoutATwistLeavesParkAtOnce) {
+  Rig rig("agx_v2", "", std::nullopt, GetParam());
   ASSERT_TRUE(rig.ready());
   ASSERT_EQ(rig.outcome(rig.driver().set_park(true)).state, RequestOutcome::State::kAnswered);
   ASSERT_EQ(rig.outcome(rig.driver().set_park(false)).state, RequestOutcome::State::kAnswered);
@@ -143,8 +103,8 @@ TEST(DriverPark, ParkReleasedWithoutATwistLeavesParkAtOnce) {
   EXPECT_FALSE(rig.snap()->controller.park_requested);
 }
 
-TEST(DriverPark, AChassisFoundInParkIsLeftByReleasingIt) {
-  Rig rig("agx_v2");
+TEST_P(DriverPark, AChassisFoundInParkIsLeftByReleasingIt) {
+  Rig rig("agx_v2", "", std::nullopt, GetParam());
   ASSERT_TRUE(rig.ready());
   // Parked by someone else (a previous session): nothing this driver can command in.
   rig.sim().with_chassis([](sim::VirtualChassis& c) {
@@ -249,7 +209,7 @@ TEST(DriverFirmware, AskedOnceTheChassisIsHeardAndShown) {
 TEST(DriverFirmware, NeverAskedOfAManualChassis) {
   Rig rig("manual");
   ASSERT_TRUE(rig.ready());
-  rig.drive({}, 1s);
+  rig.drive(BodyTwist{}, 1s);
   EXPECT_EQ(rig.snap()->firmware.state, FirmwareVersion::State::kUnsupported);
   EXPECT_FALSE(rig.sent(protocol::kVersionId));
   const RequestOutcome r = rig.outcome(rig.driver().request_firmware_version());
@@ -310,11 +270,11 @@ TEST(DriverMiniV3, NoDriveModeOnTheVendorsReading) {
             "drive mode command)");
   EXPECT_FALSE(rig.snap()->drive_mode.has_value());
   // The same on a MINI 3.0 read the vendor's way.
-  DriverConfig agx = config_for("mini_v3");
+  DriverConfig agx = test::driver_config_for("mini_v3");
   agx.controller.profile = *protocol_preset("agx_v2");
   Rig agx_on_mini("mini_v3", "", agx);
   ASSERT_TRUE(agx_on_mini.ready());
-  agx_on_mini.drive({}, 200ms);
+  agx_on_mini.drive(BodyTwist{}, 200ms);
   EXPECT_FALSE(agx_on_mini.snap()->drive_mode.has_value());
   EXPECT_EQ(
       agx_on_mini.outcome(agx_on_mini.driver().set_drive_mode(protocol::DriveMode::kVoltage)).state,
@@ -325,7 +285,7 @@ TEST(DriverMiniV3, RearOdometryAndTheBmsAlarmsReachTheSnapshot) {
   Rig rig("mini_v3");
   ASSERT_TRUE(rig.ready());
   rig.drive({0.5, 0, 0}, 2s);
-  rig.drive({}, 1s);
+  rig.drive(BodyTwist{}, 1s);
   const auto s = rig.snap();
   ASSERT_TRUE(s->feedback.rear_odometer && s->feedback.odometer);
   const OdometerFeedback& rear = s->feedback.rear_odometer->value;
@@ -359,8 +319,10 @@ TEST(DriverMiniV3, RearOdometryAndTheBmsAlarmsReachTheSnapshot) {
       1s));
 }
 
-TEST(DriverMiniV3, LightsOnOrOffParkAndTheRefusalsThatNameWhatItLacks) {
-  Rig rig("mini_v3");
+class DriverMiniV3Switching : public ::testing::TestWithParam<test::SwitchReportUnderTest> {};
+
+TEST_P(DriverMiniV3Switching, LightsOnOrOffParkAndTheRefusalsThatNameWhatItLacks) {
+  Rig rig("mini_v3", "", std::nullopt, GetParam());
   ASSERT_TRUE(rig.ready());
   LightsRequest off;
   off.front = protocol::LightMode::kOff;
@@ -389,6 +351,14 @@ TEST(DriverMiniV3, LightsOnOrOffParkAndTheRefusalsThatNameWhatItLacks) {
   EXPECT_EQ(rig.snap()->feedback.motion_mode->value.mode_raw, 3);
   EXPECT_EQ(rig.outcome(rig.driver().set_park(false)).state, RequestOutcome::State::kAnswered);
 }
+
+std::string report_name(const ::testing::TestParamInfo<test::SwitchReportUnderTest>& info) {
+  return test::to_string(info.param);
+}
+INSTANTIATE_TEST_SUITE_P(Reports, DriverPark, ::testing::ValuesIn(test::kBothSwitchReports),
+                         report_name);
+INSTANTIATE_TEST_SUITE_P(Reports, DriverMiniV3Switching,
+                         ::testing::ValuesIn(test::kBothSwitchReports), report_name);
 
 }  // namespace
 }  // namespace ranger

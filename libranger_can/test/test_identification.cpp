@@ -269,12 +269,12 @@ void mini_v1_geometry(DriverConfig& c) {
 // The model a variant is (its geometry and limits a driver must be given), or "".
 std::string model_of(const std::string& v) {
   if (v == "mini_v1") return "ranger_mini_v1";
-  if (v == "mini_v3") return "ranger_mini_v3";
+  if (v == "mini_v3" || v == "mini_v3_manual") return "ranger_mini_v3";
   return "";
 }
 void model_geometry(DriverConfig& c, const std::string& v) {
   if (v == "mini_v1") mini_v1_geometry(c);
-  if (v == "mini_v3") {
+  if (v == "mini_v3" || v == "mini_v3_manual") {
     const ModelPreset m = *model_preset(model_of(v));
     c.controller.geometry = m.geometry;
     c.controller.limits = m.limits;
@@ -302,13 +302,18 @@ std::optional<ProtocolProfile> truth(const std::string& v) {
     p.mode_numbering = ModeNumbering::kMiniV1;
   }
   if (v == "mini_v3") p = preset("mini_v3");
+  if (v == "mini_v3_manual") {
+    p = preset("mini_v3");
+    p.bms_voltage_scale = 0.1;
+  }
   if (v == "undecidable") return std::nullopt;
   return p;
 }
 
 const std::vector<std::string> kAll = {
-    "manual",      "agx_v2",  "padded",  "spin_cw",      "steer_left_positive", "speed221_body",
-    "inner_angle", "mini_v1", "mini_v3", "field_switch", "mode_left",           "undecidable"};
+    "manual",        "agx_v2",      "padded",     "spin_cw", "steer_left_positive",
+    "speed221_body", "inner_angle", "mini_v1",    "mini_v3", "mini_v3_manual",
+    "field_switch",  "mode_left",   "undecidable"};
 
 }  // namespace variants
 
@@ -514,8 +519,12 @@ TEST(IdentifyMiniV3, TheDriverInAutoDecidesMiniV3OnTheVirtualMini30AndDrives) {
 
 TEST(IdentifyMiniV3, TheVendorSdksReadingStaysSelectable) {
   // protocol agx_v2 forced on a MINI 3.0: the vendor SDK's way (0x291's third byte ignored as an
-  // extra byte, commands padded to 8, its byte 7 read as a counter) still drives it.
-  DriverConfig c = test::forced_config(*protocol_preset("agx_v2"));
+  // extra byte, commands padded to 8, its byte 7 read as a counter) still drives it, with the BMS
+  // scale a real one reports (0.01 V; the vendor's preset reads 0.1 V, the plausibility monitor
+  // names the setting otherwise).
+  ProtocolProfile sdk = *protocol_preset("agx_v2");
+  sdk.bms_voltage_scale = 0.01;
+  DriverConfig c = test::forced_config(sdk);
   const ModelPreset model = *model_preset("ranger_mini_v3");
   c.controller.geometry = model.geometry;
   c.controller.limits = model.limits;

@@ -297,8 +297,8 @@ TEST(MiniV3Wire, FrontAndRearOdometersInMillimetresDecodeInMetres) {
 }
 
 TEST(MiniV3Wire, BmsPackDataAndItsAlarmFrameOfFourBytes) {
-  // SOC 80 %, SOH 99 %, 48.5 V (0.1 V), -3.0 A, 26.5 degC.
-  const auto b = decode_as<BmsData>(frame(0x361, {80, 99, 0x01, 0xE5, 0xFF, 0xE2, 0x01, 0x09}));
+  // SOC 80 %, SOH 99 %, 48.5 V (0.01 V, the field's reading), -3.0 A, 26.5 degC.
+  const auto b = decode_as<BmsData>(frame(0x361, {80, 99, 0x12, 0xF2, 0xFF, 0xE2, 0x01, 0x09}));
   EXPECT_EQ(b.soc, 80.0);
   EXPECT_EQ(b.soh, 99.0);
   EXPECT_DOUBLE_EQ(b.voltage, 48.5);

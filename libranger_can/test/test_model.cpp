@@ -118,13 +118,16 @@ TEST(Model, MiniV2AndV3) {
 }
 
 TEST(Model, MiniV3SpeaksItsOwnManualWithItsLimits) {
-  // The RANGER MINI 3.0's manual (PROTOCOL_MINI_V3.md): linear +-2.0 m/s, +-0.7 m/s beyond 20 deg
-  // of steering, spin +-3.259 rad/s, Ackermann inner angle +-0.698 rad, oblique +-1.571 rad.
+  // The RANGER MINI 3.0's manual (PROTOCOL_MINI_V3.md): linear +-2.0 m/s, spin +-3.259 rad/s,
+  // Ackermann inner angle +-0.698 rad, oblique +-1.571 rad; beyond 20 deg of steering +-1.0 m/s
+  // (the field notes' reading of the manual; our transcription's 0.7 is a parameter away), the
+  // steering at the field's 3.26 rad/s (docs/FIELD_FACTS.md).
   const ModelPreset v3 = preset("ranger_mini_v3");
   EXPECT_EQ(v3.protocol, "mini_v3");
   EXPECT_EQ(v3.profile, *protocol_preset("mini_v3"));
   EXPECT_DOUBLE_EQ(v3.limits.max_linear_speed, 2.0);
-  EXPECT_DOUBLE_EQ(v3.limits.max_speed_at_large_steering, 0.7);
+  EXPECT_DOUBLE_EQ(v3.limits.max_speed_at_large_steering, 1.0);
+  EXPECT_DOUBLE_EQ(v3.limits.steering_rate, 3.26);
   EXPECT_DOUBLE_EQ(v3.limits.max_ackermann_steering, 0.698);
   EXPECT_NEAR(v3.limits.max_oblique_steering, 1.571, 0.0005);
   EXPECT_LE(v3.limits.max_oblique_steering, kMaxObliqueSteeringRad);

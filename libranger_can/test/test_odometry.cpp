@@ -468,5 +468,60 @@ TEST(OdometryProfile, SpinFeedbackFromTheYawRateFieldAndTheSign) {
               -0.3 / std::hypot(g.wheelbase / 2, g.track / 2), 1e-12);
 }
 
+// A silence the chassis's own odometer bridges (0x311 counted what its wheels rolled): the distance
+// goes along the path the driver's commands in the silence make, the steering turning toward what
+// they asked at limits.steering_rate (Odometry::on_command), not along the last curve; without
+// commands (a log without the host's frames), along the last curve.
+double yaw_across_a_silence(bool with_commands) {
+  OdometryConfig c;
+  c.source = OdometrySource::kMotion;
+  c.profile = *protocol_preset("mini_v3");  // 0x311 in mm
+  c.limits.steering_rate = 3.26;            // rad/s, the field's
+  Odometry odometry(c);
+  const double speed = 0.5, angle = 0.15;  // m/s; rad, REP-103 (left)
+  MotionFeedback arc;
+  arc.speed = speed;
+  arc.steering_angle = interp::manual_from_rep103_steering(angle);
+  MotionCommand asked;
+  asked.linear_speed = speed;
+  asked.steering_angle = interp::manual_from_rep103_command_steering(angle);
+  Timestamp t = kStart;
+  double counted = 0.0;
+  const auto odometer = [&](double m, Timestamp at) {
+    OdometerFeedback o;
+    o.left_distance = o.right_distance = m;
+    odometry.on_odometer(o, at);
+  };
+  for (int i = 0; i < 50; ++i) {
+    if (with_commands) odometry.on_command(asked, t);
+    odometry.on_motion_feedback(arc, t);
+    odometer(counted, t);
+    counted += speed * 0.02;
+    t += 20ms;
+  }
+  counted -= speed * 0.02;  // what the last 0x311 said
+  const Timestamp silence = t - 20ms;
+  const double yaw_before = odometry.state().pose.yaw;
+  // The arc asked for 0.1 s more (the driver had not yet seen the link go), then a stop with the
+  // wheels straight.
+  if (with_commands) {
+    for (auto s = 20ms; s <= 2000ms; s += 20ms)
+      odometry.on_command(s <= 100ms ? asked : MotionCommand{}, silence + s);
+  }
+  odometer(counted + 0.11, silence + 2s);  // it coasted 0.11 m
+  EXPECT_NEAR(odometry.state().last_gap_odometer_distance, 0.11, 1e-6);
+  return odometry.state().pose.yaw - yaw_before;
+}
+
+TEST(OdometryGap, TheOdometersDistanceFollowsTheCommandsNotTheLastCurve) {
+  const double last_curve = yaw_across_a_silence(false);
+  const double commanded = yaw_across_a_silence(true);
+  EXPECT_GT(last_curve, 0.0);
+  // 0.06 m at the arc's curvature (0.12 s until the stop's first command), then the wheels
+  // straighten in 46 ms while it brakes the rest: about two thirds of the last curve's turn.
+  EXPECT_GT(commanded, 0.55 * last_curve);
+  EXPECT_LT(commanded, 0.75 * last_curve);
+}
+
 }  // namespace
 }  // namespace ranger

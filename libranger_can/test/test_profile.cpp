@@ -87,7 +87,9 @@ TEST(ProfilePresets, MiniV3FollowsTheMini30Manual) {
   EXPECT_EQ(m.steering_reference, SteeringReference::kInnerFront);
   EXPECT_EQ(m.spin_field, SpinField::kYawRate);
   EXPECT_EQ(m.spin_sign, +1);
-  EXPECT_EQ(m.bms_voltage_scale, 0.1);
+  // The field's readings where a real one contradicts the transcribed manual (FIELD_FACTS.md).
+  EXPECT_EQ(m.bms_voltage_scale, 0.01);
+  EXPECT_FALSE(m.vehicle_status_1_is_estop);
   // Its own: the 32-bit fault word without a counter, park as 3 and no side slip, 0x291 of 3
   // bytes with 0x312 and 0x423, odometers in mm, lights on/off, each command's own length.
   EXPECT_EQ(m.error_word, ErrorWordLayout::kMini32);
@@ -157,8 +159,8 @@ const std::vector<SettingCase>& setting_cases() {
       {"spin_sign", {"ccw", "cw"}, "ccw", "ccw", "ccw"},
       {"feedback_speed", {"mean_wheel", "body_centre"}, "mean_wheel", "body_centre", "body_centre"},
       {"error_word", {"manual32", "agx16", "mini32"}, "manual32", "agx16", "mini32"},
-      {"vehicle_status_1_is_estop", {"true", "false"}, "true", "true", "true"},
-      {"bms_voltage_scale", {"0.01", "0.1"}, "0.01", "0.1", "0.1"},
+      {"vehicle_status_1_is_estop", {"true", "false"}, "true", "true", "false"},
+      {"bms_voltage_scale", {"0.01", "0.1"}, "0.01", "0.1", "0.01"},
       {"bms_current_sign",
        {"discharge_positive", "charge_positive"},
        "charge_positive",

@@ -235,7 +235,9 @@ void ChassisController::on_system_status(const SystemStatus& m, Timestamp now) {
 
 void ChassisController::on_motion_mode(const MotionModeFeedback& m) {
   state_.chassis_mode = m.mode_known ? std::optional<MotionMode>(m.mode) : std::nullopt;
-  if (state_.chassis_mode != MotionMode::kPark) leave_park_ = false;
+  // Out of park once 0x291 says so and the switch out is done (a chassis reporting the new mode at
+  // once still turns its wheels: the switch goes on to its end, mode_switch.hpp).
+  if (state_.chassis_mode != MotionMode::kPark && !mode_switch_.active()) leave_park_ = false;
   if (m.mode == MotionMode::kPark && m.mode_known) {
     // Park: nothing to command in, but the switch into it (request_park) completes here.
     state_.motion_mode.reset();
@@ -757,7 +759,7 @@ ChassisController::MotionGate ChassisController::gate_motion() const {
   g.parking = r == MotionRefusal::kParked && state_.chassis_mode.has_value();
   const bool drivable = r == MotionRefusal::kNone || r == MotionRefusal::kModeSwitchFailed;
   g.leaving_park =
-      leave_park_ && state_.parked() &&
+      leave_park_ && (state_.parked() || mode_switch_.active()) &&
       (drivable || r == MotionRefusal::kCmdTimeout || r == MotionRefusal::kBelowMinimum ||
        r == MotionRefusal::kInvalidCommand || r == MotionRefusal::kStaleCommand);
   g.may_drive = (drivable && state_.has_command) || (g.probing && probe_mode_.has_value()) ||

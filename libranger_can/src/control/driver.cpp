@@ -280,6 +280,9 @@ void Driver::try_open(Timestamp now) {
   if (source_->read_only()) controller_config.listen_only = true;
   controller_ = std::make_unique<ChassisController>(*bus_, controller_config);
   controller_->set_send_observer([this](const SentFrame& sent) {
+    if (const auto* command = std::get_if<MotionCommand>(&sent.message)) {
+      odometry_.on_command(*command, sent.frame.stamp + frame_clock_offset_);
+    }
     sent_.push_back(SentEvent{sent, sent_wall_time_ ? std::chrono::system_clock::now()
                                                     : std::chrono::system_clock::time_point{}});
   });
@@ -311,6 +314,7 @@ void Driver::handle_frame(const CanFrame& frame, Timestamp now) {
   }
   vendor_.on_message(*message, now);
   controller_->on_message(*message, frame.stamp, now);
+  if (frame.stamp.count() != 0) frame_clock_offset_ = frame.stamp - now;
   if (settings_.odometry_readable()) {
     odometry_.on_message(*message, frame.stamp);
     odometry_fed_ = true;

@@ -163,6 +163,9 @@ void solve_side_slip(const BodyTwist& t, const KinematicsLimits& limits,
   s.achieved = BodyTwist{0.0, vy, 0.0};
 }
 
+// A steering faster than this (rad/s) is no chassis's: a typo.
+constexpr double kMaxSteeringRateRps = 100.0;
+
 }  // namespace
 
 Status KinematicsLimits::validate() const {
@@ -176,6 +179,7 @@ Status KinematicsLimits::validate() const {
       {"max_ackermann_steering", max_ackermann_steering, kMaxAckermannSteeringRad},
       {"max_oblique_steering", max_oblique_steering, kMaxObliqueSteeringRad},
       {"max_spin_wheel_speed", max_spin_wheel_speed, kMaxSpinSpeedMps},
+      {"steering_rate", steering_rate, kMaxSteeringRateRps},
   };
   for (const auto& c : checks) {
     Status st = check_limit(c.name, c.value, c.max);

@@ -32,10 +32,12 @@ bool valid_key(std::string_view key) {
   });
 }
 
-// The keys the library reads as numbers, and where each goes.
+// The keys the library reads as numbers, and where each goes; an optional one keeps its default
+// when a file leaves it out.
 struct NumberKey {
   const char* key;
   double& (*field)(ModelPreset&);
+  bool optional = false;
 };
 const NumberKey kNumberKeys[] = {
     {"wheelbase", [](ModelPreset& m) -> double& { return m.geometry.wheelbase; }},
@@ -50,6 +52,7 @@ const NumberKey kNumberKeys[] = {
      [](ModelPreset& m) -> double& { return m.limits.max_oblique_steering; }},
     {"max_spin_wheel_speed",
      [](ModelPreset& m) -> double& { return m.limits.max_spin_wheel_speed; }},
+    {"steering_rate", [](ModelPreset& m) -> double& { return m.limits.steering_rate; }, true},
 };
 
 // One model file being read: its flat `key: value` pairs, and errors that name the file and line.
@@ -144,6 +147,7 @@ Result<ModelPreset> parse_model(std::string_view text, std::string_view origin) 
   const auto display_name = file.find("display_name");
   m.display_name = display_name ? display_name->value : m.name;
   for (const NumberKey& n : kNumberKeys) {
+    if (n.optional && !file.find(n.key)) continue;
     auto e = file.required(n.key);
     if (!e) return e.error();
     auto v = parse_double(n.key, e->value);

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <type_traits>
 #include <utility>
 #include <variant>
+#include <vector>
 
 #include "ranger_can/wire/interpretation.hpp"
 
@@ -18,6 +20,14 @@ using protocol::MotionMode;
 // Slower than this (m/s, the body's or a spinning wheel's), the motion before a gap says no
 // direction for the distance the chassis's odometer counted in it.
 constexpr double kStandstillSpeed = 1e-3;
+// The gap model (gap_path): its time step (s) and most steps, the speed's rates of change it
+// tries (m/s^2, log-spaced), and the most commands it keeps.
+constexpr double kGapModelStep = 0.005;
+constexpr int kGapModelMaxSteps = 4000;
+constexpr double kGapModelMinAccel = 0.05;
+constexpr double kGapModelMaxAccel = 50.0;
+constexpr int kGapModelAccelerations = 40;
+constexpr std::size_t kMaxCommands = 4096;
 
 }  // namespace
 
@@ -140,6 +150,103 @@ void Odometry::reset(const Pose2D& pose) {
   anchored_ = false;
   previous_twist_ = gap_twist_ = BodyTwist{};
   odometer_.reset();
+  commands_.clear();
+}
+
+void Odometry::on_command(const MotionCommand& command, Timestamp stamp) {
+  if (!commands_.empty() && stamp < commands_.back().stamp) commands_.clear();  // time went back
+  commands_.push_back(SentCommand{stamp, command});
+  // What a gap starting after the latest feedback needs: the newest command before it, and on.
+  const Timestamp heard = odometer_ ? std::min(odometer_->stamp, state_.stamp) : state_.stamp;
+  while (commands_.size() >= 2 && (commands_[1].stamp <= heard || commands_.size() > kMaxCommands))
+    commands_.pop_front();
+}
+
+std::optional<Pose2D> Odometry::gap_path(const BodyTwist& motion, Timestamp start, Timestamp end,
+                                         double distance) const {
+  const bool ackermann = mode_ == MotionMode::kAckermann;
+  const double rate = config_.limits.steering_rate;
+  const double span = seconds(end - start);
+  if ((!ackermann && mode_ != MotionMode::kOblique) || commands_.empty() || !(rate > 0.0) ||
+      !(span > 0.0)) {
+    return std::nullopt;
+  }
+  const VehicleGeometry& g = config_.geometry;
+  const SteeringReference reference = config_.profile.steering_reference;
+  // The motion before the gap as a signed speed and a steering quantity, and back.
+  double v0 = 0.0, q0 = 0.0;
+  if (ackermann) {
+    if (std::fabs(motion.vx) <= kStandstillSpeed) return std::nullopt;
+    v0 = motion.vx;
+    q0 = interp::ackermann_front_angle(motion.wz / motion.vx, g.wheelbase, g.track, reference);
+  } else {
+    v0 = std::hypot(motion.vx, motion.vy);
+    if (v0 <= kStandstillSpeed) return std::nullopt;
+    q0 = std::atan2(motion.vy, motion.vx);
+  }
+  const auto twist_of = [&](double v, double q) {
+    if (!ackermann) return BodyTwist{v * std::cos(q), v * std::sin(q), 0.0};
+    const double k =
+        interp::ackermann_curvature_from_front_angle(q, g.wheelbase, g.track, reference);
+    return BodyTwist{v, 0.0, std::isfinite(k) ? k * v : 0.0};
+  };
+  // What was asked, from when (s after the start; a command before the gap counts from it).
+  struct Asked {
+    double t, speed, quantity;
+  };
+  std::vector<Asked> asked;
+  for (const SentCommand& c : commands_) {
+    if (c.stamp >= end) break;
+    asked.push_back({std::max(0.0, seconds(c.stamp - start)), c.command.linear_speed,
+                     interp::rep103_from_manual_command_steering(c.command.steering_angle)});
+  }
+  if (asked.empty()) return std::nullopt;
+  if (!ackermann && std::fabs(std::remainder(q0 - asked.front().quantity, 2 * M_PI)) > M_PI / 2) {
+    q0 = wrap_angle(q0 + M_PI);  // the same motion, reversing along the commanded direction
+    v0 = -v0;
+  }
+  const int n = std::clamp(static_cast<int>(std::ceil(span / kGapModelStep)), 1, kGapModelMaxSteps);
+  const double h = span / n;
+  const auto approach = [](double x, double goal, double max_step) {
+    return std::fabs(goal - x) <= max_step ? goal : x + std::copysign(max_step, goal - x);
+  };
+  // Rolls through the gap with the speed changing at `accel`: the body centre's path length; with
+  // `pose`, advances it along the path scaled by `scale` (the curvature kept).
+  const auto roll = [&](double accel, double scale, Pose2D* pose) {
+    double v = v0, q = q0, rolled = 0.0;
+    std::size_t k = 0;
+    for (int i = 0; i < n; ++i) {
+      const double t = i * h;
+      while (k + 1 < asked.size() && asked[k + 1].t <= t)
+        ++k;
+      const bool heard = asked[k].t <= t;
+      const double vn = approach(v, heard ? asked[k].speed : v, accel * h);
+      const double qn = approach(q, heard ? asked[k].quantity : q, rate * h);
+      const BodyTwist twist = twist_of((v + vn) / 2, (q + qn) / 2);
+      rolled += std::hypot(twist.vx, twist.vy) * h;
+      if (pose) *pose = integrate_pose(*pose, twist, h * scale);
+      v = vn;
+      q = qn;
+    }
+    return rolled;
+  };
+  // The speed's rate of change that rolls the distance counted (the closest on a log grid).
+  double best_accel = 0.0, best_error = std::numeric_limits<double>::infinity(), best_rolled = 0.0;
+  for (int i = 0; i <= kGapModelAccelerations; ++i) {
+    const double accel =
+        kGapModelMinAccel * std::pow(kGapModelMaxAccel / kGapModelMinAccel,
+                                     static_cast<double>(i) / kGapModelAccelerations);
+    const double rolled = roll(accel, 0.0, nullptr);
+    if (std::fabs(rolled - distance) < best_error) {
+      best_error = std::fabs(rolled - distance);
+      best_accel = accel;
+      best_rolled = rolled;
+    }
+  }
+  if (!(best_rolled > kStandstillSpeed * h)) return std::nullopt;
+  Pose2D pose = state_.pose;
+  roll(best_accel, distance / best_rolled, &pose);
+  return pose;
 }
 
 bool Odometry::on_frame(const CanFrame& frame) {
@@ -213,7 +320,8 @@ bool Odometry::on_odometer(const OdometerFeedback& m, Timestamp stamp) {
   const double rolled_per_second =
       speed > kStandstillSpeed ? speed : std::fabs(motion.wz) * spin_radius;
   if (!std::isfinite(d) || d <= 0.0 || rolled_per_second <= kStandstillSpeed) return false;
-  state_.pose = integrate_pose(state_.pose, motion, d / rolled_per_second);
+  const std::optional<Pose2D> path = gap_path(motion, before->stamp, stamp, d);
+  state_.pose = path ? *path : integrate_pose(state_.pose, motion, d / rolled_per_second);
   state_.distance += d;
   state_.last_gap_odometer_distance = d;
   return true;

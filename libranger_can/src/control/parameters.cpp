@@ -97,6 +97,20 @@ const std::vector<Parameter> kParameters = {
     row("mode_switch_max_attempts", T::kInteger, "", closed(1.0, 100.0),
         "attempts before a switch is reported failed",
         RANGER_INTEGER(controller.mode_switch_max_attempts)),
+    row("mode_switch_blind_time", T::kSeconds, "s", closed(0.05, 10.0),
+        "a mode switch is complete once 0x291 reports the new mode and the wheels (0x271) stand "
+        "at its angles, never on 0x291's flag alone; without 0x271 (or with wheels that settle "
+        "off their angles) this long after its 0x141: the chassis's own switch time (a RANGER MINI "
+        "3.0 was seen to take at most 0.57 s, docs/FIELD_FACTS.md)",
+        RANGER_SECONDS(controller.mode_switch_blind_time)),
+    row("mode_switch_min_time", T::kSeconds, "s", closed(0.001, 10.0),
+        "a mode switch is never complete sooner than this after its 0x141, whatever 0x291 and the "
+        "wheels say (the field's shortest switch: 0.08 s)",
+        RANGER_SECONDS(controller.mode_switch_min_time)),
+    row("mode_switch_wheel_tolerance", T::kNumber, "rad", closed(0.001, 0.5),
+        "the wheels stand at the new mode's angles when each is within this of its angle (0x271) "
+        "and still",
+        RANGER_NUMBER(controller.mode_switch_wheel_tolerance)),
     row("standstill_speed", T::kNumber, "m/s", closed(0.0, 1.0),
         "every wheel slower than this = at rest (mode switches wait for it)",
         RANGER_NUMBER(controller.standstill_speed)),

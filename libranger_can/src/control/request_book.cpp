@@ -68,7 +68,11 @@ std::optional<Verdict> settle_park(const RequestOutcome& r, const LightsRequest&
                                    const RequestEvidence& e, const RequestTiming& t) {
   const ControllerState& c = *e.controller;
   const bool late = e.now - r.sent > t.park_timeout;
-  if (r.on && c.parked()) {
+  // The switch into park, or out of it, is done when the driver's switch is (mode_switch.hpp: the
+  // wheels at the new mode's angles, or the chassis's switch time), never on 0x291 alone: a chassis
+  // reporting the new mode at once (the field's MINI 3.0) still turns its wheels.
+  const bool switch_done = c.mode_switch.phase == ModeSwitchPhase::kIdle;
+  if (r.on && c.parked() && switch_done) {
     return Verdict{State::kAnswered,
                    "parked (0x291 reports park): motion is refused until park is released",
                    std::nullopt};
@@ -87,7 +91,7 @@ std::optional<Verdict> settle_park(const RequestOutcome& r, const LightsRequest&
   }
   if (r.on) return std::nullopt;
   if (c.park_requested) return Verdict{State::kFailed, "park was requested again", std::nullopt};
-  if (c.chassis_mode != protocol::MotionMode::kPark) {
+  if (c.chassis_mode != protocol::MotionMode::kPark && switch_done) {
     return Verdict{State::kAnswered, "park released: motion allowed", std::nullopt};
   }
   if (late) {

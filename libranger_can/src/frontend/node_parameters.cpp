@@ -264,6 +264,7 @@ void add_control(std::vector<Binding>& out) {
   for (const char* name :
        {"cmd_vel_timeout", "auto_command_mode", "auto_reclaim_after_remote", "rearm_on_zero_twist",
         "link_timeout", "min_command_interval", "mode_switch_timeout", "mode_switch_max_attempts",
+        "mode_switch_blind_time", "mode_switch_min_time", "mode_switch_wheel_tolerance",
         "standstill_speed", "steer_first_threshold", "low_battery_soc"}) {
     out.push_back(driver_row(name));
   }
@@ -361,6 +362,16 @@ void add_geometry_and_limits(std::vector<Binding>& out) {
                     "wheel speed in spin mode (yaw rate = speed / hypot(wheelbase/2, track/2))")
                     .by_default(models(l.max_spin_wheel_speed))
                     .apply(RANGER_SET(driver.controller.limits.max_spin_wheel_speed, v.number)));
+  out.push_back(
+      Row("steering_rate", T::kNumber, "rad/s", open_closed(0.0, 100.0), l.steering_rate,
+          "how fast the chassis turns its steering (no manual gives it; the RANGER MINI 3.0 was "
+          "seen "
+          "at 3.26 rad/s): the odometry's assumption for a silence of the chassis's feedback that "
+          "its own odometer bridges, the wheels turning toward what the driver commanded "
+          "meanwhile; "
+          "not a command limit")
+          .by_default(models(l.steering_rate))
+          .apply(RANGER_SET(driver.controller.limits.steering_rate, v.number)));
 }
 
 // ros_controllers' per-axis limits (diff_drive_controller's SpeedLimiter parameters), generated

@@ -182,9 +182,29 @@ void ChassisModel::sub_step(double h) {
 
   if (switch_phase_ == SwitchPhase::kNone && mode_ != MotionMode::kSpin) {
     const double delta = target_.steering - steering_;
-    const double max_step = limits_.steering_rate * h;
-    steering_ =
-        std::abs(delta) <= max_step ? target_.steering : steering_ + std::copysign(max_step, delta);
+    const double a = limits_.steering_acceleration;
+    if (a > 0.0) {
+      // Trapezoidal: as fast as the rate and the acceleration allow while the speed at the end of
+      // the sub-step still stops at the target (v_end^2 = 2 a (dist - (v + v_end) h / 2), solved).
+      const double dir = delta > 0.0 ? 1.0 : -1.0;
+      const double dist = std::abs(delta);
+      const double v = steering_velocity_ * dir;  // toward the target
+      const double disc = a * a * h * h + 4.0 * (2.0 * a * dist - a * h * v);
+      const double v_brake = std::max(0.0, (-a * h + std::sqrt(std::max(0.0, disc))) / 2.0);
+      const double vn = std::max(std::min({limits_.steering_rate, v + a * h, v_brake}), v - a * h);
+      const double step = (v + vn) / 2.0 * h;
+      if (dist < 1e-9 || step >= dist - 1e-12) {
+        steering_ = target_.steering;
+        steering_velocity_ = 0.0;
+      } else {
+        steering_ += dir * step;
+        steering_velocity_ = dir * vn;
+      }
+    } else {
+      const double max_step = limits_.steering_rate * h;
+      steering_ = std::abs(delta) <= max_step ? target_.steering
+                                              : steering_ + std::copysign(max_step, delta);
+    }
   }
 
   const double goal = switching() ? 0.0 : target_.speed;
@@ -230,6 +250,7 @@ void ChassisModel::sub_step(double h) {
       switch_elapsed_ = switch_duration_;
       mode_ = switch_target_;
       steering_ = 0.0;
+      steering_velocity_ = 0.0;
       target_ = MotionTarget{};
       emergency_ = false;
       switch_phase_ = SwitchPhase::kNone;

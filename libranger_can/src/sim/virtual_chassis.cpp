@@ -41,25 +41,6 @@ std::string names_of(std::uint32_t bits, ErrorWordLayout layout) {
   return text::join(protocol::error_bit_names(bits, layout), ",");
 }
 
-// The nominal period of a frame (the frame table).
-constexpr std::chrono::milliseconds period_of(std::uint32_t id) {
-  return std::chrono::milliseconds(protocol::frame_period_ms(id));
-}
-// The frames each schedule sends share its period.
-constexpr bool same_period(std::initializer_list<std::uint32_t> ids) {
-  for (const std::uint32_t id : ids) {
-    if (protocol::frame_period_ms(id) != protocol::frame_period_ms(*ids.begin())) return false;
-  }
-  return protocol::frame_period_ms(*ids.begin()) > 0;
-}
-static_assert(same_period({protocol::kSystemStatusId, protocol::kMotionFeedbackId,
-                           protocol::kMotorHighSpeedBaseId + 1, protocol::kSteeringAnglesId,
-                           protocol::kWheelSpeedsId, protocol::kMotionModeFeedbackId,
-                           protocol::kLightStateId, protocol::kRemoteControlStateId}));
-static_assert(same_period({protocol::kUltrasonic1to4Id, protocol::kUltrasonic5to8Id}));
-static_assert(same_period({protocol::kMotorLowSpeedBaseId + 1}));
-static_assert(same_period({protocol::kBmsBaseId, protocol::kBmsBaseId + 1}));
-
 // The 0x221 / 0x111 Ackermann angle of the profile's reading, from the mean front angle the model
 // keeps (REP-103 signs).
 double front_angle_from_mean(double mean, const VehicleGeometry& g, SteeringReference reference) {
@@ -84,11 +65,12 @@ VirtualChassis::VirtualChassis(Bus& bus, const VirtualChassisConfig& config, Tim
       ultrasonic_enabled_(config.ultrasonic_enabled),
       ultrasonic_(config.ultrasonic),
       garbage_rng_(config.garbage_seed) {
-  // Each schedule sends the frames of one period of the frame table (send_due).
-  schedules_[kFast] = {period_of(protocol::kSystemStatusId), boot_time};
-  schedules_[kUltrasonic] = {period_of(protocol::kUltrasonic1to4Id), boot_time};
-  schedules_[kSlow] = {period_of(protocol::kMotorLowSpeedBaseId + 1), boot_time};
-  schedules_[kBms] = {period_of(protocol::kBmsBaseId), boot_time};
+  // Each schedule sends one group of the frame-rate schedule at the chassis's period for it
+  // (frame_schedule.hpp; send_due).
+  schedules_[kFast] = {config.frame_rates.of(FrameGroup::kFast), boot_time};
+  schedules_[kUltrasonic] = {config.frame_rates.of(FrameGroup::kUltrasonic), boot_time};
+  schedules_[kSlow] = {config.frame_rates.of(FrameGroup::kSlow), boot_time};
+  schedules_[kBms] = {config.frame_rates.of(FrameGroup::kBms), boot_time};
   control_mode_ = config.boot_in_remote_mode ? ControlMode::kRemote : ControlMode::kStandby;
   event(std::string("power on in ") + std::string(protocol::to_string(control_mode_)) +
         " mode, motion mode " + std::string(protocol::to_string(motion_.mode())) + ", battery " +

@@ -164,9 +164,9 @@ ProtocolProfile make_agx_v2() {
   return p;
 }
 
-// The RANGER MINI 3.0's manual as transcribed (PROTOCOL_MINI_V3.md): the vendor's units, signs,
-// spin field and BMS scale (which its manual states alike), its own fault word, mode numbering,
-// frames and lengths.
+// The RANGER MINI 3.0's manual as transcribed (PROTOCOL_MINI_V3.md): the vendor's units, signs
+// and spin field (which its manual states alike), its own fault word, mode numbering, frames and
+// lengths; the BMS scale and the e-stop's body status as a real one reports them.
 ProtocolProfile make_mini_v3() {
   ProtocolProfile p = make_agx_v2();
   p.revision = "mini_v3";
@@ -176,6 +176,10 @@ ProtocolProfile make_mini_v3() {
   p.odometer_unit = OdometerUnit::kMillimetre;  // 0x311 / 0x312: left, right in mm
   p.light_modes = LightModes::kOnOff;           // on/off only
   p.tx_dlc = 0;  // its manual gives each command's length (0x141, 0x421, 0x423, 0x441: 1)
+  // Where a real MINI 3.0 contradicts our transcription of its manual, the field's reading
+  // (docs/FIELD_FACTS.md; the manual's stays a setting away: --set NAME=VALUE, sim:mini_v3_manual):
+  p.vehicle_status_1_is_estop = false;  // an e-stop is body status 2 + fault bit 7; 1 never seen
+  p.bms_voltage_scale = 0.01;           // 0x361's voltage in 0.01 V (53.0 V = 0x14B4)
   return p;
 }
 

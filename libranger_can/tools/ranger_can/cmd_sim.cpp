@@ -113,9 +113,6 @@ Result<SimOptions> options_from(const ParsedArgs& args) {
   o.errors = args.all("--error");
   o.stuck = args.has("--stuck-mode-switch");
   o.config.limits.acceleration = args.number("--accel", o.config.limits.acceleration);
-  if (args.has("--steering-rate")) {
-    o.config.limits.steering_rate = deg_to_rad(args.number("--steering-rate", 0.0));
-  }
   o.config.garbage_seed = static_cast<std::uint32_t>(args.integer("--seed", o.config.garbage_seed));
   o.pose_out = args.get_or("--pose-out", "");
   o.pose_rate = args.number("--pose-rate", o.pose_rate);
@@ -134,6 +131,14 @@ Result<SimOptions> options_from(const ParsedArgs& args) {
   if (args.has("--switch-slew")) {
     sw.turn = sim::SwitchTurn::kSlew;
     sw.slew_rate = args.number("--switch-slew", sw.slew_rate);
+  }
+  // The steering and the frame rates, over the model's and the variant's too.
+  if (args.has("--steering-rate")) {
+    o.config.limits.steering_rate = deg_to_rad(args.number("--steering-rate", 0.0));
+  }
+  if (args.has("--bms-period")) {
+    o.config.frame_rates.period[static_cast<std::size_t>(sim::FrameGroup::kBms)] =
+        from_seconds(args.number("--bms-period", 0.0));
   }
   for (const auto& e : o.errors) {
     if (auto b = parse_error_bit(e, o.config.profile.error_word); !b) return b.error();
@@ -531,9 +536,14 @@ const CommandSpec& sim_command() {
                  "acceleration limit (default " + number_text(defaults.limits.acceleration) + ")",
                  number_in(0.01, 20.0)),
           option("--steering-rate", "DEG/S",
-                 "steering slew rate (default " +
-                     number_text(rad_to_deg(defaults.limits.steering_rate)) + ")",
+                 "steering slew rate while driving (default the model's: " +
+                     number_text(rad_to_deg(defaults.limits.steering_rate)) +
+                     "; ranger_mini_v3 the field's 3.26 rad/s = 186.8, with its profile)",
                  number_in(1.0, 3600.0)),
+          option("--bms-period", "S",
+                 "0x361/0x362 every S seconds (default the frame-rate schedule's: the manual's "
+                 "0.5; ranger_mini_v3 the field's 0.25)",
+                 number_in(0.02, 10.0)),
           option("--seed", "N",
                  "seed of the garbage-frame generator (default " +
                      std::to_string(defaults.garbage_seed) + ")",

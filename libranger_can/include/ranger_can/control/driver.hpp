@@ -234,6 +234,9 @@ class Driver {
   SettingsSupervisor settings_;
   Odometry odometry_;
   bool odometry_fed_ = false;  // the odometry has integrated frames (a new profile keeps its pose)
+  // The frames' clock minus the driver's (the latest stamped frame's): the commands the odometry
+  // is told of go on the frames' clock.
+  std::chrono::nanoseconds frame_clock_offset_{0};
   WheelJointTracker joints_;
   FrameStats frames_;
   VendorFeatures vendor_;

@@ -30,6 +30,9 @@
 namespace ranger {
 
 // Limits the kinematics clamps to. Defaults follow the manual (0x111 ranges, spec sheet speed).
+// The steering rate assumed where a model names none (our virtual RANGER's): 90 deg/s.
+inline constexpr double kDefaultSteeringRateRps = deg_to_rad(90.0);
+
 struct KinematicsLimits {
   double max_linear_speed = 1.5;  // m/s, |0x111 linear speed|; capped at
                                   // interpretation::kMaxLinearSpeedMps by validate()
@@ -40,6 +43,11 @@ struct KinematicsLimits {
   double max_ackermann_steering = kMaxAckermannSteeringRad;  // rad, mean front-wheel angle
   double max_oblique_steering = kMaxObliqueSteeringRad;      // rad, direction of travel
   double max_spin_wheel_speed = kMaxSpinSpeedMps;            // m/s wheel tangential speed
+  // How fast the chassis turns its steering (rad/s of 0x111's steering quantity: the Ackermann
+  // front angle, the oblique direction), for what the odometry assumes the wheels did during a
+  // silence of the chassis. No manual gives it: the RANGER's is our virtual chassis's 90 deg/s;
+  // the RANGER MINI 3.0's the field's 3.26 rad/s (docs/FIELD_FACTS.md). Not a command limit.
+  double steering_rate = kDefaultSteeringRateRps;
 
   // Every field finite, positive and within the protocol's range; the message names the field.
   Status validate() const;

@@ -21,6 +21,7 @@
 #include <array>
 #include <chrono>
 #include <cstdint>
+#include <deque>
 #include <optional>
 #include <string_view>
 
@@ -148,9 +149,16 @@ class Odometry {
   bool on_motion_feedback(const MotionFeedback& m, Timestamp stamp);
   bool on_motion_mode(const MotionModeFeedback& m, Timestamp stamp);
   // The chassis's own odometer: where it reports metres, the distance it counted across a gap in
-  // its frames advances the pose along the arc the chassis was driving before the gap (its
-  // direction and curvature); the gap's variance (account_gap) stays, the path's shape unknown.
+  // its frames advances the pose along the path the chassis drove in the gap, as far as the
+  // commands tell it (on_command): from the motion before the gap, its steering quantity (the
+  // Ackermann front angle, the oblique direction) turning toward what each command asked at
+  // limits.steering_rate, its speed toward what each asked at the one constant rate that rolls
+  // the distance counted. Without commands (a log without the host's frames), and in spin, side
+  // slip and park, along the motion before the gap. The gap's variance (account_gap) stays.
   bool on_odometer(const OdometerFeedback& m, Timestamp stamp);
+  // A 0x111 the host sent, stamped on the frames' clock: what the chassis was asked to do while
+  // it was silent (on_odometer). Kept until a later one is older than the latest feedback.
+  void on_command(const MotionCommand& command, Timestamp stamp);
 
   // Back to `pose` with the initial covariance; twist, counters and time anchor cleared.
   void reset(const Pose2D& pose = {});
@@ -164,6 +172,10 @@ class Odometry {
   bool wheels_fresh(Timestamp stamp) const;
   void account_gap(std::chrono::nanoseconds gap, Timestamp end);
   bool step(const BodyTwist& twist, Timestamp stamp, OdometrySource source);
+  // The pose after rolling `distance` from `start` to `end` as on_odometer says (nullopt: no
+  // commands, or a mode or motion the model does not cover).
+  std::optional<Pose2D> gap_path(const BodyTwist& motion, Timestamp start, Timestamp end,
+                                 double distance) const;
 
   OdometryConfig config_;
   OdometryState state_;
@@ -177,6 +189,11 @@ class Odometry {
     bool rear = false;
   };
   std::optional<OdometerReading> odometer_;  // the latest, of the axle in use (front first)
+  struct SentCommand {
+    Timestamp stamp{0};
+    MotionCommand command;
+  };
+  std::deque<SentCommand> commands_;  // oldest first; the newest before the feedback's kept
 
   bool have_angles_ = false;
   SteeringAnglesFeedback angles_;

@@ -49,6 +49,10 @@ struct MotionLimits {
   double deceleration = 2.0;                              // m/s^2 when slowing down or stopping
   double emergency_deceleration = 6.0;                    // m/s^2 for e-stop and power cut
   double steering_rate = deg_to_rad(90.0);                // rad/s of the body steering quantity
+  // rad/s^2 the steering speeds up and slows down at; 0: at steering_rate at once (a pure rate).
+  // The field's profile t = d / rate + lag is a trapezoid of acceleration rate / lag (triangular
+  // below rate * lag).
+  double steering_acceleration = 0.0;
 };
 
 // What the chassis has been asked to do, REP-103 signs (VirtualChassis converts from the wire).
@@ -124,6 +128,7 @@ class ChassisModel {
   bool emergency_ = false;
   double speed_ = 0.0;
   double steering_ = 0.0;
+  double steering_velocity_ = 0.0;  // rad/s (steering_acceleration > 0)
 
   SwitchPhase switch_phase_ = SwitchPhase::kNone;
   protocol::MotionMode switch_target_ = protocol::MotionMode::kAckermann;

@@ -2,9 +2,10 @@
 //
 // Deterministic core: the owner feeds received frames with on_frame(frame, now) and calls
 // step(now) often (every few ms); the chassis advances its physics (chassis_model.hpp) to `now`
-// and sends every feedback frame that fell due at the manual's period, each computed from the
-// state at its due time. No clock is read and no thread is started here; VirtualChassisRunner
-// (virtual_chassis_runner.hpp) adds both for the CLI and tests on a real interface.
+// and sends every feedback frame that fell due at its period (the frame-rate schedule,
+// frame_schedule.hpp), each computed from the state at its due time. No clock is read and no thread
+// is started here; VirtualChassisRunner (virtual_chassis_runner.hpp) adds both for the CLI and
+// tests on a real interface.
 //
 // Behaviour (manual section 3.2; readings of the manual's gaps are marked "reading"):
 //  * Boots in standby (or in remote mode if configured). In standby it obeys 0x421 only. In remote
@@ -95,6 +96,7 @@
 #include "ranger_can/sim/chassis_lights.hpp"
 #include "ranger_can/sim/chassis_model.hpp"
 #include "ranger_can/sim/drivetrain_model.hpp"
+#include "ranger_can/sim/frame_schedule.hpp"
 #include "ranger_can/sim/switch_model.hpp"
 #include "ranger_can/transport/bus.hpp"
 #include "ranger_can/wire/codec.hpp"
@@ -134,6 +136,9 @@ struct VirtualChassisConfig {
   // How a switch is reported and how the wheels turn (the manual's reading by default; the
   // field's for the MINI 3.0: chassis_for_model, sim_bus_source.hpp).
   SwitchModelConfig switch_model;
+  // The period of each group of feedback frames (frame_schedule.hpp: the manual's by default; the
+  // field's for the MINI 3.0).
+  FrameRates frame_rates = manual_frame_rates();
   std::chrono::nanoseconds command_timeout =
       std::chrono::milliseconds(protocol::kChassisCommandTimeoutMs);
   double initial_soc = 90.0;         // %
