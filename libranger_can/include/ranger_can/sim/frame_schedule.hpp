@@ -8,13 +8,14 @@
 // RANGER MINI 3.0 showed (field notes of zeroworks-robotics/ranger_ros2, docs/, the topic
 // contract of 2026-09-10: docs/FIELD_FACTS.md):
 //
-//   group       frames                                         manual   field (MINI 3.0)
-//   fast        0x211 0x221 0x251.. 0x271 0x281 0x291           20 ms    20 ms (20.9 measured)
+// clang-format off
+//   group       frames                                     manual   field (MINI 3.0)
+//   fast        0x211 0x221 0x251.. 0x271 0x281 0x291       20 ms    20 ms (20.9 measured)
 //               0x231 0x241 (vendor) 0x311 0x312 (odometers)
-//   ultrasonic  0x411 0x412                                     50 ms    none (the MINI 3.0 has
-//   none) slow        0x261..                                         100 ms   not reported: the
-//   manual's bms         0x361 0x362 (and the slots 0x363..)             500 ms   250 ms (87,555
-//   frames)
+//   ultrasonic  0x411 0x412                                 50 ms    none (no ultrasonic)
+//   slow        0x261..                                    100 ms    not reported: the manual's
+//   bms         0x361 0x362 (and the slots 0x363..)        500 ms    250 ms (87,555 frames)
+// clang-format on
 //
 // A chassis runs one column (FrameRates): the manual's by default, the field's for the MINI 3.0
 // (sim:mini_v3, --model ranger_mini_v3); the variant mini_v3_manual keeps the manual's.
