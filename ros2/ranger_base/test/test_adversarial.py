@@ -21,7 +21,6 @@ import os
 import time
 
 import pytest
-import rclpy
 from geometry_msgs.msg import Twist
 from ranger_msgs.msg import SystemState
 from ranger_msgs.srv import SetMotionMode
@@ -41,12 +40,11 @@ _ns = itertools.count(1)
 
 
 @pytest.fixture(scope="module")
-def client():
-    rclpy.init()
+def client(ros):
+    """One client for the module's shared robots (conftest's is one per test)."""
     c = Client()
     yield c
     c.close()
-    rclpy.shutdown()
 
 
 @pytest.fixture(scope="module")
