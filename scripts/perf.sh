@@ -10,8 +10,8 @@
 #
 # Runs bench_codec (+ callgrind instructions per decoded frame), bench_control, bench_bus
 # (in-process loopback), the e2e odometry figures (lock-step, simulated clock) and
-# ranger_base/scripts/measure_performance.py (and the ROS 2 node's, ros2/ranger_base, when
-# scripts/test_ros2.sh has built its workspace). Builds the benchmarks in build/perf, a Release
+# ranger_base/scripts/measure_performance.py (and the ROS 2 node's, ros2/ranger_base, on Jazzy
+# and Kilted, where scripts/test_ros2.sh has built their workspaces). Builds the benchmarks in build/perf, a Release
 # build of its own (figures never depend on how build/lib is configured), and the node with
 # scripts/build.sh ros. About 5 minutes of measuring; RANGER_JOBS sets the build jobs (2).
 # RANGER_PERF_NOTE: a line for the header (e.g. what else ran on the machine meanwhile).
@@ -63,12 +63,18 @@ run odometry "$out/tests/e2e/test_e2e_loopback --gtest_filter='*OdometryMatchesG
 if [ "$ros" = 1 ]; then
   run node "export PATH=/usr/bin:\$PATH; source install/setup.bash; /usr/bin/python3 \
 ranger_base/scripts/measure_performance.py --duration 20 --samples 400 --json $raw/node.json"
-  # The ROS 2 node in the same run (the workspace scripts/test_ros2.sh builds), when it is there.
-  # Kilted's, unless RANGER_ROS2_DISTRO names another.
-  if [ -f "build/ros2_ws_${RANGER_ROS2_DISTRO:-kilted}/install/setup.bash" ]; then
-    run node_ros2 "source scripts/ros2_env.sh 88; python -m ranger_base.measure_performance \
---duration 20 --samples 400 --json $raw/node_ros2.json"
-  fi
+  # The ROS 2 node in the same run, on each distribution whose workspace scripts/test_ros2.sh
+  # built (RANGER_ROS2_DISTRO: those named; default jazzy and kilted), each with a domain id of
+  # its own (RANGER_PERF_ROS2_DOMAIN_BASE, default 88: Jazzy 88, Kilted 89).
+  domain=${RANGER_PERF_ROS2_DOMAIN_BASE:-88}
+  for distro in ${RANGER_ROS2_DISTRO:-jazzy kilted}; do
+    if [ -f "build/ros2_ws_$distro/install/setup.bash" ]; then
+      run "node_ros2_$distro" "RANGER_ROS2_DISTRO=$distro source scripts/ros2_env.sh $domain; \
+python -m ranger_base.measure_performance --duration 20 --samples 400 \
+--json $raw/node_ros2_$distro.json"
+    fi
+    domain=$((domain + 1))
+  done
 fi
 
 {

@@ -127,39 +127,58 @@ def node():
         f"{t} {r} Hz" for t, r in load["subscribers_messages_per_s"].items()), "node")
 
 
-def node_ros2():
-    """ROS 2 node
-    ros2/ranger_base's ranger_base_node (rclpy over the ranger_can binding) in the same run, the
-    same load: `port_name:=sim`, subscribers on `odom`, `/tf`, `joint_states` (raw: bytes, no
-    Python message, as the ROS 1 measurement's `rospy.AnyMsg`), `cmd_vel` at 20 Hz; latency as
-    above, from the twist's bytes handed to the publisher (serialised beforehand) to the 0x111's
-    send stamp (ros2/ranger_base/ranger_base/measure_performance.py). The node takes `cmd_vel`'s
-    bytes and reads them in C++ (`ranger_can.read_twist`)."""
-    doc = json.loads(read("node_ros2.json"))
-    load, lat, floor = doc["load"], doc["latency_cmd_vel_to_0x111"], doc["rclpy_floor"]
-    ros1 = json.loads(read("node.json"))["load"] if read("node.json") else {}
-    cpu, ros1_cpu = load["driver_cpu_percent"], ros1.get("driver_cpu_percent")
-    ratio = cpu / ros1_cpu if cpu is not None and ros1_cpu else None
-    row("Driver CPU (node minus chassis thread)", "chassis thread not found" if cpu is None else
-        f"{cpu} % of one core" + (f" ({ratio:.1f}x the ROS 1 node's {ros1_cpu} %)" if ratio
-                                  else ""), "node_ros2", "≤ 2x the ROS 1 node's",
-        ratio is not None and ratio <= 2.0)
-    row("rclpy floor: the same topics and rates, no driver", f"{floor['cpu_percent']} %",
-        "node_ros2")
-    if cpu is not None:
-        above = round(cpu - floor["cpu_percent"], 2)
-        row("Driver CPU above the rclpy floor", f"{above} %" + (
-            f" (the ROS 1 node above roscpp's: {ros1['driver_over_floor_percent']} %)"
-            if "driver_over_floor_percent" in ros1 else ""), "node_ros2")
-    row("Per thread, % (name)", ", ".join(f"{t['name']}: {t['cpu_percent']}"
-                                         for t in load["threads"] if t["cpu_percent"]),
-        "node_ros2")
-    rss = load["rss_kib_median"] * 1.024e-3
-    row("RSS", f"{rss:.1f} MB (median)", "node_ros2")
-    for p, limit in (("p50", None), ("p90", None), ("p99", 2.0)):
-        row(f"cmd_vel -> 0x111 latency {p}", f"{lat[p + '_ms']} ms" + (
-            f" (max {lat['max_ms']}, {lat['samples']} samples)" if p == "p99" else ""),
-            "node_ros2", f"≤ {limit:g} ms" if limit else "", limit and lat[p + "_ms"] <= limit)
+def node_ros2(distro):
+    """A section's step: the ROS 2 node on `distro` (its step node_ros2_DISTRO)."""
+    step = f"node_ros2_{distro}"
+
+    def measured():
+        doc = json.loads(read(f"{step}.json"))
+        load, lat, floor = doc["load"], doc["latency_cmd_vel_to_0x111"], doc["rclpy_floor"]
+        ros1 = json.loads(read("node.json"))["load"] if read("node.json") else {}
+        cpu, ros1_cpu = load["driver_cpu_percent"], ros1.get("driver_cpu_percent")
+        ratio = cpu / ros1_cpu if cpu is not None and ros1_cpu else None
+        row("Driver CPU (node minus chassis thread)", "chassis thread not found" if cpu is None
+            else f"{cpu} % of one core" + (f" ({ratio:.2f}x the ROS 1 node's {ros1_cpu} %)"
+                                           if ratio else ""), step, "≤ 1.5x the ROS 1 node's",
+            ratio is not None and ratio <= 1.5)
+        row("rclpy floor: the same topics and rates, no driver", f"{floor['cpu_percent']} %",
+            step)
+        if cpu is not None:
+            above = round(cpu - floor["cpu_percent"], 2)
+            row("Driver CPU above the rclpy floor", f"{above} %" + (
+                f" (the ROS 1 node above roscpp's: {ros1['driver_over_floor_percent']} %)"
+                if "driver_over_floor_percent" in ros1 else ""), step)
+        row("Per thread, % (name)", ", ".join(f"{t['name']}: {t['cpu_percent']}"
+                                             for t in load["threads"] if t["cpu_percent"]), step)
+        rss = load["rss_kib_median"] * 1.024e-3
+        row("RSS", f"{rss:.1f} MB (median)", step, "≤ 60 MB", rss <= 60.0)
+        for p, limit in (("p50", None), ("p90", None), ("p99", 1.0)):
+            row(f"cmd_vel -> 0x111 latency {p}", f"{lat[p + '_ms']} ms" + (
+                f" (max {lat['max_ms']}, {lat['samples']} samples)" if p == "p99" else ""),
+                step, f"≤ {limit:g} ms" if limit else "", limit and lat[p + "_ms"] <= limit)
+    measured.__name__ = step
+    measured.__doc__ = f"""ROS 2 node on {distro.capitalize()}
+    ros2/ranger_base's ranger_base_node (rclpy over the ranger_can binding; the fast path of
+    ranger_base/rclpy_fast.py, the default) on ROS 2 {distro.capitalize()} (its venv of PyPI
+    wheels, scripts/setup_ros2.sh), in the same run, the same load: `port_name:=sim`,
+    subscribers on `odom`, `/tf`, `joint_states` (raw: bytes, no Python message, as the ROS 1
+    measurement's `rospy.AnyMsg`), `cmd_vel` at 20 Hz; latency as above, from the twist's bytes
+    handed to the publisher (serialised beforehand) to the 0x111's send stamp
+    (ros2/ranger_base/ranger_base/measure_performance.py). The node takes `cmd_vel`'s bytes and
+    reads them in C++ (`ranger_can.read_twist`). Where the resident memory goes (Jazzy, one
+    process, VmRSS after each step, measured 2026-11-28): Python 9 MB; `import rclpy` 24 MB;
+    the first node 35 MB (numpy, which the parameter services' messages import, 16 MB, and
+    Fast DDS's participant, its heap and threads, the rest); ranger_can and ranger_base 4 MB;
+    the driver, its threads and the node's 20 publishers and 7 services the rest. The goal of
+    60 MB is below what rclpy and Fast DDS take before the node does anything (70 MB): not met
+    by a change in this node. Where the CPU goes: the rclpy floor (rclpy and Fast DDS sending
+    the same messages, no driver) is itself about the ROS 1 node's whole driver CPU; cProfile of
+    the publication thread (ranger_publish, the largest; 25 s on Jazzy, wall-clock):
+    `publish_raw` (rclpy into Fast DDS) 1.04 s for 3174 messages, the node's own Python (states,
+    diagnostics, the audience, the cmd_vel type check, the encoder) under 0.2 s, the rest
+    waiting in `Driver.wait_motion` with the GIL released: what is above the goal is rclpy's and
+    Fast DDS's per-message cost, not the node's Python."""
+    return measured
 
 
 def keepalive():
@@ -261,7 +280,8 @@ section(codec, callgrind)
 section(control)
 section(bus)
 section(node)
-section(node_ros2)
+section(node_ros2("jazzy"))
+section(node_ros2("kilted"))
 section(keepalive)
 section(nodelet)
 section(fleet)

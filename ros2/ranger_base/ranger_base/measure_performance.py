@@ -219,7 +219,7 @@ def measure_latency(node, samples, params):
         if t is not None:
             stamp = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
             latencies.append(1000.0 * (stamp - t))
-    from .node import OwnThreadGroup, SubscriptionThread
+    from .rclpy_fast import OwnThreadGroup, SubscriptionThread
     with Robot(node, ns, ["publish_cmd:=true", "cmd_vel_timeout:=1.0", *params]):
         # cmd_vel_out (50 Hz: every keep-alive) on a thread of its own, as the node takes
         # cmd_vel: not the executor's, whose Python work at every wake-up would hold the GIL
@@ -262,7 +262,7 @@ def run_floor(ns):
     from tf2_msgs.msg import TFMessage
 
     from . import conversions
-    from .node import OwnThreadGroup, SubscriptionThread, name_os_thread
+    from .rclpy_fast import OwnThreadGroup, SubscriptionThread, name_os_thread
     rclpy.init()
     node = rclpy.create_node("rclpy_floor", namespace=ns)
     odom_pub = node.create_publisher(Odometry, "odom", 10)

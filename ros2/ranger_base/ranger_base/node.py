@@ -7,6 +7,8 @@ identification, the odometry) runs in C++ on a thread of the library's own; this
     node's own that waits for cmd_vel alone (not the executor, whose every wake-up rebuilds its
     wait set in Python: that costs more than the driver itself and delays the command), taking
     its bytes and reading them in C++ (ranger_can.read_twist: no Python message per command);
+    that thread is rclpy's private API, kept in rclpy_fast with its public fallback (cmd_vel in
+    a callback group of its own, served by the executor), chosen at start-up and logged;
   * the driver's estimates -> odom, /tf, joint_states at publish_rate (each estimate once,
     stamped with its frames' time, only while the chassis is heard; Driver.wait_motion paces
     them in C++ and hands over ready values for messages allocated once), the states at
@@ -19,7 +21,6 @@ All names are relative (push the node into a namespace for several robots); /tf 
 /diagnostics are global by their conventions.
 """
 
-import ctypes
 import os
 import signal
 import sys
@@ -31,14 +32,12 @@ from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import Twist, TwistStamped
 from nav_msgs.msg import Odometry
 from rcl_interfaces.msg import SetParametersResult
-from rclpy.callback_groups import CallbackGroup, MutuallyExclusiveCallbackGroup
+from rclpy.callback_groups import MutuallyExclusiveCallbackGroup
 try:
     from rclpy.event_handler import PublisherEventCallbacks, SubscriptionEventCallbacks
 except ImportError:  # Humble: the same classes under their older module name
     from rclpy.qos_event import PublisherEventCallbacks, SubscriptionEventCallbacks
 from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
-from rclpy.guard_condition import GuardCondition
-from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.duration import Duration
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
@@ -53,7 +52,9 @@ from tf2_msgs.msg import TFMessage
 import ranger_can
 from ranger_can import RangerError, RequestFailed, RequestTimeout
 
-from . import conversions, parameters
+from . import conversions, parameters, rclpy_fast
+# Every private call of rclpy's is in rclpy_fast (with its public fallback).
+from .rclpy_fast import name_os_thread
 
 # The services' numbers and what they mean: the library's (ranger_msgs' constants are the same
 # numbers, test/test_adapter.py), never re-typed here.
@@ -86,76 +87,8 @@ def _advance(due, period, now):
     return due if due >= now else now + period
 
 
-def name_os_thread(name):
-    """Names the calling thread as the OS shows it (top -H, /proc/PID/task/TID/comm; Python's
-    thread names stay inside Python), as the ROS 1 node names its threads."""
-    try:
-        ctypes.CDLL(None).prctl(15, name.encode()[:15], 0, 0, 0)  # PR_SET_NAME
-    except (OSError, AttributeError):
-        pass
-
-
 class ParameterError(Exception):
     """Start-up refused: every bad parameter, one per line."""
-
-
-class OwnThreadGroup(CallbackGroup):
-    """The callback group of what a thread of the node's own serves (cmd_vel): no executor ever
-    takes it up, so it stays out of the executor's wait set."""
-
-    def can_execute(self, entity):
-        return False
-
-    def beginning_execution(self, entity):
-        return False
-
-    def ending_execution(self, entity):
-        pass
-
-
-class SubscriptionThread:
-    """Serves one subscription on a thread of its own: waits on a wait set holding only that
-    subscription (and a guard condition to end it) with the GIL released, takes each message and
-    calls the callback (as rclpy.wait_for_message waits). No executor wakes for it."""
-
-    def __init__(self, node, subscription, name):
-        self._sub = subscription
-        self._context = node.context
-        self._wake = GuardCondition(None, None, context=node.context)
-        self._stop = threading.Event()
-        self._logger = node.get_logger()
-        self._thread = threading.Thread(target=self._run, name=name, daemon=True)
-
-    def start(self):
-        self._thread.start()
-
-    def stop(self):
-        """Ends the thread (the callback does not run afterwards); idempotent."""
-        self._stop.set()
-        if self._thread.is_alive():
-            self._wake.trigger()
-            self._thread.join()
-        self._wake.destroy()
-
-    def _run(self):
-        name_os_thread(self._thread.name)
-        sub, handle = self._sub, self._sub.handle
-        wait_set = _rclpy.WaitSet(1, 1, 0, 0, 0, 0, self._context.handle)
-        while not self._stop.is_set():
-            try:
-                wait_set.clear_entities()
-                wait_set.add_subscription(handle)
-                wait_set.add_guard_condition(self._wake.handle)
-                wait_set.wait(1_000_000_000)
-                if self._stop.is_set():
-                    break
-                while (taken := handle.take_message(sub.msg_type, sub.raw)) is not None:
-                    sub.callback(taken[0])
-            except Exception as e:  # noqa: BLE001 (nothing may end the thread but stop())
-                if not self._context.ok():
-                    break
-                self._logger.error(f"{sub.topic_name}: {e}", throttle_duration_sec=5.0)
-                self._stop.wait(0.05)
 
 
 class RangerNode(Node):
@@ -288,9 +221,9 @@ class RangerNode(Node):
             msg_type, callback, raw = ((TwistStamped, self._on_cmd_vel_stamped, False) if stamped
                                        else (Twist, self._on_cmd_vel, self._read_raw))
             self.cmd_sub = self.create_subscription(
-                msg_type, "cmd_vel", callback, 1, callback_group=OwnThreadGroup(),
+                msg_type, "cmd_vel", callback, 1, callback_group=rclpy_fast.callback_group(),
                 event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False), raw=raw)
-            self._cmd_thread = SubscriptionThread(self, self.cmd_sub, "ranger_cmd_vel")
+            self._cmd_thread = rclpy_fast.serve(self, self.cmd_sub, "ranger_cmd_vel")
             self._cmd_stamped = stamped
             if old_thread is not None:  # the node runs
                 self._cmd_thread.start()
@@ -333,6 +266,7 @@ class RangerNode(Node):
             f"{self.params['base_frame']}{', TF on' if self.tf_pub else ', TF off'})")
         for severity, text in self.driver.startup_lines:  # the library's words, as ROS 1's
             self._log_at(severity, text)
+        self.get_logger().info(rclpy_fast.choose().line())
 
     def shutdown(self):
         """Stops the chassis first (the driver's zero motion command), then publication."""

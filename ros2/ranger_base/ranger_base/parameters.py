@@ -22,6 +22,8 @@ from rcl_interfaces.msg import ParameterType as PT
 
 import ranger_can
 
+from . import rclpy_fast
+
 # What may change while the node runs (ROS 2 only: ROS 1 reads its parameters once).
 CHANGEABLE = {"publish_rate", "state_publish_rate"}
 
@@ -90,12 +92,6 @@ class Declared:
     errors: List[str] = field(default_factory=list)
 
 
-def _override(node, name):
-    overrides = getattr(node, "_parameter_overrides", {})
-    p = overrides.get(name)
-    return None if p is None else p.value
-
-
 def _declare(node, name, type_name, default, desc):
     """Declares with the descriptor; an override rclpy refuses (type, range) is declared away
     and returned as given, for the library's message."""
@@ -108,7 +104,7 @@ def _declare(node, name, type_name, default, desc):
             node.declare_parameter(name, default, desc)
         return None
     except (InvalidParameterTypeException, InvalidParameterValueException, TypeError):
-        given = _override(node, name)
+        given = rclpy_fast.refused_value(node, name)
         if default is None:
             node.declare_parameter(name, Parameter.Type(_TYPES[type_name]), desc,
                                    ignore_override=True)
@@ -148,8 +144,10 @@ def declare_all(node, display: str) -> Declared:
         refused = _declare(node, name, row.type, default_of(row), descriptor(row))
         if refused is not None:
             out.given[row.name] = _plain(refused)
-        elif _override(node, name) is not None:
-            out.given[row.name] = _plain(node.get_parameter(name).value)
+        else:
+            given = rclpy_fast.given_value(node, name, default_of(row))
+            if given is not None:
+                out.given[row.name] = _plain(given)
     # ROS 2 gives an empty list as a byte array or an empty array of another type.
     if "sim/errors" in out.given and not out.given["sim/errors"]:
         out.given["sim/errors"] = []

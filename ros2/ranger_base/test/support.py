@@ -37,12 +37,13 @@ def ros_args(params, ns=None):
 
 
 class NodeProcess:
-    def __init__(self, ns, params, log_dir):
+    def __init__(self, ns, params, log_dir, env=None):
         self.ns = ns
         self.log_path = os.path.join(log_dir, f"{ns.strip('/').replace('/', '_') or 'root'}.log")
         self.log = open(self.log_path, "wb")
         self.proc = subprocess.Popen([node_executable()] + ros_args(params, ns), stdout=self.log,
-                                     stderr=subprocess.STDOUT, start_new_session=True)
+                                     stderr=subprocess.STDOUT, start_new_session=True,
+                                     env=dict(os.environ, **env) if env else None)
 
     def output(self):
         if not self.log.closed:
@@ -126,11 +127,12 @@ class Client:
 class Robot:
     """One ranger_base_node under `ns` with a client listening to it."""
 
-    def __init__(self, client, ns, log_dir, cmd_type=Twist, **params):
-        """cmd_type: the type of the test's cmd_vel publisher (`cmd`; None: none)."""
+    def __init__(self, client, ns, log_dir, cmd_type=Twist, env=None, **params):
+        """cmd_type: the type of the test's cmd_vel publisher (`cmd`; None: none); env: variables
+        added to the node's environment."""
         self.client, self.ns = client, ns
         params.setdefault("port_name", "sim")
-        self.process = NodeProcess(ns, params, log_dir)
+        self.process = NodeProcess(ns, params, log_dir, env)
         c = client
         c.listen(f"{ns}/system_state", SystemState)
         c.listen(f"{ns}/odom", Odometry)

@@ -11,6 +11,8 @@ truth (sim/ground_truth) and what the node says (system_state), never by a log l
     asked nor drive a direction neither asked;
   * bad service arguments are refused naming what is valid on that chassis;
   * odometry across `silent 2` while driving: system_state says the gap, odom's covariance grew.
+  * after each attack the latest command drives (still_obeying); a silence of the link latched
+    meanwhile (under load, or on purpose: `silent 0.5`) holds the chassis at rest until resume.
 The robots are shared by the tests of this module (one node per chassis); the fixture hands each
 test its robot at rest and armed, re-arming what an earlier test left latched (fleet). Durations
 only pace the commands, as a teleop would."""
@@ -21,7 +23,6 @@ import os
 import time
 
 import pytest
-import rclpy
 from geometry_msgs.msg import Twist
 from ranger_msgs.msg import SystemState
 from ranger_msgs.srv import SetMotionMode
@@ -41,12 +42,11 @@ _ns = itertools.count(1)
 
 
 @pytest.fixture(scope="module")
-def client():
-    rclpy.init()
+def client(ros):
+    """One client for the module's shared robots (conftest's is one per test)."""
     c = Client()
     yield c
     c.close()
-    rclpy.shutdown()
 
 
 @pytest.fixture(scope="module")
@@ -170,14 +170,44 @@ def assert_within(truths, vx, vy, wz):
 
 def still_obeying(r):
     """No fault, and the latest command drives: 0.3 m/s, then at rest. A silence of the link
-    alone (the machine loaded beyond link_timeout while the attack ran) is re-armed first: it is
-    the machine's, not the attack's; any other latch stays and fails."""
+    (the machine loaded beyond link_timeout while the attack ran) latches rearm_required after
+    link_lost: the node must then not move, whatever the commander asks, until it is re-armed
+    deliberately (resume), and obey after it (held_until_resume); any other latch fails."""
     assert not r.state().active_errors
-    if r.state().rearm_required and list(r.state().latched_causes) == ["link_lost"]:
-        settle(r)
-    drive_until(r, twist(0.3), lambda: abs(r.truth().twist.twist.linear.x - 0.3) < 0.01,
-                "obeying the latest command")
+    for _ in range(3):  # a silence may latch again while the commander drives: held again
+        s = r.state()
+        if s.rearm_required:
+            assert list(s.latched_causes) == ["link_lost"], (
+                "latched by the attack, not by a silence of the link", s)
+            held_until_resume(r)
+        drive_until(r, twist(0.3), lambda: abs(r.truth().twist.twist.linear.x - 0.3) < 0.01
+                    or r.state().rearm_required, "obeying the latest command")
+        if abs(r.truth().twist.twist.linear.x - 0.3) < 0.01:
+            break
+    else:
+        raise AssertionError(f"{r.ns}: latched by a silence of the link at every attempt")
     stop_and_settle(r)
+
+
+def held_until_resume(r):
+    """After a silence of the link: once heard again and at rest, 0.3 m/s asked for five states
+    moves nothing and every state says rearm_required; after resume, 0.3 m/s drives."""
+    drive_until(r, twist(0.3), lambda: (lambda s: s.link_up and not s.active_causes)(r.state()),
+                "the link heard again after its silence")
+    drive_until(r, twist(0.3), lambda: at_rest(r),
+                "at rest while latched after a silence of the link (asked 0.3 m/s, no resume)")
+    at, start = position(r), mark(r)
+    for s in drive_for_states(r, twist(0.3), 5):
+        assert s.rearm_required, ("re-armed without resume after a silence of the link", s)
+    assert max(fastest(truths_since(r, start))) < EXACT, "moved after a silence without resume"
+    assert moved_since(r, at) < EXACT, "moved after a silence without resume"
+
+    def resumed():  # the deliberate re-arm (again, should the link fall silent meanwhile)
+        s = r.state()
+        if s.rearm_required and s.link_up and not s.active_causes:
+            r.client.call(Trigger, f"{r.ns}/resume", Trigger.Request())
+        return not r.state().rearm_required
+    r.client.wait_for(resumed, 60, f"{r.ns} re-armed by resume")
 
 
 def drives(r, vx=0.5):
@@ -364,3 +394,17 @@ def test_odometry_across_a_silence_says_the_gap_and_grows_the_covariance(fleet, 
     assert covariance[0] >= variance + reach * reach - 1e-6, (covariance[0], variance, reach)
     assert covariance[7] >= reach * reach - 1e-6, (covariance[7], reach)
     stop_and_settle(r)  # the link loss latched: settle resumes
+
+
+@pytest.mark.parametrize("port", PORTS)
+def test_after_a_silence_of_the_link_still_obeying_holds_until_resume(fleet, port):
+    """still_obeying's re-arm after a silence of the link, on purpose (under load it comes by
+    itself, mid-attack): the latch holds the chassis at rest while 0.3 m/s is asked, and resume
+    alone re-arms it."""
+    r = fleet(port)
+    drives(r, 0.3)
+    r.inject("silent 0.5")
+    drive_until(r, twist(0.3), lambda: (lambda s: s.rearm_required
+                                        and "link_lost" in s.latched_causes)(r.state()),
+                "link_lost latched")
+    still_obeying(r)

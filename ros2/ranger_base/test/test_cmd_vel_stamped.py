@@ -4,44 +4,19 @@ stamped twist older than cmd_vel_timeout is not obeyed (system_state: stale_comm
 library's words); a zero stamp means now. Judged by the virtual chassis's ground truth and by
 system_state, never by a wall-clock duration."""
 
-import itertools
 import os
 
 import pytest
 import rclpy
 from geometry_msgs.msg import Twist, TwistStamped
 
-from support import Client, Robot
-
-_ns = itertools.count(1)
-
-
-@pytest.fixture(scope="module", autouse=True)
-def ros():
-    rclpy.init()
-    yield
-    rclpy.shutdown()
+NS_PREFIX = "st"
 
 
 @pytest.fixture
-def client():
-    c = Client()
-    yield c
-    c.close()
-
-
-@pytest.fixture
-def robot(client, tmp_path):
-    started = []
-
-    def start(cmd_type=Twist, **params):
-        r = Robot(client, f"/st{os.getpid()}_{next(_ns)}", str(tmp_path), cmd_type=cmd_type,
-                  **params)
-        started.append(r)
-        return r
-    yield start
-    for r in started:
-        r.stop()
+def robot(robots):
+    """robot(cmd_type=Twist, **params): a node on `sim`."""
+    return lambda cmd_type=Twist, **params: robots("sim", cmd_type=cmd_type, **params)
 
 
 def stamped(client, vx, age=0.0, zero=False):

@@ -3,7 +3,6 @@ suite where it applies. Each test runs the node as owners do, in a process of it
 namespace of its own; discovery stays on this host (ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST and
 the stage's ROS_DOMAIN_ID, set by scripts/test_ros2.sh)."""
 
-import itertools
 import math
 import os
 import signal
@@ -11,44 +10,16 @@ import subprocess
 import time
 
 import pytest
-import rclpy
 
 import ranger_can
 from ranger_msgs.msg import SystemState
 from ranger_msgs.srv import ClearErrors, SetDriveMode, SetLights
 from std_srvs.srv import SetBool, Trigger
 
-from support import Client, Robot, node_executable, ros_args, yaw
-
-_ns = itertools.count(1)
+from support import node_executable, ros_args, yaw
 
 
-@pytest.fixture(scope="module", autouse=True)
-def ros():
-    rclpy.init()
-    yield
-    rclpy.shutdown()
-
-
-@pytest.fixture
-def client():
-    c = Client()
-    yield c
-    c.close()
-
-
-@pytest.fixture
-def robots(client, tmp_path):
-    started = []
-
-    def start(port="sim", **params):
-        r = Robot(client, f"/t{os.getpid()}_{next(_ns)}", str(tmp_path), port_name=port,
-                  **params)
-        started.append(r)
-        return r
-    yield start
-    for r in started:
-        r.stop()
+NS_PREFIX = "t"
 
 
 def drive(robot, vx=0.0, vy=0.0, wz=0.0, distance=None, angle=None):

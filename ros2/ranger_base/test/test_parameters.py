@@ -9,14 +9,7 @@ from rcl_interfaces.msg import ParameterType as PT
 from rclpy.parameter import Parameter
 
 import ranger_can
-from ranger_base import parameters
-
-
-@pytest.fixture(scope="module", autouse=True)
-def ros():
-    rclpy.init()
-    yield
-    rclpy.shutdown()
+from ranger_base import parameters, rclpy_fast
 
 
 def test_declared_names_are_the_librarys_table_and_diagnostic_period():
@@ -41,7 +34,7 @@ def test_descriptors_come_from_the_rows():
     assert parameters.default_of(rows["publish_rate"]) == 50.0
 
 
-def test_declaration_hands_the_library_what_was_given():
+def test_declaration_hands_the_library_what_was_given(ros):
     node = rclpy.create_node("declare_test", parameter_overrides=[
         Parameter("odom_frame", value="robot1/odom"), Parameter("tx_dlc", value=8),
         Parameter("linear.x.max_velocity", value=1.5), Parameter("diagnostic_period", value=2.0)])
@@ -57,5 +50,27 @@ def test_declaration_hands_the_library_what_was_given():
         assert set(parameters.declared_names()) <= declared_names
         with ranger_can.Driver("sim", params=declared.given, start=False) as d:
             assert d.settings["odom_frame"] == "robot1/odom"
+    finally:
+        node.destroy_node()
+
+
+@pytest.mark.parametrize("path", [rclpy_fast.FAST, rclpy_fast.PUBLIC])
+def test_each_path_hands_the_library_what_was_given_and_what_rclpy_refused(ros, monkeypatch,
+                                                                           path):
+    """The fast path reads rclpy's overrides; the public one the declared values and, for a value
+    rclpy refuses, a declaration without constraints: the library gets the same either way."""
+    monkeypatch.setattr(rclpy_fast, "_choice", rclpy_fast.Choice(path, "this test"))
+    node = rclpy.create_node(f"declare_{path}", parameter_overrides=[
+        Parameter("odom_frame", value="robot1/odom"), Parameter("tx_dlc", value=8),
+        Parameter("publish_rate", value=100.0), Parameter("wheelbase", value=0.6),
+        Parameter("cmd_vel_timeout", value=0.4)])
+    try:
+        declared = parameters.declare_all(node, f"/declare_{path}.")
+        assert declared.errors == []
+        assert declared.given == {"odom_frame": "robot1/odom", "tx_dlc": 8, "publish_rate": 100.0,
+                                  "wheelbase": 0.6, "cmd_vel_timeout": 0.4}, path
+        # The refused ones are declared nonetheless, with their descriptors.
+        assert node.describe_parameter("publish_rate").read_only is False
+        assert node.describe_parameter("tx_dlc").read_only is True
     finally:
         node.destroy_node()

@@ -10,8 +10,6 @@ fails, naming it."""
 import os
 import re
 
-import pytest
-import rclpy
 from rcl_interfaces.srv import ListParameters
 
 from support import Client, Robot
@@ -65,13 +63,6 @@ def ros1_interface():
 def ros2_type(ros1_type, kind):
     package, name = ros1_type.split("/")
     return f"{package}/{kind}/{name}"
-
-
-@pytest.fixture(scope="module")
-def ros():
-    rclpy.init()
-    yield
-    rclpy.shutdown()
 
 
 def test_readme_tables_parse():

@@ -5,49 +5,20 @@ the same answer are not logged again). rclpy keeps a logging call site's severit
 another there (ValueError, on Jazzy where Kilted's deprecated warn() hid it): an info answer
 after a warning one must still be answered and logged."""
 
-import itertools
-import os
-
 import pytest
-import rclpy
 from nav_msgs.msg import Odometry
 from ranger_msgs.msg import SystemState
 from ranger_msgs.srv import ClearErrors, SetDriveMode, SetLights, SetMotionMode, SetUltrasonic
 from std_srvs.srv import SetBool, Trigger
 
-from support import Client, Robot
-
-_ns = itertools.count(1)
-
-
-@pytest.fixture(scope="module", autouse=True)
-def ros():
-    rclpy.init()
-    yield
-    rclpy.shutdown()
+NS_PREFIX = "svc"
 
 
 @pytest.fixture
-def client():
-    c = Client()
-    yield c
-    c.close()
-
-
-@pytest.fixture
-def robot(client, tmp_path):
-    started = []
-
-    def start(port, **params):
-        r = Robot(client, f"/svc{os.getpid()}_{next(_ns)}", str(tmp_path), port_name=port,
-                  **params)
-        client.listen(f"{r.ns}/system_state", SystemState, keep=True)
-        client.listen(f"{r.ns}/odom", Odometry, keep=True)
-        started.append(r)
-        return r
-    yield start
-    for r in started:
-        r.stop()
+def robot(robots):
+    """robot(port, **params): a node whose states and odometry the client keeps, every one."""
+    return lambda port, **params: robots(
+        port, keep=[("system_state", SystemState), ("odom", Odometry)], **params)
 
 
 def count(r, topic):
