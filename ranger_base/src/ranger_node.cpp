@@ -467,9 +467,11 @@ void RangerNode::publication_loop() {
         const auto decision = motion.decide(*snapshot, now);
         waiting_for_snapshot = decision.wait_for_estimate;
         if (!waiting_for_snapshot) snapshot_wanted_ = false;
-        if (decision.publish()) {
-          publish_motion(*snapshot, decision);
-          if (sim_ && ground_truth_pub_.getNumSubscribers() > 0) publish_ground_truth();
+        if (decision.publish()) publish_motion(*snapshot, decision);
+        // The virtual chassis's truth at the motion rate, heard or not (as long as nothing is
+        // awaited): it moves on while the chassis is silent.
+        if (!waiting_for_snapshot && sim_ && ground_truth_pub_.getNumSubscribers() > 0) {
+          publish_ground_truth();
         }
       }
       if (states.due(now)) {
