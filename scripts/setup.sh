@@ -19,7 +19,7 @@ ros_pkgs=(ros-base-dev libroscpp-dev librostest-dev python3-rostest python3-rosl
   libdiagnostic-updater-dev libdiagnostic-aggregator-dev libdiagnostic-aggregator-tools
   ros-robot-state-publisher rviz liburdfdom-tools libeigen3-dev catkin rosbash
   libnodeletlib-dev libnodelet-dev libnodeletlib-tools python3-nodelet pluginlib-dev
-  libtf2-msgs-dev
+  libtf2-msgs-dev libtopic-tools-dev
   colcon python3-colcon-ros python3-colcon-cmake python3-colcon-bash python3-colcon-output
   python3-colcon-parallel-executor python3-colcon-package-selection
   python3-colcon-package-information python3-colcon-test-result python3-colcon-library-path
@@ -30,7 +30,7 @@ ros_pkgs=(ros-base-dev libroscpp-dev librostest-dev python3-rostest python3-rosl
 noetic_pkgs=(ros-noetic-ros-base ros-noetic-rostest ros-noetic-tf2-ros ros-noetic-tf2-geometry-msgs
   ros-noetic-nav-msgs ros-noetic-sensor-msgs ros-noetic-std-srvs ros-noetic-diagnostic-updater
   ros-noetic-diagnostic-aggregator ros-noetic-robot-state-publisher ros-noetic-rviz
-  ros-noetic-nodelet ros-noetic-pluginlib
+  ros-noetic-nodelet ros-noetic-pluginlib ros-noetic-topic-tools
   liburdfdom-tools libeigen3-dev python3-colcon-common-extensions python3-matplotlib)
 test_pkgs=(can-utils iproute2 kmod qemu-system-x86 linux-image-amd64 busybox-static cpio gzip
   xvfb xauth imagemagick clang libclang-rt-14-dev valgrind clang-format ccache)

@@ -112,5 +112,74 @@ TEST(Answers, AnInjectionIsLoggedAppliedOrRefusedWithTheValidCommands) {
   EXPECT_NE(refused.text.find("estop"), std::string::npos);
 }
 
+TEST(Answers, EveryRequestKindHasItsWordsForNotConfirmedInTime) {
+  using K = RequestOutcome::Kind;
+  auto sent = [](K kind, bool on = false) {
+    RequestOutcome o = outcome(State::kSent);
+    o.kind = kind;
+    o.on = on;
+    return request_answer(o);
+  };
+  EXPECT_EQ(sent(K::kPark, true).message, "park not confirmed in time (sent)");
+  EXPECT_EQ(sent(K::kPark, false).message, "release not confirmed in time (sent)");
+  EXPECT_EQ(sent(K::kLights).message, "the chassis did not report its lights in time (sent)");
+  EXPECT_EQ(sent(K::kUltrasonic).message,
+            "the chassis did not confirm the ultrasonic setting in time (sent)");
+  EXPECT_EQ(sent(K::kDriveMode).message, "drive mode not confirmed in time (sent)");
+  EXPECT_EQ(sent(K::kResume).message, "resume not applied (sent)");
+  EXPECT_FALSE(sent(K::kClearErrors).success);
+  RequestOutcome resumed = outcome(State::kAnswered);
+  resumed.kind = K::kResume;
+  EXPECT_EQ(request_answer(resumed).message, "re-armed: cmd_vel drives the chassis again");
+  RequestOutcome failed = outcome(State::kFailed, "park: unsupported by protocol manual");
+  failed.kind = K::kPark;
+  EXPECT_EQ(request_answer(failed).message, "park: unsupported by protocol manual");
+}
+
+TEST(Answers, TheServicesChecksRefuseBeforeSendingInOneWording) {
+  EXPECT_FALSE(ultrasonic_request_refused(true, false));
+  EXPECT_EQ(ultrasonic_request_refused(true, true)->message,
+            "contradictory request (enable and disable both true): set exactly one of them; "
+            "nothing sent");
+  EXPECT_EQ(ultrasonic_request_refused(false, false)->message,
+            "empty request (neither enable nor disable): set exactly one of them; nothing sent");
+
+  const auto lights = lights_request(2, 77, 3, 40);  // breathing (brightness ignored), custom 40
+  ASSERT_TRUE(lights.ok()) << lights.error().message;
+  EXPECT_EQ(lights->front, protocol::LightMode::kBreathing);
+  EXPECT_EQ(lights->front_brightness, 0);
+  EXPECT_EQ(lights->rear, protocol::LightMode::kCustom);
+  EXPECT_EQ(lights->rear_brightness, 40);
+  EXPECT_EQ(lights_request(7, 0, 1, 0).error().message,
+            "front_mode 7 is not one of 0 (OFF), 1 (ON), 2 (BREATHING), 3 (CUSTOM): nothing sent");
+  // A brightness is 0..100, in every front end and in the driver alike (one check).
+  EXPECT_EQ(lights_request(1, 0, 3, 101).error().message,
+            "rear_brightness 101 outside 0..100: nothing sent");
+  EXPECT_EQ(lights_request(protocol::LightMode::kCustom, 255, protocol::LightMode::kOn, 0)
+                .error()
+                .message,
+            "front_brightness 255 outside 0..100: nothing sent");
+  EXPECT_FALSE(lights_request(1, -1, 1, 0).ok());
+  EXPECT_TRUE(lights_request(3, 100, 3, 0).ok());
+
+  EXPECT_EQ(*drive_mode_request(1), protocol::DriveMode::kVoltage);
+  EXPECT_EQ(drive_mode_request(2).error().message,
+            "drive mode 2 is not one of 0 (CURRENT), 1 (VOLTAGE): nothing sent");
+}
+
+TEST(Answers, EachAnswerIsOneLogLineAtItsSeverityNamingTheServiceOnce) {
+  const auto ok = answer_line("resume", {true, "re-armed: cmd_vel drives the chassis again"});
+  EXPECT_EQ(ok.severity, Severity::kInfo);
+  EXPECT_EQ(ok.text, "resume: re-armed: cmd_vel drives the chassis again");
+  const auto refused = answer_line("park", {false, "park: unsupported by protocol manual"});
+  EXPECT_EQ(refused.severity, Severity::kWarn);
+  EXPECT_EQ(refused.text, "park: unsupported by protocol manual");  // not "park: park: ..."
+  EXPECT_EQ(answer_line("resume", {false, "resume refused: still active"}).text,
+            "resume refused: still active");
+  EXPECT_TRUE(is_answer_event(EventKind::kRequestSettled));
+  EXPECT_TRUE(is_answer_event(EventKind::kMotionModeRequested));
+  EXPECT_FALSE(is_answer_event(EventKind::kCommandRefused));
+}
+
 }  // namespace
 }  // namespace ranger

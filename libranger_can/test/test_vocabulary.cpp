@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <set>
 
 #include "ranger_can/control/vocabulary.hpp"
@@ -95,6 +96,77 @@ TEST(Vocabulary, WhichModesAProfileCanDrive) {
   EXPECT_TRUE(can_drive_in(MotionMode::kSideSlip, agx));
   EXPECT_FALSE(can_drive_in(MotionMode::kPark, agx));
   EXPECT_EQ(std::string(frame_name(protocol::kSystemStatusId)), "system_status");
+}
+
+// sensor_msgs/BatteryState as the library says it (both nodes map it): from the BMS while it
+// reports, the system status's voltage alone otherwise; status by the current's sign, health by
+// the first alarm of the table.
+TEST(Vocabulary, TheBatteryReportIsTheBmsOrTheSystemStatusVoltage) {
+  ChassisFeedback fb;
+  const auto none = battery_report(fb, Timestamp(10s));
+  EXPECT_FALSE(none.present);
+  EXPECT_EQ(none.status, PowerSupplyStatus::kUnknown);
+  EXPECT_EQ(none.health, PowerSupplyHealth::kUnknown);
+  EXPECT_TRUE(std::isnan(none.voltage));
+
+  fb.system_status.emplace();
+  fb.system_status->stamp = Timestamp(9s);
+  fb.system_status->value.battery_voltage = 51.5;
+  const auto status_only = battery_report(fb, Timestamp(10s));
+  EXPECT_TRUE(status_only.present);
+  EXPECT_EQ(status_only.stamp, Timestamp(9s));
+  EXPECT_DOUBLE_EQ(status_only.voltage, 51.5);
+  EXPECT_EQ(status_only.status, PowerSupplyStatus::kUnknown);
+
+  BmsData pack;
+  pack.voltage = 52.0;
+  pack.current = -3.0;
+  pack.soc = 150.0;  // clamped to 1
+  pack.temperature = 25.0;
+  fb.bms[0] = Stamped<BmsData>{pack, Timestamp(10s), Timestamp(8s)};
+  BmsData slot;
+  slot.voltage = 13.0;
+  slot.temperature = 24.0;
+  fb.bms[2] = Stamped<BmsData>{slot, Timestamp(10s), Timestamp(8s)};
+  auto r = battery_report(fb, Timestamp(10s));
+  EXPECT_EQ(r.stamp, Timestamp(8s));
+  EXPECT_DOUBLE_EQ(r.voltage, 52.0);
+  EXPECT_DOUBLE_EQ(r.percentage, 1.0);
+  EXPECT_EQ(r.status, PowerSupplyStatus::kDischarging);
+  EXPECT_EQ(r.health, PowerSupplyHealth::kGood);
+  EXPECT_TRUE(std::isnan(r.cell_voltage[0]));
+  EXPECT_DOUBLE_EQ(r.cell_voltage[1], 13.0);
+  EXPECT_DOUBLE_EQ(r.cell_temperature[1], 24.0);
+
+  EXPECT_EQ(power_supply_status(2.0), PowerSupplyStatus::kCharging);
+  EXPECT_EQ(power_supply_status(0.0), PowerSupplyStatus::kNotCharging);
+  namespace b = protocol::bms_status;
+  EXPECT_EQ(power_supply_health(b::kOverVoltage | b::kLowTemperature, 0),
+            PowerSupplyHealth::kOvervoltage);
+  EXPECT_EQ(power_supply_health(b::kHighTemperature, 0), PowerSupplyHealth::kOverheat);
+  EXPECT_EQ(power_supply_health(b::kLowTemperature, 0), PowerSupplyHealth::kCold);
+  EXPECT_EQ(power_supply_health(0, b::kChargeOverCurrent), PowerSupplyHealth::kUnspecFailure);
+  EXPECT_EQ(power_supply_health(b::kUnderVoltage, 0), PowerSupplyHealth::kUnspecFailure);
+  EXPECT_EQ(power_supply_health(0, 0), PowerSupplyHealth::kGood);
+}
+
+// sensor_msgs/Range's value (REP-117): a distance, NaN for no reading, +inf for nothing seen.
+TEST(Vocabulary, ARangeBeyondMaxRangeIsNothingSeen) {
+  const double d = ultrasonic_range(100);
+  ASSERT_TRUE(std::isfinite(d));
+  EXPECT_DOUBLE_EQ(range_reading(100, d + 0.01), d);
+  EXPECT_EQ(range_reading(100, d - 0.01), std::numeric_limits<double>::infinity());
+  EXPECT_TRUE(std::isnan(range_reading(0, 5.0)));   // no reading
+  EXPECT_TRUE(std::isnan(range_reading(-1, 5.0)));  // offline
+}
+
+TEST(Vocabulary, ThePoseCovarianceIsTheFloorPlusTheVariance) {
+  const auto c = pose_covariance({1.0, 2.0, 3.0}, {10, 20, 30, 40, 50, 60});
+  EXPECT_DOUBLE_EQ(c[0], 11.0);
+  EXPECT_DOUBLE_EQ(c[7], 22.0);
+  EXPECT_DOUBLE_EQ(c[14], 30.0);
+  EXPECT_DOUBLE_EQ(c[35], 63.0);
+  EXPECT_DOUBLE_EQ(c[1], 0.0);
 }
 
 }  // namespace

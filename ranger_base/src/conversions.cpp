@@ -8,6 +8,7 @@
 #include <limits>
 
 #include <ranger_can/control/geometry.hpp>
+#include <ranger_can/frontend/answers.hpp>
 #include <ranger_can/text.hpp>
 
 namespace ranger_base {
@@ -108,13 +109,6 @@ geometry_msgs::TransformStamped to_transform(const nav_msgs::Odometry& odometry)
   out.transform.translation.z = odometry.pose.pose.position.z;
   out.transform.rotation = odometry.pose.pose.orientation;
   return out;
-}
-
-Timestamp joints_stamp(const ranger::ChassisFeedback& feedback) {
-  Timestamp t{0};
-  if (feedback.steering_angles) t = std::max(t, feedback.steering_angles->stamp);
-  if (feedback.wheel_speeds) t = std::max(t, feedback.wheel_speeds->stamp);
-  return t;
 }
 
 sensor_msgs::JointState to_joint_state(const ranger::WheelJoints& joints, const ros::Time& stamp) {
@@ -324,29 +318,7 @@ ranger_msgs::RemoteState to_remote_state(const ranger::RemoteState& remote,
 }
 
 ranger::Result<ranger::LightsRequest> to_lights_request(const ranger_msgs::SetLights::Request& r) {
-  ranger::LightsRequest out;
-  const struct {
-    const char* name;
-    std::uint8_t mode, brightness;
-    ranger::LightMode* out_mode;
-    std::uint8_t* out_brightness;
-  } lights[] = {{"front", r.front_mode, r.front_brightness, &out.front, &out.front_brightness},
-                {"rear", r.rear_mode, r.rear_brightness, &out.rear, &out.rear_brightness}};
-  for (const auto& l : lights) {
-    if (l.mode > ranger_msgs::SetLights::Request::CUSTOM) {
-      return ranger::Error{ranger::Errc::kInvalidArgument,
-                           std::string(l.name) + "_mode " + std::to_string(l.mode) +
-                               " is not a light mode (OFF 0, ON 1, BREATHING 2, CUSTOM 3)"};
-    }
-    if (l.brightness > 100) {
-      return ranger::Error{
-          ranger::Errc::kInvalidArgument,
-          std::string(l.name) + "_brightness " + std::to_string(l.brightness) + " is above 100"};
-    }
-    *l.out_mode = static_cast<ranger::LightMode>(l.mode);
-    *l.out_brightness = l.mode == ranger_msgs::SetLights::Request::CUSTOM ? l.brightness : 0;
-  }
-  return out;
+  return ranger::lights_request(r.front_mode, r.front_brightness, r.rear_mode, r.rear_brightness);
 }
 
 void fill_lights_response(const std::optional<ranger::LightsState>& lights,
@@ -420,56 +392,30 @@ ranger_msgs::BmsStateArray to_bms_state(const ranger::ChassisFeedback& feedback,
 
 sensor_msgs::BatteryState to_battery_state(const ranger::ChassisFeedback& fb, Timestamp now,
                                            const ros::Time& stamp) {
+  // What the library says of the pack (ranger::battery_report), field for field.
   using sensor_msgs::BatteryState;
+  static_assert(BatteryState::POWER_SUPPLY_STATUS_DISCHARGING ==
+                static_cast<int>(ranger::PowerSupplyStatus::kDischarging));
+  static_assert(BatteryState::POWER_SUPPLY_HEALTH_COLD ==
+                static_cast<int>(ranger::PowerSupplyHealth::kCold));
+  const ranger::BatteryReport r = ranger::battery_report(fb, now);
   BatteryState out;
-  out.header.stamp = stamp;
-  out.voltage = out.current = out.temperature = out.charge = out.capacity = out.percentage = kNaN;
+  out.header.stamp = r.stamp.count() > 0 ? to_ros_time(r.stamp) : stamp;
+  out.present = r.present;
+  out.voltage = static_cast<float>(r.voltage);
+  out.current = static_cast<float>(r.current);
+  out.temperature = static_cast<float>(r.temperature);
+  out.percentage = static_cast<float>(r.percentage);
+  out.charge = out.capacity = kNaN;
   out.design_capacity = kNaN;  // 24 Ah per battery, but how many are fitted is not reported
-  out.power_supply_status = BatteryState::POWER_SUPPLY_STATUS_UNKNOWN;
-  out.power_supply_health = BatteryState::POWER_SUPPLY_HEALTH_UNKNOWN;
+  out.power_supply_status = static_cast<std::uint8_t>(r.status);
+  out.power_supply_health = static_cast<std::uint8_t>(r.health);
   static_assert(ranger::vehicle_spec::kBatteryChemistry == "LiFePO4");
   out.power_supply_technology = BatteryState::POWER_SUPPLY_TECHNOLOGY_LIFE;
   out.location = "pack";
-
-  const auto& pack = fb.bms[0];
-  if (ranger::bms_present(fb, 0, now)) {
-    out.header.stamp = to_ros_time(pack->stamp);
-    out.present = true;
-    out.voltage = static_cast<float>(pack->value.voltage);
-    out.current = static_cast<float>(pack->value.current);
-    out.temperature = static_cast<float>(pack->value.temperature);
-    out.percentage = static_cast<float>(std::clamp(pack->value.soc / 100.0, 0.0, 1.0));
-    // sensor_msgs/BatteryState: current negative while discharging, as the BMS reports it.
-    if (pack->value.current > 0.0) {
-      out.power_supply_status = BatteryState::POWER_SUPPLY_STATUS_CHARGING;
-    } else if (pack->value.current < 0.0) {
-      out.power_supply_status = BatteryState::POWER_SUPPLY_STATUS_DISCHARGING;
-    } else {
-      out.power_supply_status = BatteryState::POWER_SUPPLY_STATUS_NOT_CHARGING;
-    }
-    out.power_supply_health = BatteryState::POWER_SUPPLY_HEALTH_GOOD;
-    if (const auto& alarm = fb.bms_alarm[0]) {
-      const auto flags = to_bms_flags(alarm->value.alarm1, alarm->value.alarm2);
-      if (flags.over_voltage) {
-        out.power_supply_health = BatteryState::POWER_SUPPLY_HEALTH_OVERVOLTAGE;
-      } else if (flags.high_temperature) {
-        out.power_supply_health = BatteryState::POWER_SUPPLY_HEALTH_OVERHEAT;
-      } else if (flags.low_temperature) {
-        out.power_supply_health = BatteryState::POWER_SUPPLY_HEALTH_COLD;
-      } else if (flags.under_voltage || flags.discharge_over_current || flags.charge_over_current) {
-        out.power_supply_health = BatteryState::POWER_SUPPLY_HEALTH_UNSPEC_FAILURE;
-      }
-    }
-  } else if (const auto& status = fb.system_status) {
-    out.header.stamp = to_ros_time(status->stamp);
-    out.present = true;  // the chassis runs, so it has a battery; the BMS is not reporting
-    out.voltage = static_cast<float>(status->value.battery_voltage);
-  }
-  for (int b = 1; b <= ranger::kBatteryCount; ++b) {
-    const auto& slot = fb.bms[static_cast<std::size_t>(b)];
-    const bool present = ranger::bms_present(fb, b, now);
-    out.cell_voltage.push_back(present ? static_cast<float>(slot->value.voltage) : kNaN);
-    out.cell_temperature.push_back(present ? static_cast<float>(slot->value.temperature) : kNaN);
+  for (std::size_t b = 0; b < r.cell_voltage.size(); ++b) {
+    out.cell_voltage.push_back(static_cast<float>(r.cell_voltage[b]));
+    out.cell_temperature.push_back(static_cast<float>(r.cell_temperature[b]));
   }
   return out;
 }
@@ -492,10 +438,7 @@ sensor_msgs::Range to_range(int sensor, std::int16_t raw, const NodeParameters& 
   out.field_of_view = static_cast<float>(u.field_of_view);
   out.min_range = static_cast<float>(u.min_range);
   out.max_range = static_cast<float>(u.max_range);
-  out.range = ultrasonic_range_m(raw);
-  if (std::isfinite(out.range) && out.range > u.max_range) {
-    out.range = std::numeric_limits<float>::infinity();
-  }
+  out.range = static_cast<float>(ranger::range_reading(raw, u.max_range));
   return out;
 }
 

@@ -21,6 +21,7 @@
 #include <string>
 
 #include <ranger_can/frontend/answers.hpp>
+#include <ranger_can/frontend/publication.hpp>
 #include <ranger_can/sim/chassis_commands.hpp>
 #include <ranger_can/text.hpp>
 #include <ranger_can/transport/bus_source.hpp>
@@ -41,7 +42,6 @@ const ranger::Clock& bus_clock() {
   static const ranger::SystemClock clock;
   return clock;
 }
-
 
 // A service answer from the library's words onto a ROS response.
 template <class Response>
@@ -76,26 +76,15 @@ void log_event(const ranger::DriverEvent& event) {
   log_at(event.severity, ranger::describe(event));
 }
 
-// A publication is due from this long before its time (the estimates come with the driver's
-// iterations, which jitter), never more than a quarter of its period.
-std::chrono::steady_clock::duration early_margin(std::chrono::steady_clock::duration period) {
-  return std::min<std::chrono::steady_clock::duration>(std::chrono::milliseconds(5), period / 4);
+// A service's answer onto its response, and its one log line (the library's words; the driver's
+// events that are the same answer are not logged besides: log_events).
+template <class Response>
+bool answer(std::string_view service, const ranger::ServiceAnswer& said, Response& res) {
+  const auto line = ranger::answer_line(service, said);
+  log_at(line.severity, line.text);
+  return respond(said, res);
 }
 
-std::chrono::steady_clock::duration period_of(double rate_hz) {
-  return std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-      std::chrono::duration<double>(1.0 / rate_hz));
-}
-
-// A fixed-rate schedule: the next publication is due one period after the previous due time, so
-// the average rate is the configured one; after a stall it restarts from now instead of
-// publishing a burst.
-void advance(std::chrono::steady_clock::time_point& next,
-             std::chrono::steady_clock::duration period,
-             std::chrono::steady_clock::time_point now) {
-  next += period;
-  if (next < now) next = now + period;
-}
 }  // namespace
 
 ranger::Result<std::unique_ptr<RangerNode>> RangerNode::create(const ros::NodeHandle& nh,
@@ -178,10 +167,7 @@ void RangerNode::start() {
   driver_->start();
   publication_thread_ = std::thread([this] { publication_loop(); });
 
-  // Latest command wins: a queue of one drops stale twists under a flood instead of replaying
-  // them late; TCP_NODELAY keeps the latency down.
-  cmd_vel_sub_ = cmd_nh_.subscribe("cmd_vel", 1, &RangerNode::on_cmd_vel, this,
-                                   ros::TransportHints().tcpNoDelay());
+  subscribe_cmd_vel();
   if (sim_) {
     sim_inject_sub_ = service_nh_.subscribe("sim/inject", 10, &RangerNode::on_sim_inject, this);
   }
@@ -217,7 +203,12 @@ void RangerNode::shutdown() {
   if (shut_down_) return;
   shut_down_ = true;
   // Commands stop first: no cmd_vel may restart the chassis after the stop.
-  cmd_vel_sub_.shutdown();
+  cmd_vel_type_timer_.stop();
+  {
+    std::lock_guard<std::mutex> lock(cmd_vel_sub_mutex_);
+    cmd_vel_closed_ = true;
+    cmd_vel_sub_.shutdown();
+  }
   sim_inject_sub_.shutdown();
   driver_->stop();  // the zero motion command (an event says it), then the driver thread ends
   publication_stop_ = true;
@@ -233,11 +224,104 @@ void RangerNode::shutdown() {
 // ---- callbacks
 // -----------------------------------------------------------------------------------
 
+namespace {
+constexpr const char* kTwistType = "geometry_msgs/Twist";
+constexpr const char* kTwistStampedType = "geometry_msgs/TwistStamped";
+}  // namespace
+
+void RangerNode::subscribe_cmd_vel() {
+  // Latest command wins: a queue of one drops stale twists under a flood instead of replaying
+  // them late; TCP_NODELAY keeps the latency down.
+  const auto hints = ros::TransportHints().tcpNoDelay();
+  const char* taken = "";
+  switch (params_.cmd_vel_stamped) {
+    case ranger::CmdVelStamped::kPlain:
+      cmd_vel_sub_ = cmd_nh_.subscribe("cmd_vel", 1, &RangerNode::on_cmd_vel, this, hints);
+      taken = "geometry_msgs/Twist (cmd_vel_stamped false)";
+      break;
+    case ranger::CmdVelStamped::kStamped:
+      cmd_vel_sub_ = cmd_nh_.subscribe("cmd_vel", 1, &RangerNode::on_cmd_vel_stamped, this, hints);
+      taken = "geometry_msgs/TwistStamped (cmd_vel_stamped true)";
+      break;
+    case ranger::CmdVelStamped::kAuto:
+      // Any type: each message is read as the type its publisher declares, Twist or TwistStamped.
+      cmd_vel_sub_ = cmd_nh_.subscribe("cmd_vel", 1, &RangerNode::on_cmd_vel_any, this, hints);
+      cmd_vel_type_timer_ = service_nh_.createTimer(
+          ros::Duration(0.25), [this](const ros::TimerEvent&) { recheck_cmd_vel_type(); });
+      taken =
+          "the type of its publishers, geometry_msgs/Twist or geometry_msgs/TwistStamped "
+          "(cmd_vel_stamped auto: no publisher yet; said again when one appears)";
+      break;
+  }
+  ROS_INFO("cmd_vel: taken as %s", taken);
+}
+
+void RangerNode::recheck_cmd_vel_type() {
+  const int taken = cmd_vel_type_.load();
+  if (taken == 0) return;  // nothing taken yet: the first publisher's type is taken
+  // The type taken still comes (a subscription of any type keeps a link to a publisher of the
+  // other type, refused, so its publisher count says nothing).
+  const auto quiet = std::chrono::steady_clock::now().time_since_epoch() -
+                     std::chrono::nanoseconds(last_cmd_vel_ns_.load());
+  if (quiet < std::chrono::milliseconds(500)) return;
+  ros::master::V_TopicInfo topics;
+  if (!ros::master::getTopics(topics)) return;
+  const std::string topic = cmd_nh_.resolveName("cmd_vel");
+  const auto published =
+      std::find_if(topics.begin(), topics.end(), [&](const auto& t) { return t.name == topic; });
+  if (published == topics.end()) return;  // no publisher at all
+  const int other = taken == 1 ? 2 : 1;
+  if (published->datatype != (other == 1 ? kTwistType : kTwistStampedType)) return;
+  std::lock_guard<std::mutex> lock(cmd_vel_sub_mutex_);
+  if (cmd_vel_closed_) return;
+  // A subscription of any type again: the new publisher's type is taken (and said). The old one
+  // ends first: a second subscription of the topic would join its (typed) connection.
+  cmd_vel_type_ = 0;
+  cmd_vel_sub_.shutdown();
+  cmd_vel_sub_ = cmd_nh_.subscribe("cmd_vel", 1, &RangerNode::on_cmd_vel_any, this,
+                                   ros::TransportHints().tcpNoDelay());
+}
+
 void RangerNode::on_cmd_vel(const geometry_msgs::Twist::ConstPtr& msg) {
+  drive(*msg, std::nullopt);
+}
+
+void RangerNode::on_cmd_vel_stamped(const geometry_msgs::TwistStamped::ConstPtr& msg) {
+  drive(msg->twist, msg->header.stamp);
+}
+
+void RangerNode::on_cmd_vel_any(const topic_tools::ShapeShifter::ConstPtr& msg) {
+  const std::string& type = msg->getDataType();
+  const int kind = type == kTwistType ? 1 : type == kTwistStampedType ? 2 : 0;
+  if (kind == 0) {
+    ROS_WARN_THROTTLE(5.0, "cmd_vel: a %s is neither %s nor %s: not obeyed", type.c_str(),
+                      kTwistType, kTwistStampedType);
+    return;
+  }
+  last_cmd_vel_ns_ = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                         std::chrono::steady_clock::now().time_since_epoch())
+                         .count();
+  if (cmd_vel_type_.exchange(kind) != kind) {
+    ROS_INFO("cmd_vel: taken as %s (cmd_vel_stamped auto: the type of its publishers)",
+             type.c_str());
+  }
+  if (kind == 1) {
+    drive(*msg->instantiate<geometry_msgs::Twist>(), std::nullopt);
+  } else {
+    const auto stamped = msg->instantiate<geometry_msgs::TwistStamped>();
+    drive(stamped->twist, stamped->header.stamp);
+  }
+}
+
+void RangerNode::drive(const geometry_msgs::Twist& twist, std::optional<ros::Time> stamp) {
   // All six fields go to the driver: the library refuses a NaN or an infinity in any of them. A
-  // refusal (NaN, not connected) is the driver's event, logged with the others.
-  const ranger::Status st = driver_->command(to_motion_request(*msg));
-  if (st && has_non_planar_components(*msg)) {
+  // refusal (NaN, not connected, a stale stamp) is the driver's event, logged with the others.
+  ranger::MotionRequest request = to_motion_request(twist);
+  if (stamp && !stamp->isZero()) {  // a zero stamp means now
+    request.age = std::chrono::nanoseconds((ros::Time::now() - *stamp).toNSec());
+  }
+  const ranger::Status st = driver_->command(request);
+  if (st && has_non_planar_components(twist)) {
     ROS_WARN_THROTTLE(5.0, "cmd_vel: linear.z, angular.x and angular.y are ignored (planar base)");
   }
 }
@@ -273,42 +357,33 @@ void RangerNode::on_sim_inject(const std_msgs::String::ConstPtr& msg) {
 }
 
 bool RangerNode::on_resume(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
-  // (The outcome is logged as the driver's event.)
-  auto answer = ranger::resume_refused_offline(*driver_->snapshot(), params_.port_name);
-  if (answer) ROS_WARN("%s", answer->message.c_str());
-  if (!answer) answer = ranger::resume_answer(wait_for(driver_->resume(), Kind::kResume));
-  return respond(*answer, res);
+  auto refused = ranger::resume_refused_offline(*driver_->snapshot(), params_.port_name);
+  return answer(
+      "resume",
+      refused ? *refused : ranger::request_answer(wait_for(driver_->resume(), Kind::kResume)), res);
 }
 
 bool RangerNode::on_clear_errors(ranger_msgs::ClearErrors::Request& req,
                                  ranger_msgs::ClearErrors::Response& res) {
   const auto posted = driver_->clear_errors(req.code);
   res.error_word = driver_->snapshot()->controller.error_bits;
-  if (!posted) return respond({false, posted.error().message}, res);
+  if (!posted) return answer("clear_errors", {false, posted.error().message}, res);
   const auto outcome = wait_for(*posted, Kind::kClearErrors);
-  const auto answer =
+  const auto answered =
       ranger::clear_errors_answer(req.code, outcome, driver_->snapshot()->profile.error_word);
   res.error_word =
-      answer.success ? *outcome.error_word : driver_->snapshot()->controller.error_bits;
-  return respond(answer, res);
+      answered.success ? *outcome.error_word : driver_->snapshot()->controller.error_bits;
+  return answer("clear_errors", answered, res);
 }
 
 bool RangerNode::on_set_ultrasonic(ranger_msgs::SetUltrasonic::Request& req,
                                    ranger_msgs::SetUltrasonic::Response& res) {
-  const auto known = driver_->snapshot()->controller.ultrasonic_enabled;
-  res.enabled = known.value_or(false);
-  if (req.enable == req.disable) {
-    res.success = false;
-    res.message = std::string(req.enable ? "contradictory request (enable and disable both true)"
-                                         : "empty request (neither enable nor disable)") +
-                  ": set exactly one of them; nothing sent";
-    return true;
-  }
-  const auto outcome = wait_for(driver_->set_ultrasonic(req.enable), Kind::kUltrasonic);
+  const auto refused = ranger::ultrasonic_request_refused(req.enable, req.disable);
+  const auto answered = refused ? *refused
+                                : ranger::request_answer(wait_for(
+                                      driver_->set_ultrasonic(req.enable), Kind::kUltrasonic));
   res.enabled = driver_->snapshot()->controller.ultrasonic_enabled.value_or(false);
-  return respond(
-      ranger::answer_of(outcome, "the chassis did not confirm the ultrasonic setting in time"),
-      res);
+  return answer("set_ultrasonic", answered, res);
 }
 
 bool RangerNode::on_set_motion_mode(ranger_msgs::SetMotionMode::Request& req,
@@ -316,63 +391,48 @@ bool RangerNode::on_set_motion_mode(ranger_msgs::SetMotionMode::Request& req,
   const auto& numbers = ranger::motion_mode_numbers();
   const auto known = std::find_if(numbers.begin(), numbers.end(),
                                   [&](const auto& n) { return n.first == req.mode; });
-  ranger::ServiceAnswer answer{false, ""};
+  ranger::ServiceAnswer answered{false, ""};
   if (known == numbers.end()) {
-    answer.message = ranger::unknown_motion_mode_number(req.mode, driver_->snapshot()->profile);
+    answered.message = ranger::unknown_motion_mode_number(req.mode, driver_->snapshot()->profile);
   } else if (const ranger::Status st = driver_->set_motion_mode(known->second); !st) {
-    answer.message = st.error().message;
+    answered.message = st.error().message;
   } else {
-    answer = {true, ranger::motion_mode_pinned(known->second)};
+    answered = {true, ranger::motion_mode_pinned(known->second)};
   }
-  if (!answer.success) ROS_WARN("set_motion_mode: %s", answer.message.c_str());
-  return respond(answer, res);
+  return answer("set_motion_mode", answered, res);
 }
 
 bool RangerNode::on_set_lights(ranger_msgs::SetLights::Request& req,
                                ranger_msgs::SetLights::Response& res) {
-  res.success = false;
-  const auto wanted = to_lights_request(req);
+  ranger::ServiceAnswer answered{false, ""};
+  const auto wanted = ranger::lights_request(req.front_mode, req.front_brightness, req.rear_mode,
+                                             req.rear_brightness);
   if (!wanted) {
-    res.message = wanted.error().message + ": nothing sent";
-    fill_lights_response(driver_->snapshot()->lights, res);
-    return true;
+    answered.message = wanted.error().message;
+  } else if (const auto posted = driver_->set_lights(*wanted); !posted) {
+    answered.message = posted.error().message;
+  } else {
+    answered = ranger::request_answer(wait_for(*posted, Kind::kLights));
   }
-  const auto posted = driver_->set_lights(*wanted);
-  if (!posted) {
-    res.message = posted.error().message;
-    return true;
-  }
-  respond(ranger::answer_of(wait_for(*posted, Kind::kLights),
-                            "the chassis did not report its lights in time"),
-          res);
   fill_lights_response(driver_->snapshot()->lights, res);
-  return true;
+  return answer("set_lights", answered, res);
 }
 
 bool RangerNode::on_park(std_srvs::SetBool::Request& req, std_srvs::SetBool::Response& res) {
-  const auto outcome = wait_for(driver_->set_park(req.data), Kind::kPark);
-  return respond(ranger::answer_of(outcome, std::string(req.data ? "park" : "release") +
-                                                " not confirmed in time"),
-                 res);
+  return answer("park", ranger::request_answer(wait_for(driver_->set_park(req.data), Kind::kPark)),
+                res);
 }
 
 bool RangerNode::on_set_drive_mode(ranger_msgs::SetDriveMode::Request& req,
                                    ranger_msgs::SetDriveMode::Response& res) {
-  res.success = false;
-  const auto mode = ranger::drive_mode_from_wire(req.mode);
-  if (!mode) {
-    res.message = "drive mode " + std::to_string(req.mode) +
-                  " is not one of 0 (CURRENT), 1 (VOLTAGE): nothing sent";
-  } else {
-    respond(ranger::answer_of(wait_for(driver_->set_drive_mode(*mode), Kind::kDriveMode),
-                              "drive mode not confirmed in time"),
-            res);
-  }
+  const auto mode = ranger::drive_mode_request(req.mode);
+  const auto answered =
+      !mode ? ranger::ServiceAnswer{false, mode.error().message}
+            : ranger::request_answer(wait_for(driver_->set_drive_mode(*mode), Kind::kDriveMode));
   const auto reported = driver_->snapshot()->drive_mode;
   res.drive_mode = ranger_msgs::SystemState::DRIVE_MODE_NONE;
   if (reported) res.drive_mode = static_cast<std::uint8_t>(*reported);
-  if (!res.success) ROS_WARN("set_drive_mode: %s", res.message.c_str());
-  return true;
+  return answer("set_drive_mode", answered, res);
 }
 
 // ---- publishing
@@ -381,54 +441,55 @@ bool RangerNode::on_set_drive_mode(ranger_msgs::SetDriveMode::Request& req,
 void RangerNode::publication_loop() {
   ::pthread_setname_np(::pthread_self(), "ranger_publish");
   using Clock = std::chrono::steady_clock;
-  const auto motion_period = period_of(params_.publish_rate);
-  const auto state_period = period_of(params_.state_publish_rate);
-  const auto diagnostics_period = period_of(1.0);
-  const auto motion_early = early_margin(motion_period);
-  const auto state_early = early_margin(state_period);
+  // The library's schedules (frontend/publication.hpp), as the ROS 2 node paces its own.
+  ranger::MotionPacer motion(params_.publish_rate);
+  ranger::PublicationSchedule states(params_.state_publish_rate);
+  ranger::PublicationSchedule diagnostics(1.0);
   const auto start = Clock::now();
-  next_motion_publication_ = next_state_publication_ = next_diagnostics_publication_ = start;
+  motion.start(start);
+  states.start(start);
+  diagnostics.start(start);
   bool waiting_for_snapshot = false;  // motion is due, the latest snapshot had nothing new
   while (!publication_stop_) {
     try {
       log_events();
       publish_sent();
       const auto now = Clock::now();
-      const bool motion_heard = motion_has_subscribers();
-      if (now >= next_motion_publication_ - motion_early && !motion_heard) {
+      if (motion.due(now) && !motion_has_subscribers()) {
         // Nobody listens: nothing is built, and the thread sleeps until the states are due
         // (which see a new subscriber within one state period).
         waiting_for_snapshot = false;
-        advance(next_motion_publication_, motion_period, now);
-      } else if (now >= next_motion_publication_ - motion_early) {
+        motion.skip(now);
+      } else if (motion.due(now)) {
         // Wanted before the snapshot is read: an iteration that ends meanwhile wakes us.
         snapshot_wanted_ = true;
-        if (publish_motion(*driver_->snapshot())) {
-          snapshot_wanted_ = false;
-          waiting_for_snapshot = false;
-          if (sim_ && ground_truth_pub_.getNumSubscribers() > 0) publish_ground_truth();
-          advance(next_motion_publication_, motion_period, now);
-        } else {
-          waiting_for_snapshot = true;
+        const auto snapshot = driver_->snapshot();
+        const auto decision = motion.decide(*snapshot, now);
+        waiting_for_snapshot = decision.wait_for_estimate;
+        if (!waiting_for_snapshot) snapshot_wanted_ = false;
+        if (decision.publish()) publish_motion(*snapshot, decision);
+        // The virtual chassis's truth at the motion rate, heard or not (as long as nothing is
+        // awaited): it moves on while the chassis is silent.
+        if (!waiting_for_snapshot && sim_ && ground_truth_pub_.getNumSubscribers() > 0) {
+          publish_ground_truth();
         }
       }
-      if (now >= next_state_publication_ - state_early) {
+      if (states.due(now)) {
         publish_states();
-        advance(next_state_publication_, state_period, now);
+        states.advance(now);
       }
-      if (now >= next_diagnostics_publication_) {
+      if (diagnostics.due(now)) {
         publish_diagnostics();
-        advance(next_diagnostics_publication_, diagnostics_period, now);
+        diagnostics.advance(now);
       }
     } catch (const std::exception& e) {  // nothing may escape the thread
       ROS_ERROR_THROTTLE(5.0, "publishing failed: %s", e.what());
     }
     // Until the next publication is due, a frame was sent, or (motion due) the driver's next
     // iteration.
-    auto until = std::min(next_state_publication_ - state_early, next_diagnostics_publication_);
-    if (!waiting_for_snapshot && motion_has_subscribers()) {
-      until = std::min(until, next_motion_publication_ - motion_early);
-    }
+    auto until = std::min(states.wake_at(), diagnostics.wake_at());
+    if (!waiting_for_snapshot && motion_has_subscribers())
+      until = std::min(until, motion.wake_at());
     publication_waker_.sleep_until(ranger::Timestamp(until.time_since_epoch()));
   }
   try {
@@ -449,14 +510,12 @@ void RangerNode::publish_sent() {
     publish_shared(cmd_vel_out_pub_, to_twist_stamped(t.twist, t.stamp, params_.base_frame));
 }
 
-bool RangerNode::publish_motion(const ranger::DriverSnapshot& s) {
-  // Publish only what is known: nothing while the chassis is not heard (never, or link lost),
-  // and each estimate once, stamped with the time of the frames that produced it.
-  // A message is built only for a topic with a subscriber (in this process or another).
-  if (!s.motion_known) return true;  // nothing to wait for
-  bool published = false;
-  if (s.odometry.stamp > last_odom_stamp_) {
-    last_odom_stamp_ = s.odometry.stamp;
+void RangerNode::publish_motion(const ranger::DriverSnapshot& s,
+                                const ranger::MotionDecision& decision) {
+  // Each estimate once (the library's MotionPacer decides), stamped with the time of the frames
+  // that produced it; a message is built only for a topic with a subscriber (in this process or
+  // another).
+  if (decision.odometry) {
     const bool odom_heard = odom_pub_.getNumSubscribers() > 0;
     const bool tf_heard = tf_pub_ && tf_pub_.getNumSubscribers() > 0;
     if (odom_heard || tf_heard) {
@@ -468,16 +527,12 @@ bool RangerNode::publish_motion(const ranger::DriverSnapshot& s) {
       }
       if (odom_heard) odom_pub_.publish(odom);
     }
-    published = true;
   }
-  const ranger::Timestamp joints = joints_stamp(s.feedback);
-  if ((s.joints.has_steering || s.joints.has_wheels) && joints > last_joints_stamp_) {
-    last_joints_stamp_ = joints;
-    publish_if_heard(joint_state_pub_,
-                     [&] { return to_joint_state(s.joints, to_ros_time(joints)); });
-    published = true;
+  if (decision.joints) {
+    publish_if_heard(joint_state_pub_, [&] {
+      return to_joint_state(s.joints, to_ros_time(ranger::joints_stamp(s.feedback)));
+    });
   }
-  return published;
 }
 
 bool RangerNode::motion_has_subscribers() const {
@@ -530,7 +585,8 @@ void RangerNode::log_events() {
     ROS_WARN("%" PRIu64 " driver events were not logged (the log fell behind)", missed);
   for (const ranger::DriverEvent& e : events_) {
     logged_event_ = e.sequence;
-    log_event(e);
+    // A service's answer is logged once, as the answer (answer()), not as the driver's event too.
+    if (!ranger::is_answer_event(e.kind)) log_event(e);
   }
 }
 

@@ -100,6 +100,7 @@ def test_minimal_on_can0_by_default():
     assert p["/ranger_base_node/base_frame"] == "base_footprint"  # the URDF's root
     assert p["/ranger_base_node/frame_prefix"] == ""
     assert p["/ranger_base_node/publish_odom_tf"] is True
+    assert p["/ranger_base_node/cmd_vel_stamped"] == "auto"  # the node's default
     # The RANGER, its protocol settings identified from the chassis, no commissioning file.
     assert p["/ranger_base_node/model"] == "ranger"
     assert p["/ranger_base_node/protocol"] == "auto"
@@ -110,9 +111,11 @@ def test_minimal_on_can0_by_default():
 
 
 def test_minimal_arguments_reach_the_node():
-    p = params("ranger_minimal.launch", "port_name:=can1", "publish_odom_tf:=false")
+    p = params("ranger_minimal.launch", "port_name:=can1", "publish_odom_tf:=false",
+               "cmd_vel_stamped:=true")
     assert p["/ranger_base_node/port_name"] == "can1"
     assert p["/ranger_base_node/publish_odom_tf"] is False
+    assert p["/ranger_base_node/cmd_vel_stamped"] == "true"  # a string, as the node reads it
     assert params("ranger_minimal.launch", "sim:=true", "port_name:=can1")[
         "/ranger_base_node/port_name"] == "sim"
 

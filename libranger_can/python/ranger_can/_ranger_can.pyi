@@ -1,5 +1,5 @@
 # Type stubs of the extension module (libranger_can/python/src/module.cpp).
-from typing import Dict, List, Optional, Tuple
+from typing import Dict, List, Optional, Sequence, Tuple
 
 __version__: str
 
@@ -128,6 +128,23 @@ class DiagnosticGroup:
 class CliResult:
     exit_code: int; out: str; err: str
 
+class BatteryReport:
+    # sensor_msgs/BatteryState as the library says it (the pack's BMS, or the system status's
+    # voltage alone); stamp_ns 0: none; status and health: the message's numbers.
+    present: bool; stamp_ns: int
+    voltage: float; current: float; temperature: float; percentage: float
+    power_supply_status: int; power_supply_health: int
+    cell_voltage: List[float]; cell_temperature: List[float]
+
+class PublicationSchedule:
+    # A fixed-rate schedule (times: time.monotonic() s): due from min(5 ms, period / 4) early;
+    # after a stall from now.
+    def __init__(self, rate_hz: float) -> None: ...
+    def start(self, now: float) -> None: ...
+    def due(self, now: float) -> bool: ...
+    def advance(self, now: float, rate_hz: Optional[float] = ...) -> None: ...
+    wake_at: float
+
 class Snapshot:
     sequence: int; now_ns: int; port: str; bus_open: bool; read_only: bool; bus_error: str
     bus_state: str; link: str
@@ -137,6 +154,9 @@ class Snapshot:
     switching: bool; mode_override: Optional[str]
     refusal: str  # ranger_can.refusal_names(): "none", "estop", "rearm_required", ...
     refusal_detail: str  # what it means and what to do, in words ("" while driven)
+    link_up: bool  # system_state's link_up
+    motion_inhibited_reason: str  # system_state's: the refusal's name, "" while driven
+    battery_report: BatteryReport  # sensor_msgs/BatteryState's facts
     rearm_required: bool; latched_causes: List[str]; active_causes: List[str]
     reclaim_blocked: bool; awaiting_command_mode: bool; cmd_timed_out: bool
     steer_first_factor: float
@@ -188,6 +208,23 @@ def unknown_motion_mode_number(number: int, snapshot: Snapshot) -> str: ...
 def motion_mode_pinned(mode: Optional[str]) -> str: ...
 def resume_refused_offline(snapshot: Snapshot, port: str) -> Optional[str]: ...
 def resume_answered() -> str: ...
+# Any request's answer (success, message) after the wait, by its kind: the ROS 1 node's words.
+def request_answer(outcome: RequestOutcome) -> Tuple[bool, str]: ...
+# The services' checks before anything is sent: why not (ending ": nothing sent"), or None.
+def ultrasonic_request_refused(enable: bool, disable: bool) -> Optional[str]: ...
+def lights_request_refused(front_mode: int, front_brightness: int, rear_mode: int,
+                           rear_brightness: int) -> Optional[str]: ...
+# SetDriveMode's number: the drive mode's name; RangerError naming the valid numbers.
+def drive_mode_request(number: int) -> str: ...
+# A service's answer as its one log line: (severity, text).
+def answer_line(service: str, success: bool, message: str) -> Tuple[str, str]: ...
+# The driver's event kinds that are a service's answer (not logged besides it).
+def answer_event_kinds() -> List[str]: ...
+# Row-major 6x6: `floor` on the diagonal plus the x, y, yaw variance.
+def pose_covariance(floor: Sequence[float], variance: Sequence[float]) -> List[float]: ...
+def diagonal_covariance(diagonal: Sequence[float]) -> List[float]: ...
+# sensor_msgs/Range's range (REP-117): m; NaN for no reading; +inf beyond max_range.
+def range_reading(raw: int, max_range: float) -> float: ...
 # clear_errors' answer (success, message) from its outcome (answered, failed or unanswered) and
 # the snapshot's error-word layout: the error word and its faults by name, or why not.
 def clear_errors_answer(code: int, outcome: RequestOutcome,

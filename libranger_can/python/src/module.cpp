@@ -22,6 +22,7 @@
 #include "ranger_can/control/rearm.hpp"
 #include "ranger_can/control/vocabulary.hpp"
 #include "ranger_can/frontend/answers.hpp"
+#include "ranger_can/frontend/publication.hpp"
 #include "ranger_can/sim/chassis_commands.hpp"
 #include "ranger_can/sim/sim_bus_source.hpp"
 #include "ranger_can/text.hpp"
@@ -93,6 +94,14 @@ void check(const Status& st) {
 std::chrono::nanoseconds to_ns(double s) {
   if (!(s >= 0.0)) return std::chrono::nanoseconds(0);
   return from_seconds(std::min(s, 1e6));
+}
+
+// time.monotonic() seconds <-> the steady clock (both CLOCK_MONOTONIC).
+SteadyTime steady_time(double s) {
+  return SteadyTime(std::chrono::duration_cast<SteadyDuration>(std::chrono::duration<double>(s)));
+}
+double seconds_of(SteadyTime t) {
+  return std::chrono::duration<double>(t.time_since_epoch()).count();
 }
 
 protocol::MotionMode parse_mode(const std::string& text) {
@@ -532,6 +541,52 @@ PYBIND11_MODULE(_ranger_can, m) {
         return std::string("MotionUpdate(") + (u.odometry ? "odometry " : "") +
                (u.joints ? "joints " : "") + std::to_string(u.sent.size()) + " sent)";
       });
+  py::class_<BatteryReport>(m, "BatteryReport")
+      .def_readonly("present", &BatteryReport::present)
+      .def_property_readonly("stamp_ns",
+                             [](const BatteryReport& r) { return r.stamp.count(); })  // 0: none
+      .def_readonly("voltage", &BatteryReport::voltage)
+      .def_readonly("current", &BatteryReport::current)
+      .def_readonly("temperature", &BatteryReport::temperature)
+      .def_readonly("percentage", &BatteryReport::percentage)
+      .def_property_readonly("power_supply_status",
+                             [](const BatteryReport& r) { return static_cast<int>(r.status); })
+      .def_property_readonly("power_supply_health",
+                             [](const BatteryReport& r) { return static_cast<int>(r.health); })
+      .def_property_readonly("cell_voltage",
+                             [](const BatteryReport& r) {
+                               return std::vector<double>(r.cell_voltage.begin(),
+                                                          r.cell_voltage.end());
+                             })
+      .def_property_readonly("cell_temperature", [](const BatteryReport& r) {
+        return std::vector<double>(r.cell_temperature.begin(), r.cell_temperature.end());
+      });
+  // A front end's fixed-rate schedule (frontend/publication.hpp); times in s of time.monotonic()
+  // (CLOCK_MONOTONIC, the steady clock's).
+  py::class_<PublicationSchedule>(m, "PublicationSchedule")
+      .def(py::init([](double rate_hz) {
+             if (!(rate_hz > 0.0)) invalid("PublicationSchedule: the rate must be > 0 Hz");
+             return PublicationSchedule(rate_hz);
+           }),
+           py::arg("rate_hz"))
+      .def(
+          "start", [](PublicationSchedule& p, double now) { p.start(steady_time(now)); },
+          py::arg("now"))
+      .def(
+          "due", [](const PublicationSchedule& p, double now) { return p.due(steady_time(now)); },
+          py::arg("now"))
+      .def(
+          "advance",
+          [](PublicationSchedule& p, double now, std::optional<double> rate_hz) {
+            if (rate_hz) {
+              if (!(*rate_hz > 0.0)) invalid("PublicationSchedule: the rate must be > 0 Hz");
+              p.set_rate(*rate_hz);
+            }
+            p.advance(steady_time(now));
+          },
+          py::arg("now"), py::arg("rate_hz") = py::none())
+      .def_property_readonly("wake_at",
+                             [](const PublicationSchedule& p) { return seconds_of(p.wake_at()); });
   bind_tables(m);
   bind_wire(m);
   py::class_<CliResult>(m, "CliResult")
@@ -574,6 +629,14 @@ PYBIND11_MODULE(_ranger_can, m) {
                              [](const S& s) { return name_of(s.c().mode_override); })
       .def_property_readonly("refusal",
                              [](const S& s) { return std::string(to_string(s.c().refusal)); })
+      // system_state's link_up and motion_inhibited_reason ("" while motion is accepted).
+      .def_property_readonly("link_up",
+                             [](const S& s) { return s.c().link == LinkState::kConnected; })
+      .def_property_readonly("motion_inhibited_reason",
+                             [](const S& s) { return refusal_name(s.c()); })
+      // sensor_msgs/BatteryState's facts (ranger::battery_report).
+      .def_property_readonly("battery_report",
+                             [](const S& s) { return battery_report(s.s().feedback, s.s().now); })
       .def_property_readonly(
           "refusal_detail",
           [](const S& s) { return describe_refusal(s.c(), s.s().identification.get()); })
@@ -785,14 +848,11 @@ PYBIND11_MODULE(_ranger_can, m) {
       .def("resume", [](PySession& p) { return p.s().driver().resume(); })
       .def(
           "set_lights",
-          [](PySession& p, const std::string& front, int front_brightness, const std::string& rear,
-             int rear_brightness) {
-            if (front_brightness < 0 || front_brightness > 255 || rear_brightness < 0 ||
-                rear_brightness > 255) {
-              invalid("lights: a brightness is 0..100");
-            }
-            LightsRequest r{parse_light(front), static_cast<std::uint8_t>(front_brightness),
-                            parse_light(rear), static_cast<std::uint8_t>(rear_brightness)};
+          [](PySession& p, const std::string& front, long long front_brightness,
+             const std::string& rear, long long rear_brightness) {
+            // The library's one check of a brightness (0..100), as every front end's.
+            const LightsRequest r = value_or_throw(lights_request(
+                parse_light(front), front_brightness, parse_light(rear), rear_brightness));
             return value_or_throw(p.s().driver().set_lights(r));
           },
           py::arg("front"), py::arg("front_brightness"), py::arg("rear"),
@@ -894,8 +954,8 @@ PYBIND11_MODULE(_ranger_can, m) {
   m.def("motion_mode_numbers", [] {
     std::vector<std::pair<int, std::optional<std::string>>> out;
     for (const auto& [number, mode] : motion_mode_numbers()) {
-      out.emplace_back(number, mode ? std::optional<std::string>(protocol::to_string(*mode))
-                                    : std::nullopt);
+      out.emplace_back(
+          number, mode ? std::optional<std::string>(protocol::to_string(*mode)) : std::nullopt);
     }
     return out;
   });
@@ -972,6 +1032,59 @@ PYBIND11_MODULE(_ranger_can, m) {
         return py::make_tuple(a.success, a.message);
       },
       py::arg("code"), py::arg("outcome"), py::arg("snapshot"));
+  m.def(
+      "request_answer",  // any request's answer after the wait, by its kind
+      [](const OutcomeView& outcome) {
+        const ServiceAnswer a = request_answer(outcome.outcome);
+        return py::make_tuple(a.success, a.message);
+      },
+      py::arg("outcome"));
+  m.def(
+      "ultrasonic_request_refused",
+      [](bool enable, bool disable) -> std::optional<std::string> {
+        const auto refused = ultrasonic_request_refused(enable, disable);
+        if (!refused) return std::nullopt;
+        return refused->message;
+      },
+      py::arg("enable"), py::arg("disable"));
+  m.def(
+      "lights_request_refused",  // SetLights' numbers checked: why not, or None
+      [](long long front_mode, long long front_brightness, long long rear_mode,
+         long long rear_brightness) -> std::optional<std::string> {
+        const auto r = lights_request(front_mode, front_brightness, rear_mode, rear_brightness);
+        if (r) return std::nullopt;
+        return r.error().message;
+      },
+      py::arg("front_mode"), py::arg("front_brightness"), py::arg("rear_mode"),
+      py::arg("rear_brightness"));
+  m.def(
+      "drive_mode_request",  // SetDriveMode's number: its name; RangerError naming the valid ones
+      [](long long number) {
+        return std::string(protocol::to_string(value_or_throw(drive_mode_request(number))));
+      },
+      py::arg("number"));
+  m.def(
+      "answer_line",  // a service's answer as its one log line: (severity, text)
+      [](const std::string& service, bool success, const std::string& message) {
+        const LogLine l = answer_line(service, ServiceAnswer{success, message});
+        return py::make_tuple(std::string(to_string(l.severity)), l.text);
+      },
+      py::arg("service"), py::arg("success"), py::arg("message"));
+  m.def("answer_event_kinds", [] {  // the driver's events that are a service's answer
+    std::vector<std::string> out;
+    for (const auto& row : kEventKindNames) {
+      if (is_answer_event(row.value)) out.emplace_back(row.name);
+    }
+    return out;
+  });
+  m.def(
+      "pose_covariance",  // floor on the diagonal + the x, y, yaw variance (row-major 6x6)
+      [](const std::array<double, 6>& floor, const std::array<double, 3>& variance) {
+        return pose_covariance(variance, floor);
+      },
+      py::arg("floor"), py::arg("variance"));
+  m.def("diagonal_covariance", &diagonal_covariance, py::arg("diagonal"));
+  m.def("range_reading", &range_reading, py::arg("raw"), py::arg("max_range"));
   m.def("resume_answered", [] {  // what resume answers once the driver re-armed
     RequestOutcome answered;
     answered.state = RequestOutcome::State::kAnswered;

@@ -4,6 +4,8 @@
 #include <cstring>
 #include <utility>
 
+#include "ranger_can/control/vocabulary.hpp"
+
 namespace ranger::python {
 namespace {
 
@@ -55,12 +57,10 @@ void planar_pose(CdrWriter& w, double x, double y, double qz, double qw) {
     w.f64(c);
 }
 
-void covariance(CdrWriter& w, const std::array<double, 6>& diagonal,
-                const std::array<double, 6>& added) {
-  for (std::size_t i = 0; i < 36; ++i) {
-    const std::size_t axis = i / 6;
-    w.f64(i % 7 == 0 ? diagonal[axis] + added[axis] : 0.0);
-  }
+// A covariance as the library makes it (ranger::pose_covariance, diagonal_covariance).
+void covariance(CdrWriter& w, const Covariance& c) {
+  for (double v : c)
+    w.f64(v);
 }
 
 // The encapsulation identifiers (the first two bytes, big endian) whose body read_twist reads:
@@ -110,11 +110,11 @@ std::string MotionWireEncoder::odometry(const OdometryValues& v) const {
   w.header(sec, nanosec, setup_.odom_frame);
   w.string(setup_.base_frame);
   planar_pose(w, x, y, qz, qw);  // pose: PoseWithCovariance
-  covariance(w, setup_.pose_covariance_diagonal, {var_x, var_y, 0.0, 0.0, 0.0, var_yaw});
+  covariance(w, pose_covariance({var_x, var_y, var_yaw}, setup_.pose_covariance_diagonal));
   // twist: TwistWithCovariance
   for (double c : {vx, vy, 0.0, 0.0, 0.0, wz})
     w.f64(c);
-  covariance(w, setup_.twist_covariance_diagonal, {});
+  covariance(w, diagonal_covariance(setup_.twist_covariance_diagonal));
   return w.take();
 }
 

@@ -64,7 +64,7 @@ void Session::stop() {
 }
 
 void Session::on_step(const std::shared_ptr<const DriverSnapshot>& s) {
-  const Timestamp estimate = std::max(s->odometry.stamp, joints_stamp(*s));
+  const Timestamp estimate = std::max(s->odometry.stamp, joints_stamp(s->feedback));
   bool wake = false;  // a new estimate, and wait_motion waits for one (not merely for its time)
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -121,37 +121,37 @@ std::vector<SentMotion> Session::wait_sent(std::chrono::nanoseconds timeout) {
 MotionUpdate Session::wait_motion(std::chrono::nanoseconds period,
                                   std::chrono::nanoseconds timeout) {
   using Clock = std::chrono::steady_clock;
-  const auto early = std::min<Clock::duration>(std::chrono::milliseconds(5), period / 4);
   const auto deadline = Clock::now() + timeout;
   MotionUpdate out;
   std::unique_lock<std::mutex> lock(mutex_);
+  // The library's pacing (frontend/publication.hpp), as the ROS 1 node's publication thread.
+  const auto steady_period = std::chrono::duration_cast<SteadyDuration>(period);
+  if (!pacer_) {
+    pacer_.emplace(steady_period);
+    pacer_->start(Clock::now());
+  } else {
+    pacer_->set_period(steady_period);
+  }
   while (!stopped_) {
     out.sent.assign(sent_.begin(), sent_.end());
     sent_.clear();
     const auto now = Clock::now();
     bool waiting = false;  // due, and the latest snapshot has nothing new: the next estimate
-    if (now >= motion_due_ - early) {
+    if (pacer_->due(now)) {
       auto s = driver_->snapshot();
-      const Timestamp joints = joints_stamp(*s);
-      out.odometry = s->motion_known && s->odometry.stamp > published_odometry_;
-      out.joints = s->motion_known && (s->joints.has_steering || s->joints.has_wheels) &&
-                   joints > published_joints_;
-      if (out.odometry || out.joints || !s->motion_known) {  // published, or nothing to wait for
-        motion_due_ += period;
-        if (motion_due_ < now) motion_due_ = now + period;
-      }
-      if (out.odometry || out.joints) {
-        published_odometry_ = std::max(published_odometry_, s->odometry.stamp);
-        published_joints_ = std::max(published_joints_, joints);
+      const MotionDecision decision = pacer_->decide(*s, now);
+      out.odometry = decision.odometry;
+      out.joints = decision.joints;
+      if (decision.publish()) {
         out.snapshot = std::move(s);
         return out;
       }
-      waiting = s->motion_known;
+      waiting = decision.wait_for_estimate;
     }
     if (!out.sent.empty() || now >= deadline) return out;
     const std::uint64_t estimates = estimates_;
     estimate_awaited_ = waiting;
-    motion_.wait_until(lock, waiting ? deadline : std::min(deadline, motion_due_ - early), [&] {
+    motion_.wait_until(lock, waiting ? deadline : std::min(deadline, pacer_->wake_at()), [&] {
       return stopped_ || !sent_.empty() || (waiting && estimates_ != estimates);
     });
     estimate_awaited_ = false;

@@ -19,6 +19,7 @@
 #include "ranger_can/clock.hpp"
 #include "ranger_can/control/diagnostics.hpp"
 #include "ranger_can/control/driver.hpp"
+#include "ranger_can/frontend/publication.hpp"
 #include "ranger_can/result.hpp"
 #include "ranger_can/sim/sim_bus_source.hpp"
 
@@ -114,11 +115,10 @@ class Session {
   std::deque<SentMotion> sent_;      // bounded, guarded by mutex_
   bool stop_sent_ = false;           // guarded by mutex_
   // The estimate's progress (on the driver's thread) and wait_motion's schedule; by mutex_.
-  Timestamp estimate_stamp_{0};    // the newest odometry or joint-state stamp seen
-  std::uint64_t estimates_ = 0;    // how often it advanced
-  bool estimate_awaited_ = false;  // wait_motion waits for the next estimate: wake it for one
-  std::chrono::steady_clock::time_point motion_due_{};
-  Timestamp published_odometry_{0}, published_joints_{0};
+  Timestamp estimate_stamp_{0};       // the newest odometry or joint-state stamp seen
+  std::uint64_t estimates_ = 0;       // how often it advanced
+  bool estimate_awaited_ = false;     // wait_motion waits for the next estimate: wake it for one
+  std::optional<MotionPacer> pacer_;  // wait_motion's schedule and what it published
   std::mutex diagnostics_mutex_;
   std::optional<ChassisDiagnostics> diagnostics_;  // by diagnostics_mutex_
 };

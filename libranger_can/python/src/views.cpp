@@ -62,13 +62,6 @@ OdometryView odometry_view(const DriverSnapshot& s) {
   return v;
 }
 
-Timestamp joints_stamp(const DriverSnapshot& s) {
-  Timestamp stamp{0};
-  if (s.feedback.steering_angles) stamp = std::max(stamp, s.feedback.steering_angles->stamp);
-  if (s.feedback.wheel_speeds) stamp = std::max(stamp, s.feedback.wheel_speeds->stamp);
-  return stamp;
-}
-
 namespace {
 std::pair<std::int64_t, std::uint32_t> split(Timestamp t) {
   const std::int64_t n = ns(t);
@@ -96,7 +89,7 @@ OdometryValues odometry_values(const DriverSnapshot& s) {
 
 JointValues joint_values(const DriverSnapshot& s) {
   const WheelJoints& j = s.joints;
-  const auto [sec, nanosec] = split(joints_stamp(s));
+  const auto [sec, nanosec] = split(joints_stamp(s.feedback));
   JointValues out{sec, nanosec, {}, {}};
   for (std::size_t w = 0; w < static_cast<std::size_t>(kWheelCount); ++w) {
     std::get<2>(out)[w] = j.steering_position[w];
@@ -118,7 +111,7 @@ JointsView joints_view(const DriverSnapshot& s) {
   v.wheel_velocity = values(j.wheel_velocity);
   v.has_steering = j.has_steering;
   v.has_wheels = j.has_wheels;
-  v.stamp_ns = ns(joints_stamp(s));
+  v.stamp_ns = ns(joints_stamp(s.feedback));
   return v;
 }
 

@@ -13,6 +13,7 @@
 
 #include "ranger_can/control/driver.hpp"
 #include "ranger_can/control/driver_events.hpp"
+#include "ranger_can/control/vocabulary.hpp"
 #include "ranger_can/sim/virtual_chassis.hpp"
 
 namespace ranger::python {
@@ -117,9 +118,6 @@ struct EventView {
   std::string text;  // describe(): the line the ROS node logs
   std::string json;  // to_json()
 };
-
-// The time of the newest frame behind the joint states (steering angles, wheel speeds).
-Timestamp joints_stamp(const DriverSnapshot& s);
 
 // The motion estimate in the shape a publisher fills its messages with, in one call: the stamp
 // split into s and ns (as ROS splits it), the heading also as a unit quaternion about z.

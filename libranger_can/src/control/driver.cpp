@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <exception>
+#include <tuple>
 #include <utility>
 
 #include "ranger_can/text.hpp"
@@ -193,8 +194,10 @@ void Driver::standstill_probe(std::optional<StandstillProbe> probe) {
 }
 
 Result<std::uint64_t> Driver::set_lights(const LightsRequest& lights) {
-  if (lights.front_brightness > 100 || lights.rear_brightness > 100) {
-    return Error{Errc::kInvalidArgument, "lights: brightness is 0..100"};
+  for (const auto& [side, mode, brightness] :
+       {std::tuple{"front", lights.front, lights.front_brightness},
+        std::tuple{"rear", lights.rear, lights.rear_brightness}}) {
+    if (auto checked = light_brightness(side, mode, brightness); !checked) return checked.error();
   }
   const std::uint64_t id = requests_.add(RequestOutcome::Kind::kLights,
                                          "lights " + describe(lights.front, lights.front_brightness,

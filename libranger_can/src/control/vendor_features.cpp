@@ -41,6 +41,16 @@ RemoteState remote_state_from(const RemoteControlState& rc, Timestamp received) 
   return r;
 }
 
+Result<std::uint8_t> light_brightness(std::string_view side, protocol::LightMode mode,
+                                      long long value) {
+  if (value < 0 || value > kMaxLightBrightness) {
+    return Error{Errc::kInvalidArgument,
+                 std::string(side) + "_brightness " + std::to_string(value) + " outside 0.." +
+                     std::to_string(kMaxLightBrightness) + ": nothing sent"};
+  }
+  return static_cast<std::uint8_t>(mode == protocol::LightMode::kCustom ? value : 0);
+}
+
 std::string describe(protocol::LightMode front, std::uint8_t front_brightness,
                      protocol::LightMode rear, std::uint8_t rear_brightness) {
   return "front " + light_text(front, front_brightness) + ", rear " +

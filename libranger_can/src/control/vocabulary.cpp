@@ -1,6 +1,8 @@
 #include "ranger_can/control/vocabulary.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <limits>
 
 #include "ranger_can/wire/interpretation.hpp"
@@ -87,10 +89,82 @@ Covariance diagonal_covariance(const std::array<double, 6>& diagonal) {
 }
 
 Covariance pose_covariance(const OdometryState& odometry, const std::array<double, 6>& floor) {
+  return pose_covariance(
+      {odometry.pose_variance[0], odometry.pose_variance[1], odometry.pose_variance[2]}, floor);
+}
+
+Covariance pose_covariance(const std::array<double, 3>& pose_variance,
+                           const std::array<double, 6>& floor) {
   Covariance out = diagonal_covariance(floor);
-  out[0] += odometry.pose_variance[0];   // x
-  out[7] += odometry.pose_variance[1];   // y
-  out[35] += odometry.pose_variance[2];  // yaw
+  out[0] += pose_variance[0];   // x
+  out[7] += pose_variance[1];   // y
+  out[35] += pose_variance[2];  // yaw
+  return out;
+}
+
+double range_reading(std::int16_t raw, double max_range) {
+  const double range = ultrasonic_range(raw);
+  if (std::isfinite(range) && range > max_range) return std::numeric_limits<double>::infinity();
+  return range;
+}
+
+Timestamp joints_stamp(const ChassisFeedback& feedback) {
+  Timestamp t{0};
+  if (feedback.steering_angles) t = std::max(t, feedback.steering_angles->stamp);
+  if (feedback.wheel_speeds) t = std::max(t, feedback.wheel_speeds->stamp);
+  return t;
+}
+
+PowerSupplyStatus power_supply_status(double current) {
+  if (current > 0.0) return PowerSupplyStatus::kCharging;
+  if (current < 0.0) return PowerSupplyStatus::kDischarging;
+  return PowerSupplyStatus::kNotCharging;
+}
+
+PowerSupplyHealth power_supply_health(std::uint8_t alarm1, std::uint8_t alarm2) {
+  namespace b = protocol::bms_status;
+  // The first rule whose bits are set decides.
+  static constexpr struct {
+    std::uint8_t status1, status2;
+    PowerSupplyHealth health;
+  } kRules[] = {
+      {b::kOverVoltage, 0, PowerSupplyHealth::kOvervoltage},
+      {b::kHighTemperature, 0, PowerSupplyHealth::kOverheat},
+      {b::kLowTemperature, 0, PowerSupplyHealth::kCold},
+      {b::kUnderVoltage | b::kDischargeOverCurrent, b::kChargeOverCurrent,
+       PowerSupplyHealth::kUnspecFailure},
+  };
+  for (const auto& rule : kRules) {
+    if ((alarm1 & rule.status1) != 0 || (alarm2 & rule.status2) != 0) return rule.health;
+  }
+  return PowerSupplyHealth::kGood;
+}
+
+BatteryReport battery_report(const ChassisFeedback& feedback, Timestamp now) {
+  BatteryReport out;
+  const auto& pack = feedback.bms[0];
+  if (bms_present(feedback, 0, now)) {
+    out.present = true;
+    out.stamp = pack->stamp;
+    out.voltage = pack->value.voltage;
+    out.current = pack->value.current;
+    out.temperature = pack->value.temperature;
+    out.percentage = std::clamp(pack->value.soc / 100.0, 0.0, 1.0);
+    out.status = power_supply_status(pack->value.current);
+    out.health = PowerSupplyHealth::kGood;
+    if (const auto& alarm = feedback.bms_alarm[0])
+      out.health = power_supply_health(alarm->value.alarm1, alarm->value.alarm2);
+  } else if (const auto& status = feedback.system_status) {
+    out.present = true;  // the chassis runs, so it has a battery; the BMS is not reporting
+    out.stamp = status->stamp;
+    out.voltage = status->value.battery_voltage;
+  }
+  for (int b = 1; b <= kBatteryCount; ++b) {
+    const auto slot = static_cast<std::size_t>(b);
+    if (!bms_present(feedback, b, now)) continue;
+    out.cell_voltage[slot - 1] = feedback.bms[slot]->value.voltage;
+    out.cell_temperature[slot - 1] = feedback.bms[slot]->value.temperature;
+  }
   return out;
 }
 

@@ -1,5 +1,7 @@
 #include "ranger_can/frontend/answers.hpp"
 
+#include <cctype>
+
 #include "ranger_can/control/vocabulary.hpp"
 #include "ranger_can/sim/chassis_commands.hpp"
 #include "ranger_can/text.hpp"
@@ -28,6 +30,28 @@ ServiceAnswer answer_of(const RequestOutcome& outcome, std::string_view unconfir
                   ? outcome.message
                   : std::string(unconfirmed) + " (" + std::string(to_string(outcome.state)) + ")";
   return a;
+}
+
+ServiceAnswer request_answer(const RequestOutcome& outcome) {
+  using K = RequestOutcome::Kind;
+  switch (outcome.kind) {
+    case K::kResume:
+      return resume_answer(outcome);
+    case K::kUltrasonic:
+      return answer_of(outcome, "the chassis did not confirm the ultrasonic setting in time");
+    case K::kLights:
+      return answer_of(outcome, "the chassis did not report its lights in time");
+    case K::kPark:
+      return answer_of(outcome,
+                       outcome.on ? "park not confirmed in time" : "release not confirmed in time");
+    case K::kDriveMode:
+      return answer_of(outcome, "drive mode not confirmed in time");
+    case K::kFirmwareVersion:
+      return answer_of(outcome, "the chassis did not report its firmware version in time");
+    case K::kClearErrors:
+      break;
+  }
+  return answer_of(outcome, "clear_errors not confirmed in time");
 }
 
 std::optional<ServiceAnswer> resume_refused_offline(const DriverSnapshot& snapshot,
@@ -86,6 +110,81 @@ std::string motion_mode_pinned(std::optional<protocol::MotionMode> mode) {
   return mode ? "motion mode pinned to " + std::string(protocol::to_string(*mode)) +
                     " (the switch happens at standstill)"
               : "automatic motion-mode selection";
+}
+
+std::optional<ServiceAnswer> ultrasonic_request_refused(bool enable, bool disable) {
+  if (enable != disable) return std::nullopt;
+  return ServiceAnswer{false, std::string(enable ? "contradictory request (enable and disable both "
+                                                   "true)"
+                                                 : "empty request (neither enable nor disable)") +
+                                  ": set exactly one of them; nothing sent"};
+}
+
+namespace {
+
+std::string upper(std::string s) {
+  for (char& c : s)
+    c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return s;
+}
+
+// "0 (OFF), 1 (ON), ...": a table's numbers as the services' refusals list them.
+template <class Table>
+std::string numbered(const Table& table) {
+  std::vector<std::string> items;
+  for (const auto& row : table)
+    items.push_back(std::to_string(static_cast<int>(row.value)) + " (" +
+                    upper(std::string(row.name)) + ")");
+  return text::join(items);
+}
+
+Result<protocol::LightMode> light_mode_of(const char* side, long long number) {
+  for (const auto& row : protocol::kLightModeNames) {
+    if (static_cast<long long>(row.value) == number) return row.value;
+  }
+  return Error{Errc::kInvalidArgument, std::string(side) + "_mode " + std::to_string(number) +
+                                           " is not one of " + numbered(protocol::kLightModeNames) +
+                                           ": nothing sent"};
+}
+
+}  // namespace
+
+Result<LightsRequest> lights_request(protocol::LightMode front, long long front_brightness,
+                                     protocol::LightMode rear, long long rear_brightness) {
+  auto fb = light_brightness("front", front, front_brightness);
+  if (!fb) return fb.error();
+  auto rb = light_brightness("rear", rear, rear_brightness);
+  if (!rb) return rb.error();
+  return LightsRequest{front, *fb, rear, *rb};
+}
+
+Result<LightsRequest> lights_request(long long front_mode, long long front_brightness,
+                                     long long rear_mode, long long rear_brightness) {
+  const auto front = light_mode_of("front", front_mode);
+  if (!front) return front.error();
+  const auto rear = light_mode_of("rear", rear_mode);
+  if (!rear) return rear.error();
+  return lights_request(*front, front_brightness, *rear, rear_brightness);
+}
+
+Result<protocol::DriveMode> drive_mode_request(long long number) {
+  for (const auto& row : protocol::kDriveModeNames) {
+    if (static_cast<long long>(row.value) == number) return row.value;
+  }
+  return Error{Errc::kInvalidArgument, "drive mode " + std::to_string(number) + " is not one of " +
+                                           numbered(protocol::kDriveModeNames) + ": nothing sent"};
+}
+
+LogLine answer_line(std::string_view service, const ServiceAnswer& answer) {
+  const std::string name(service);
+  const bool named =
+      answer.message.rfind(name + ":", 0) == 0 || answer.message.rfind(name + " ", 0) == 0;
+  return {answer.success ? Severity::kInfo : Severity::kWarn,
+          named ? answer.message : name + ": " + answer.message};
+}
+
+bool is_answer_event(EventKind kind) {
+  return kind == EventKind::kRequestSettled || kind == EventKind::kMotionModeRequested;
 }
 
 std::vector<LogLine> describe_protocol_setup(const NodeParameters& params) {

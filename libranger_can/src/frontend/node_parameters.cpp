@@ -247,12 +247,13 @@ void add_connection(std::vector<Binding>& out) {
                     .apply(RANGER_SET(publish_cmd, v.boolean)));
   out.push_back(
       Row("cmd_vel_stamped", T::kChoice, "", {}, std::string(to_string(d.cmd_vel_stamped)),
-          "the ROS 2 node: `cmd_vel` as geometry_msgs/TwistStamped (`true`: Nav2's "
-          "`enable_stamped_cmd_vel`, ros2_control's drive controllers, twist_mux and the teleops' "
-          "`stamped`) or Twist (`false`); `auto`: the type of the topic's publishers, once the "
-          "first appears and whenever they all use the other (said in the log). A stamp older than "
-          "`cmd_vel_timeout` is not obeyed (`stale_command`); a zero stamp means now. The ROS 1 "
-          "node takes Twist")
+          "`cmd_vel` as geometry_msgs/TwistStamped (`true`: Nav2's `enable_stamped_cmd_vel`, "
+          "ros2_control's drive controllers, twist_mux and the teleops' `stamped`) or Twist "
+          "(`false`); `auto`: the type of the topic's publishers, once the first appears and "
+          "whenever they all use the other (said in the log). A stamp older than "
+          "`cmd_vel_timeout` is not obeyed (`stale_command`); a zero stamp means now. Both nodes; "
+          "the ROS 1 node's `auto` reads each message as the type its publisher declares (said in "
+          "the log when it changes)")
           .choices(kCmdVelStampedNames.names())
           .apply([](NodeParameters& p, const ParameterValue& v) {
             p.cmd_vel_stamped = kCmdVelStampedNames.parse(v.text).value_or(CmdVelStamped::kAuto);

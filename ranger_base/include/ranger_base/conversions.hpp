@@ -62,8 +62,9 @@ std::optional<ranger::BodyTwist> achieved_twist(const ranger::SentEvent& event);
 // odometry's own stamp (the frames that produced it).
 nav_msgs::Odometry to_odometry(const ranger::OdometryState& odometry, const NodeParameters& params);
 geometry_msgs::TransformStamped to_transform(const nav_msgs::Odometry& odometry);
-// The time of the newest per-wheel frame behind `feedback`'s joints (zero: none yet).
-ranger::Timestamp joints_stamp(const ranger::ChassisFeedback& feedback);
+// The time of the newest per-wheel frame behind `feedback`'s joints (zero: none yet): the
+// library's.
+using ranger::joints_stamp;
 sensor_msgs::JointState to_joint_state(const ranger::WheelJoints& joints, const ros::Time& stamp);
 // The virtual chassis's ground truth, as an Odometry in the odom frame (zero covariance: exact).
 nav_msgs::Odometry to_ground_truth(const ranger::sim::ChassisSnapshot& sim,
@@ -76,8 +77,9 @@ ranger_msgs::SystemState to_system_state(const ranger::DriverSnapshot& snapshot,
                                          const ros::Time& stamp);
 // ---- the vendor's additions (agx_v2) ------------------------------------------------------------
 ranger_msgs::RemoteState to_remote_state(const ranger::RemoteState& remote, const ros::Time& stamp);
-// The service's request as the driver's; kInvalidArgument naming the field for a mode above
-// CUSTOM or a brightness above 100 (a brightness outside CUSTOM is ignored: sent as 0).
+// The service's request as the driver's (ranger::lights_request: the library's check and words);
+// kInvalidArgument naming the field for a mode above CUSTOM or a brightness above 100 (a
+// brightness outside CUSTOM is ignored: sent as 0).
 ranger::Result<ranger::LightsRequest> to_lights_request(const ranger_msgs::SetLights::Request& r);
 // The lights the chassis last reported (0x231) into the response; nothing when it never did.
 void fill_lights_response(const std::optional<ranger::LightsState>& lights,

@@ -30,6 +30,7 @@
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <geometry_msgs/Twist.h>
+#include <geometry_msgs/TwistStamped.h>
 #include <ranger_msgs/ClearErrors.h>
 #include <ranger_msgs/SetDriveMode.h>
 #include <ranger_msgs/SetLights.h>
@@ -40,6 +41,7 @@
 #include <std_msgs/String.h>
 #include <std_srvs/SetBool.h>
 #include <std_srvs/Trigger.h>
+#include <topic_tools/shape_shifter.h>
 
 #include <array>
 #include <atomic>
@@ -53,6 +55,7 @@
 
 #include <ranger_can/clock.hpp>
 #include <ranger_can/control/driver.hpp>
+#include <ranger_can/frontend/publication.hpp>
 #include <ranger_can/result.hpp>
 #include <ranger_can/sim/sim_bus_source.hpp>
 
@@ -90,7 +93,20 @@ class RangerNode {
   RangerNode(const ros::NodeHandle& nh, const ros::NodeHandle& private_nh, NodeParameters params,
              std::shared_ptr<ranger::BusSource> source);
 
+  // cmd_vel as cmd_vel_stamped has it: Twist (false), TwistStamped (true), or either (auto: each
+  // message as its publisher's type, said in the log when the type changes).
+  void subscribe_cmd_vel();
   void on_cmd_vel(const geometry_msgs::Twist::ConstPtr& msg);
+  void on_cmd_vel_stamped(const geometry_msgs::TwistStamped::ConstPtr& msg);
+  void on_cmd_vel_any(const topic_tools::ShapeShifter::ConstPtr& msg);
+  // cmd_vel_stamped auto: a subscription of any type takes the first publisher's for good
+  // (roscpp); once none of that type came for 0.5 s and the master has cmd_vel published as the
+  // other (its latest publisher's), cmd_vel is subscribed afresh (the services' thread, every
+  // 0.25 s).
+  void recheck_cmd_vel_type();
+  // A twist to the driver; `stamp` (TwistStamped's, zero: now) gives its age: one older than
+  // cmd_vel_timeout is not obeyed (the driver's stale_command, said in system_state).
+  void drive(const geometry_msgs::Twist& twist, std::optional<ros::Time> stamp);
   void on_sim_inject(const std_msgs::String::ConstPtr& msg);
   void on_sent(const ranger::SentEvent& event);  // driver thread: queued for publication
   void on_step();  // driver thread: wakes the publication thread if it waits for a snapshot
@@ -115,9 +131,9 @@ class RangerNode {
   void publication_loop();
   void wake_publication();  // any thread; never blocks
   void publish_sent();      // cmd_vel_out for the frames queued by on_sent
-  // Publishes what the snapshot has new; false if it has nothing new (wait for the next one).
-  bool publish_motion(const ranger::DriverSnapshot& s);  // odom, TF, joint_states
-  void publish_ground_truth();                           // sim/ground_truth
+  // odom, TF, joint_states: what the library's MotionPacer found new in the snapshot.
+  void publish_motion(const ranger::DriverSnapshot& s, const ranger::MotionDecision& decision);
+  void publish_ground_truth();          // sim/ground_truth
   bool motion_has_subscribers() const;  // odom, /tf, joint_states or sim/ground_truth
   void publish_states();                // ranger_msgs states, battery, ultrasonic
   void publish_diagnostics();
@@ -166,14 +182,18 @@ class RangerNode {
   std::vector<SentTwist> sent_queue_;  // guarded by sent_mutex_
 
   // The publication thread only.
-  std::chrono::steady_clock::time_point next_motion_publication_, next_state_publication_,
-      next_diagnostics_publication_;
-  ranger::Timestamp last_odom_stamp_{0}, last_joints_stamp_{0};
   std::array<ranger::Timestamp, 2> last_ultrasonic_stamp_{};
   ranger::Timestamp last_remote_received_{0};  // the driver's clock
   std::uint64_t logged_event_ = 0;             // the sequence number of the last event logged
   std::vector<ranger::DriverEvent> events_;    // log_events' buffer
   bool shut_down_ = false;
+  // cmd_vel_stamped auto: the type of the last cmd_vel taken (0 none yet, 1 Twist, 2
+  // TwistStamped); any thread that delivers cmd_vel.
+  std::atomic<int> cmd_vel_type_{0};
+  std::atomic<std::int64_t> last_cmd_vel_ns_{0};  // steady clock: the last cmd_vel taken (auto)
+  ros::Timer cmd_vel_type_timer_;
+  std::mutex cmd_vel_sub_mutex_;  // cmd_vel_sub_ (re)made or shut down
+  bool cmd_vel_closed_ = false;   // by cmd_vel_sub_mutex_: shut down, never made again
 };
 
 }  // namespace ranger_base

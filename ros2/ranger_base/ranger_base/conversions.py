@@ -29,13 +29,6 @@ def yaw_quaternion(yaw: float) -> Quaternion:
     return Quaternion(z=math.sin(yaw / 2.0), w=math.cos(yaw / 2.0))
 
 
-def _diagonal(values):
-    out = [0.0] * 36
-    for i, v in enumerate(values):
-        out[i * 7] = float(v)
-    return out
-
-
 def _odometry(stamp_ns, params, pose, twist) -> Odometry:
     msg = Odometry()
     msg.header.stamp = to_time(stamp_ns)
@@ -59,9 +52,11 @@ class MotionMessages:
         self.odom = Odometry()
         self.odom.header.frame_id = params["odom_frame"]
         self.odom.child_frame_id = params["base_frame"]
-        self._pose_floor = _diagonal(params["pose_covariance_diagonal"])
-        self.odom.pose.covariance = self._pose_floor
-        self.odom.twist.covariance = _diagonal(params["twist_covariance_diagonal"])
+        # The covariances are the library's (ranger_can.pose_covariance, diagonal_covariance).
+        self._pose_floor = list(params["pose_covariance_diagonal"])
+        self.odom.pose.covariance = ranger_can.pose_covariance(self._pose_floor, (0.0, 0.0, 0.0))
+        self.odom.twist.covariance = ranger_can.diagonal_covariance(
+            list(params["twist_covariance_diagonal"]))
         transform = TransformStamped()
         transform.header = self.odom.header
         transform.child_frame_id = self.odom.child_frame_id
@@ -74,7 +69,6 @@ class MotionMessages:
         self._translation = transform.transform.translation
         self._linear = self.odom.twist.twist.linear
         self._angular = self.odom.twist.twist.angular
-        self._covariance = self.odom.pose.covariance
 
     def fill_odometry(self, values):
         """values: (sec, nanosec, x, y, qz, qw, vx, vy, wz, var_x, var_y, var_yaw)."""
@@ -84,8 +78,8 @@ class MotionMessages:
         self._position.y = self._translation.y = y
         self._orientation.z, self._orientation.w = qz, qw
         self._linear.x, self._linear.y, self._angular.z = vx, vy, wz
-        floor, cov = self._pose_floor, self._covariance
-        cov[0], cov[7], cov[35] = floor[0] + var_x, floor[7] + var_y, floor[35] + var_yaw
+        self.odom.pose.covariance = ranger_can.pose_covariance(self._pose_floor,
+                                                               (var_x, var_y, var_yaw))
 
     def fill_joints(self, values):
         """values: (sec, nanosec, positions, velocities) in the order of the names."""
@@ -201,7 +195,7 @@ def _set_named(msg, names):
 def to_system_state(s, stamp, detail: str) -> SystemState:
     msg = SystemState()
     msg.header.stamp = stamp
-    msg.link_up = s.link == "connected"
+    msg.link_up = s.link_up
     msg.motion_known = s.motion_known
     if s.vehicle_status_raw is not None:
         msg.vehicle_status = s.vehicle_status_raw
@@ -220,7 +214,7 @@ def to_system_state(s, stamp, detail: str) -> SystemState:
     msg.error_word = s.error_word
     msg.active_errors = list(s.error_names)
     msg.errors = _set_named(SystemErrors(), msg.active_errors)
-    msg.motion_inhibited_reason = "" if s.refusal == "none" else s.refusal
+    msg.motion_inhibited_reason = s.motion_inhibited_reason
     msg.motion_inhibited_detail = detail
     msg.protocol = s.protocol
     msg.protocol_profile = s.profile
@@ -293,42 +287,22 @@ def to_bms_state(batteries, stamp) -> BmsStateArray:
 
 
 def to_battery_state(s, stamp) -> BatteryState:
+    """The library's battery report (ranger_can.Snapshot.battery_report: the pack from the BMS, or
+    the system status's voltage alone; status and health as sensor_msgs numbers them), field for
+    field."""
+    r = s.battery_report
     msg = BatteryState()
-    msg.header.stamp = stamp
-    msg.voltage = msg.current = msg.temperature = msg.charge = msg.capacity = NAN
-    msg.percentage = msg.design_capacity = NAN
-    msg.power_supply_status = BatteryState.POWER_SUPPLY_STATUS_UNKNOWN
-    msg.power_supply_health = BatteryState.POWER_SUPPLY_HEALTH_UNKNOWN
+    msg.header.stamp = to_time(r.stamp_ns) if r.stamp_ns > 0 else stamp
+    msg.present = r.present
+    msg.voltage, msg.current = float(r.voltage), float(r.current)
+    msg.temperature, msg.percentage = float(r.temperature), float(r.percentage)
+    msg.charge = msg.capacity = msg.design_capacity = NAN
+    msg.power_supply_status = r.power_supply_status
+    msg.power_supply_health = r.power_supply_health
     msg.power_supply_technology = BatteryState.POWER_SUPPLY_TECHNOLOGY_LIFE
     msg.location = "pack"
-    batteries = s.batteries
-    pack = batteries[0]
-    if pack.present:
-        msg.header.stamp = to_time(pack.stamp_ns)
-        msg.present = True
-        msg.voltage, msg.current = float(pack.voltage), float(pack.current)
-        msg.temperature = float(pack.temperature)
-        msg.percentage = float(min(max(pack.soc / 100.0, 0.0), 1.0))
-        msg.power_supply_status = (
-            BatteryState.POWER_SUPPLY_STATUS_CHARGING if pack.current > 0 else
-            BatteryState.POWER_SUPPLY_STATUS_DISCHARGING if pack.current < 0 else
-            BatteryState.POWER_SUPPLY_STATUS_NOT_CHARGING)
-        msg.power_supply_health = BatteryState.POWER_SUPPLY_HEALTH_GOOD
-        alarms = set(pack.alarms)
-        for name, health in (("over_voltage", BatteryState.POWER_SUPPLY_HEALTH_OVERVOLTAGE),
-                             ("high_temperature", BatteryState.POWER_SUPPLY_HEALTH_OVERHEAT),
-                             ("low_temperature", BatteryState.POWER_SUPPLY_HEALTH_COLD)):
-            if name in alarms:
-                msg.power_supply_health = health
-                break
-        else:
-            if alarms & {"under_voltage", "discharge_over_current", "charge_over_current"}:
-                msg.power_supply_health = BatteryState.POWER_SUPPLY_HEALTH_UNSPEC_FAILURE
-    elif s.battery_voltage is not None:
-        msg.present = True
-        msg.voltage = float(s.battery_voltage)
-    msg.cell_voltage = [float(b.voltage) if b.present else NAN for b in batteries[1:]]
-    msg.cell_temperature = [float(b.temperature) if b.present else NAN for b in batteries[1:]]
+    msg.cell_voltage = [float(v) for v in r.cell_voltage]
+    msg.cell_temperature = [float(t) for t in r.cell_temperature]
     return msg
 
 
@@ -356,9 +330,8 @@ def to_range(u, params) -> Range:
     msg.field_of_view = float(params["ultrasonic/field_of_view"])
     msg.min_range = float(params["ultrasonic/min_range"])
     msg.max_range = float(params["ultrasonic/max_range"])
-    msg.range = NAN if u.range is None else float(u.range)
-    if math.isfinite(msg.range) and msg.range > msg.max_range:
-        msg.range = math.inf
+    # REP-117 as the library says it: NaN for no reading, +inf for nothing seen.
+    msg.range = ranger_can.range_reading(u.raw, float(params["ultrasonic/max_range"]))
     return msg
 
 

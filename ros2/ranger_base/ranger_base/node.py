@@ -64,14 +64,10 @@ LIGHT_MODES = dict(ranger_can.light_mode_numbers())
 LIGHT_CODES = {v: k for k, v in LIGHT_MODES.items()}
 
 
-def _numbered(modes):
-    """A service's valid numbers as its answers name them: 0 OFF, 1 ON, ..."""
-    return ", ".join(f"{n} {name.upper()}" for n, name in modes.items())
-
-
 # The driver's events that answer a call of the node's (a service's request settled, the motion
-# mode pinned): each is the service's answer, logged once as the answer (_log_answer).
-ANSWER_EVENTS = {"request_settled", "motion_mode_requested"}
+# mode pinned): each is the service's answer, logged once as the answer (_log_answer); the
+# library's list, as the ROS 1 node's.
+ANSWER_EVENTS = frozenset(ranger_can.answer_event_kinds())
 
 # s: Python's thread switch interval in the node (sys.setswitchinterval; main() says why).
 GIL_SWITCH_INTERVAL = 0.0005
@@ -79,12 +75,6 @@ GIL_SWITCH_INTERVAL = 0.0005
 # s: how long the motion publication trusts its last look at who subscribes (a new subscriber
 # gets odom, /tf, joint_states at most this late).
 AUDIENCE_PERIOD = 0.1
-
-
-def _advance(due, period, now):
-    """A fixed-rate schedule: one period after the last due time; after a stall, from now."""
-    due += period
-    return due if due >= now else now + period
 
 
 class ParameterError(Exception):
@@ -337,22 +327,26 @@ class RangerNode(Node):
                                + (f": {said}" if said else ""))
 
     def _answer(self, what, call):
-        """Runs a request; (success, message, outcome)."""
+        """Runs a request; (success, message, outcome): the library's answer to the outcome
+        (ranger_can.request_answer, the ROS 1 node's words), or why it was not posted."""
         try:
             outcome = call()
-            return True, outcome.message, outcome
         except (RequestFailed, RequestTimeout) as e:
-            return False, str(e), e.outcome
+            outcome = e.outcome
+            if outcome is None:
+                return False, str(e), None
         except RangerError as e:
             return False, str(e), None
+        ok, message = ranger_can.request_answer(outcome)
+        return ok, message, outcome
 
     def _log_answer(self, what, ok, message):
         """Every service answer, one line at its severity (info, or warn for a refusal or a
         failure), in the library's words (the answer's message); the driver's events that are
         the same answer (ANSWER_EVENTS) are not logged again. Every answer has its line: the
         driver's request_settled events leave out an answer alike to the one before it."""
-        line = message if message.startswith((f"{what}:", f"{what} ")) else f"{what}: {message}"
-        self._log_at("info" if ok else "warn", line)
+        severity, line = ranger_can.answer_line(what, ok, message)
+        self._log_at(severity, line)
 
     def _on_resume(self, request, response):
         refused = ranger_can.resume_refused_offline(self.driver.snapshot(), self.port)
@@ -360,9 +354,7 @@ class RangerNode(Node):
             response.success = False
             response.message = refused
         else:
-            ok, message, _ = self._answer("resume", self.driver.resume)
-            response.success = ok
-            response.message = ranger_can.resume_answered() if ok else message
+            response.success, response.message, _ = self._answer("resume", self.driver.resume)
         self._log_answer("resume", response.success, response.message)
         return response
 
@@ -380,12 +372,10 @@ class RangerNode(Node):
         return response
 
     def _on_set_ultrasonic(self, request, response):
-        if request.enable == request.disable:
+        refused = ranger_can.ultrasonic_request_refused(request.enable, request.disable)
+        if refused is not None:
             response.success = False
-            response.message = (("contradictory request (enable and disable both true)"
-                                 if request.enable else
-                                 "empty request (neither enable nor disable)")
-                                + ": set exactly one of them; nothing sent")
+            response.message = refused
         else:
             ok, message, _ = self._answer(
                 "ultrasonic", lambda: self.driver.set_ultrasonic(request.enable))
@@ -417,17 +407,15 @@ class RangerNode(Node):
 
     def _on_set_lights(self, request, response):
         response.success = False
-        bad = [f"{side}_mode {mode}" for side, mode in (("front", request.front_mode),
-                                                        ("rear", request.rear_mode))
-               if mode not in LIGHT_MODES]
-        if bad:
-            response.message = f"{', '.join(bad)} unknown ({_numbered(LIGHT_MODES)}): nothing sent"
-        else:
-            custom = SetLights.Request.CUSTOM
+        refused = ranger_can.lights_request_refused(request.front_mode, request.front_brightness,
+                                                    request.rear_mode, request.rear_brightness)
+        if refused is not None:  # the library's check and words, as the ROS 1 node's
+            response.message = refused
+        else:  # the brightness counts in custom mode only (the library sends 0 otherwise)
             ok, message, _ = self._answer("set_lights", lambda: self.driver.set_lights(
                 front=LIGHT_MODES[request.front_mode], rear=LIGHT_MODES[request.rear_mode],
-                front_brightness=request.front_brightness if request.front_mode == custom else 0,
-                rear_brightness=request.rear_brightness if request.rear_mode == custom else 0))
+                front_brightness=request.front_brightness,
+                rear_brightness=request.rear_brightness))
             response.success = ok
             response.message = message
         lights = self.driver.snapshot().lights
@@ -448,11 +436,11 @@ class RangerNode(Node):
         return response
 
     def _on_set_drive_mode(self, request, response):
-        mode = DRIVE_MODES.get(request.mode)
-        if mode is None:
+        try:  # the library's check and words, as the ROS 1 node's
+            mode = ranger_can.drive_mode_request(request.mode)
+        except RangerError as e:
             response.success = False
-            valid = ", ".join(f"{n} ({name.upper()})" for n, name in DRIVE_MODES.items())
-            response.message = f"drive mode {request.mode} is not one of {valid}: nothing sent"
+            response.message = str(e)
         else:
             ok, message, _ = self._answer("set_drive_mode",
                                           lambda: self.driver.set_drive_mode(mode))
@@ -472,21 +460,28 @@ class RangerNode(Node):
         C++: Driver.wait_motion), when a motion frame was sent (cmd_vel_out), or when the
         states or diagnostics are due; not at every driver iteration."""
         name_os_thread("ranger_publish")
-        next_state = next_diag = next_audience = time.monotonic()
+        # The library's fixed-rate schedules (ranger_can.PublicationSchedule), as the ROS 1
+        # node's publication thread paces its states and diagnostics.
+        start = next_audience = time.monotonic()
+        states = ranger_can.PublicationSchedule(self.params["state_publish_rate"])
+        diagnostics = ranger_can.PublicationSchedule(1.0 / self.params["diagnostic_period"])
+        states.start(start)
+        diagnostics.start(start)
         while not self._stop.is_set():
             try:
                 now = time.monotonic()
-                if now >= next_state:
+                if states.due(now):
                     self._publish_states(self.driver.snapshot())
-                    next_state = _advance(next_state, 1.0 / self.params["state_publish_rate"], now)
-                if now >= next_diag:
+                    states.advance(now, self.params["state_publish_rate"])
+                if diagnostics.due(now):
                     self._publish_diagnostics()
-                    next_diag = _advance(next_diag, self.params["diagnostic_period"], now)
+                    diagnostics.advance(now, 1.0 / self.params["diagnostic_period"])
                 if now >= next_audience:
                     self._motion_audience = self._ask_motion_audience()
                     self._recheck_cmd_vel_type()
                     next_audience = now + AUDIENCE_PERIOD
-                wait = max(0.0, min(next_state, next_diag, next_audience) - time.monotonic())
+                wait = max(0.0, min(states.wake_at, diagnostics.wake_at, next_audience)
+                           - time.monotonic())
                 if any(self._motion_audience):
                     update = self.driver.wait_motion(self.params["publish_rate"], wait)
                     self._publish_motion(update)

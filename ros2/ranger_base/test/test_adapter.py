@@ -50,3 +50,51 @@ def test_no_module_retypes_a_mode_name():
                     if literal in names:
                         found.append(f"{os.path.basename(path)}:{number}: {line.strip()}")
     assert not found, "the library's mode names re-typed:\n" + "\n".join(found)
+
+
+# The library's words and numbers a module of ranger_base must not spell itself: the services'
+# checks and answers (frontend/answers.hpp), BatteryState's status and health (the library's
+# battery report), the Range of nothing seen (range_reading), the refusals and the link states.
+RETYPED = ("nothing sent", "not confirmed", "set exactly one", "contradictory request",
+           "POWER_SUPPLY_STATUS_", "POWER_SUPPLY_HEALTH_", "math.inf",
+           "re-armed", "motion mode pinned")
+
+
+def test_no_module_retypes_the_librarys_words_or_numbers():
+    names = set(ranger_can.refusal_names()) | {"never_connected", "connected", "stale"}
+    found = []
+    for path in glob.glob(os.path.join(PACKAGE, "*.py")):
+        if os.path.basename(path) == "measure_performance.py":  # a tool, no front end
+            continue
+        with open(path, encoding="utf-8") as f:
+            for number, line in enumerate(f, 1):
+                code = line.split("#", 1)[0]
+                bad = [w for w in RETYPED if w in code]
+                bad += [n for n in re.findall(r"""["']([a-z_]+)["']""", code) if n in names]
+                if bad:
+                    found.append(f"{os.path.basename(path)}:{number}: {bad}: {line.strip()}")
+    assert not found, "the library's words re-typed:\n" + "\n".join(found)
+
+
+def test_the_librarys_battery_and_range_facts_reach_the_messages():
+    from sensor_msgs.msg import BatteryState
+    from ranger_base import conversions
+
+    class Reading:  # a raw ultrasonic value beyond max_range, and one of no reading
+        stamp_ns, sensor = 1, 1
+
+        def __init__(self, raw):
+            self.raw = raw
+    params = {"frame_prefix": "", "ultrasonic/field_of_view": 0.5, "ultrasonic/min_range": 0.1,
+              "ultrasonic/max_range": 0.5}
+    assert conversions.to_range(Reading(4000), params).range == ranger_can.range_reading(4000, 0.5)
+    assert conversions.to_range(Reading(4000), params).range == float("inf")
+    assert conversions.to_range(Reading(0), params).range != conversions.to_range(
+        Reading(0), params).range  # NaN: no reading
+    with ranger_can.Driver("sim", protocol="manual", start=False) as d:
+        s = d.snapshot()
+        msg = conversions.to_battery_state(s, conversions.to_time(5))
+        report = s.battery_report
+    assert (msg.present, msg.power_supply_status, msg.power_supply_health) == (
+        report.present, report.power_supply_status, report.power_supply_health)
+    assert msg.power_supply_status == BatteryState.POWER_SUPPLY_STATUS_UNKNOWN  # nothing heard

@@ -4,7 +4,6 @@ namespace of its own; discovery stays on this host (ROS_AUTOMATIC_DISCOVERY_RANG
 the stage's ROS_DOMAIN_ID, set by scripts/test_ros2.sh)."""
 
 import math
-import os
 import signal
 import subprocess
 import time
@@ -153,7 +152,7 @@ def test_park_and_lights_on_agx_v2(robots, client):
     assert not too_bright.success and "brightness" in too_bright.message
     park = client.call(SetBool, f"{r.ns}/park", SetBool.Request(data=True))
     assert park.success, park.message
-    s = r.wait_state(lambda s: s.parked and s.motion_inhibited_reason == "parked", 10, "parked",
+    r.wait_state(lambda s: s.parked and s.motion_inhibited_reason == "parked", 10, "parked",
                      pace=lambda: r.send(vx=0.3))
     assert abs(r.truth().twist.twist.linear.x) < 1e-3
     assert client.call(SetBool, f"{r.ns}/park", SetBool.Request(data=False)).success

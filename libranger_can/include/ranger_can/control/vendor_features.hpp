@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "ranger_can/control/feedback.hpp"
+#include "ranger_can/result.hpp"
 #include "ranger_can/text.hpp"
 #include "ranger_can/types.hpp"
 #include "ranger_can/wire/codec.hpp"
@@ -80,6 +81,13 @@ struct LightsRequest {
   protocol::LightMode rear = protocol::LightMode::kOn;
   std::uint8_t rear_brightness = 0;
 };
+// A custom light brightness: 0..100 (%).
+inline constexpr int kMaxLightBrightness = 100;
+// The one check of a brightness (every front end's, the driver's): 0..kMaxLightBrightness, else
+// kInvalidArgument "<side>_brightness 101 outside 0..100: nothing sent"; what is sent: the value
+// in custom mode, 0 in any other.
+Result<std::uint8_t> light_brightness(std::string_view side, protocol::LightMode mode,
+                                      long long value);
 // "front on, rear custom 40"
 std::string describe(protocol::LightMode front, std::uint8_t front_brightness,
                      protocol::LightMode rear, std::uint8_t rear_brightness);

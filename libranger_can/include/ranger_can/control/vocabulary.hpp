@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -74,10 +75,66 @@ double ultrasonic_range(std::int16_t raw);
 // "ok", "no_reading", "offline", ... (ranger_msgs' UltrasonicReading status).
 std::string_view ultrasonic_status(std::int16_t raw);
 
+// sensor_msgs/Range's `range` for a raw ultrasonic value (REP-117): the distance in m; NaN for no
+// reading and every error code; +inf, "nothing seen", for a distance beyond `max_range`.
+double range_reading(std::int16_t raw, double max_range);
+
+// The newest of the joint feedback's frame stamps (steering angles, wheel speeds); 0 for none.
+Timestamp joints_stamp(const ChassisFeedback& feedback);
+
 // A 6x6 covariance (x, y, z, roll, pitch, yaw), row-major as ROS messages carry it.
 using Covariance = std::array<double, 36>;
 Covariance diagonal_covariance(const std::array<double, 6>& diagonal);
 // `floor` on the diagonal plus the odometry's growing x, y and yaw variance.
 Covariance pose_covariance(const OdometryState& odometry, const std::array<double, 6>& floor);
+// The same from the x, y and yaw variance alone.
+Covariance pose_covariance(const std::array<double, 3>& pose_variance,
+                           const std::array<double, 6>& floor);
+
+// ---- the battery, as sensor_msgs/BatteryState reports it -------------------------------------
+// power_supply_status and power_supply_health: sensor_msgs/BatteryState's numbers (both nodes'
+// tests compare them with the message's constants).
+enum class PowerSupplyStatus : std::uint8_t {
+  kUnknown = 0,
+  kCharging = 1,
+  kDischarging = 2,
+  kNotCharging = 3,
+  kFull = 4,
+};
+enum class PowerSupplyHealth : std::uint8_t {
+  kUnknown = 0,
+  kGood = 1,
+  kOverheat = 2,
+  kDead = 3,
+  kOvervoltage = 4,
+  kUnspecFailure = 5,
+  kCold = 6,
+  kWatchdogTimerExpire = 7,
+  kSafetyTimerExpire = 8,
+};
+// The pack's charge state by its current (sensor_msgs: negative while discharging, as the BMS
+// reports it): charging above 0, discharging below, not charging at 0.
+PowerSupplyStatus power_supply_status(double current);
+// The pack's health from its BMS alarm pair: the first of over-voltage (overvoltage),
+// high temperature (overheat), low temperature (cold), then under-voltage or an over-current
+// (unspecified failure); good without any.
+PowerSupplyHealth power_supply_health(std::uint8_t alarm1, std::uint8_t alarm2);
+
+// What sensor_msgs/BatteryState says of the pack: from the BMS (0x361) while it reports; from the
+// system status's battery voltage alone when only that is heard; nothing (present false) before.
+struct BatteryReport {
+  static constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  bool present = false;
+  Timestamp stamp{0};  // the report's frame; 0: none (the front end stamps it with its own now)
+  double voltage = kNaN, current = kNaN, temperature = kNaN;  // V, A, degC
+  double percentage = kNaN;                                   // 0..1
+  PowerSupplyStatus status = PowerSupplyStatus::kUnknown;
+  PowerSupplyHealth health = PowerSupplyHealth::kUnknown;
+  // Each battery slot 1..kBatteryCount: its voltage and temperature, NaN where not reporting.
+  static_assert(kBatteryCount == 4, "one NaN per slot below");
+  std::array<double, kBatteryCount> cell_voltage{kNaN, kNaN, kNaN, kNaN};
+  std::array<double, kBatteryCount> cell_temperature{kNaN, kNaN, kNaN, kNaN};
+};
+BatteryReport battery_report(const ChassisFeedback& feedback, Timestamp now);
 
 }  // namespace ranger

@@ -23,10 +23,22 @@ struct ServiceAnswer {
   std::string message;
 };
 
+// A line for the log at its severity.
+struct LogLine {
+  Severity severity = Severity::kInfo;
+  std::string text;
+};
+
 // A request after the front end's wait for it: success once answered. The message is the
 // driver's (the answer, or why it failed), else `unconfirmed` and the state it reached, e.g.
 // "park not confirmed in time (sent)".
 ServiceAnswer answer_of(const RequestOutcome& outcome, std::string_view unconfirmed);
+
+// Any request's answer after the wait, by its kind (RequestOutcome::kind, on): clear_errors'
+// as clear_errors_answer, resume's as resume_answer, the others as answer_of with their words for
+// "not confirmed in time" ("park not confirmed in time", "the chassis did not report its lights in
+// time", ...).
+ServiceAnswer request_answer(const RequestOutcome& outcome);
 
 // `resume` on a bus that is not open: refused before asking, naming the port and the bus's error.
 std::optional<ServiceAnswer> resume_refused_offline(const DriverSnapshot& snapshot,
@@ -50,13 +62,30 @@ std::string unknown_motion_mode_number(int number, const ProtocolProfile& profil
 // set_motion_mode accepted: "motion mode pinned to spin (the switch happens at standstill)".
 std::string motion_mode_pinned(std::optional<protocol::MotionMode> mode);
 
+// The services' checks, made before anything is sent; each refusal ends ": nothing sent".
+// set_ultrasonic: exactly one of enable and disable.
+std::optional<ServiceAnswer> ultrasonic_request_refused(bool enable, bool disable);
+// set_lights from ranger_msgs/SetLights' numbers: a mode is one of kLightModeNames' numbers, a
+// brightness 0..kMaxLightBrightness (it counts in custom mode only: 0 is sent otherwise).
+Result<LightsRequest> lights_request(long long front_mode, long long front_brightness,
+                                     long long rear_mode, long long rear_brightness);
+// The same from the modes' names (the binding's and the CLI's spelling).
+Result<LightsRequest> lights_request(protocol::LightMode front, long long front_brightness,
+                                     protocol::LightMode rear, long long rear_brightness);
+// set_drive_mode from ranger_msgs/SetDriveMode's number: 0 CURRENT, 1 VOLTAGE.
+Result<protocol::DriveMode> drive_mode_request(long long number);
+
+// The log line of a service's answer: info for a success, a warning for a refusal or a failure,
+// in the answer's words, prefixed "<service>: " unless they name the service already. Each
+// answer is logged once this way; the driver's events that are the same answer
+// (is_answer_event) are not logged besides.
+LogLine answer_line(std::string_view service, const ServiceAnswer& answer);
+// request_settled and motion_mode_requested: a service's answer (answer_line logs it).
+bool is_answer_event(EventKind kind);
+
 // The start-up log's lines about the vehicle model and where the protocol settings come from
 // (auto: identified before anything moves; forced; auto overridden by interpretation parameters,
 // a warning).
-struct LogLine {
-  Severity severity = Severity::kInfo;
-  std::string text;
-};
 std::vector<LogLine> describe_protocol_setup(const NodeParameters& params);
 // A `sim/inject` line and what the virtual chassis said (sim::apply_chassis_command): applied
 // (info), or not applied, why, and the valid commands (a warning).
