@@ -153,7 +153,7 @@ def test_park_and_lights_on_agx_v2(robots, client):
     park = client.call(SetBool, f"{r.ns}/park", SetBool.Request(data=True))
     assert park.success, park.message
     r.wait_state(lambda s: s.parked and s.motion_inhibited_reason == "parked", 10, "parked",
-                     pace=lambda: r.send(vx=0.3))
+                 pace=lambda: r.send(vx=0.3))
     assert abs(r.truth().twist.twist.linear.x) < 1e-3
     assert client.call(SetBool, f"{r.ns}/park", SetBool.Request(data=False)).success
     r.client.wait_for(lambda: r.truth().twist.twist.linear.x > 0.2, 30, "driving",
