@@ -92,6 +92,9 @@ class Answers : public ::testing::Test {
   static void TearDownTestSuite() {
     rosout_.shutdown();
     spinner_->stop();
+    // Destroyed here, not at exit: a static spinner outliving roscpp's own statics is a
+    // heap-use-after-free in ~AsyncSpinner (the ASan build of the ROS tests, as test_node_sim).
+    spinner_.reset();
   }
 
   // `answer` is the library's answer to the request: the response says it, and its one log line
