@@ -20,7 +20,7 @@
 # RANGER_ROS2_DOMAIN_ID (the first distribution's, the next one's one more; default 86 for
 # Jazzy, 87 for Kilted), RANGER_JOBS,
 # RANGER_ROS2_SKIP_PIP=1 to leave out the pip install; RANGER_ROS2_PARALLEL=0 runs the
-# distributions one after the other (default: side by side).
+# distributions' tests one after the other (default: side by side, after the builds in turn).
 set -uo pipefail
 cd "$(dirname "$0")/.."
 # shellcheck source=build_flags.sh
@@ -52,10 +52,10 @@ if [ "$setup_only" = 1 ]; then
   exit $failed
 fi
 
-# One distribution: its venv, its workspace, its tests, its domain id. Returns non-zero when
-# anything failed.
-run_distro() {  # distro domain_id
-  local distro=$1 domain=$2 venv ws started=$SECONDS
+# One distribution's colcon build in its workspace (its venv in $venv). Returns non-zero when it
+# failed.
+build_distro() {  # distro
+  local distro=$1 ws started=$SECONDS
   setup_distro "$distro" || return 1
   ws=$root/build/ros2_ws_$distro
   echo "test_ros2: $distro: venv $venv, workspace $ws"
@@ -75,7 +75,13 @@ run_distro() {  # distro domain_id
       --cmake-args -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=$ranger_relwithdebinfo_flags" \
       -DBUILD_TESTING=OFF
   ) || { echo "test_ros2: $distro: the colcon build failed" >&2; return 1; }
-  local built=$SECONDS
+  echo "test_ros2: $distro built ($((SECONDS - started)) s)"
+}
+
+# One distribution's tests, with its domain id. Returns non-zero when any failed.
+test_distro() {  # distro domain_id
+  local distro=$1 domain=$2 venv started=$SECONDS
+  setup_distro "$distro" >/dev/null || return 1
   (
     # shellcheck disable=SC1091
     RANGER_ROS2_DISTRO=$distro RANGER_ROS2_VENV=$venv \
@@ -90,35 +96,41 @@ run_distro() {  # distro domain_id
     done
     exit $rc
   ) || { echo "test_ros2: $distro: tests failed" >&2; return 1; }
-  echo "test_ros2: $distro passed (build $((built - started)) s, tests $((SECONDS - built)) s)"
+  echo "test_ros2: $distro passed (tests $((SECONDS - started)) s)"
 }
 
 /usr/bin/python3 ros2/ranger_msgs/sync_interfaces.py --check || failed=1
-# The distributions side by side (RANGER_ROS2_PARALLEL=0: one after the other): each has its own
-# venv, workspace and domain id, and their suites mostly wait on nodes and DDS. The first ones run
-# in the background, their output in build/ros2_DISTRO.log, printed whole when they are done.
+# The builds one after the other (the second distribution's compilations of the library are the
+# compiler cache's hits of the first's: the same flags at the same depth); then the tests side by
+# side (RANGER_ROS2_PARALLEL=0: one after the other): each distribution has its own venv,
+# workspace and domain id, and their suites mostly wait on nodes and DDS. The first ones' tests
+# run in the background, their output in build/ros2_DISTRO.log, printed whole when they are done.
 parallel=${RANGER_ROS2_PARALLEL:-1}
-background=()
-for i in "${!distros[@]}"; do
-  distro=${distros[$i]}
+built=()
+for distro in "${distros[@]}"; do
   case $distro in
     jazzy | kilted) ;;
     *) echo "test_ros2: RANGER_ROS2_DISTRO=$distro: jazzy or kilted" >&2; failed=1; continue ;;
   esac
+  if build_distro "$distro"; then built+=("$distro"); else failed=1; fi
+done
+background=()
+for i in "${!built[@]}"; do
+  distro=${built[$i]}
   # RANGER_ROS2_DOMAIN_ID: the first distribution's; the next ones count up from it.
   domain=${domain_of[$distro]}
   [ -z "${RANGER_ROS2_DOMAIN_ID:-}" ] || domain=$((RANGER_ROS2_DOMAIN_ID + i))
-  if [ "$parallel" = 1 ] && [ "$i" -lt $((${#distros[@]} - 1)) ]; then
-    run_distro "$distro" "$domain" >"$root/build/ros2_$distro.log" 2>&1 </dev/null &
+  if [ "$parallel" = 1 ] && [ "$i" -lt $((${#built[@]} - 1)) ]; then
+    test_distro "$distro" "$domain" >"$root/build/ros2_$distro.log" 2>&1 </dev/null &
     background+=("$distro:$!")
   else
-    run_distro "$distro" "$domain" || failed=1
+    test_distro "$distro" "$domain" || failed=1
   fi
 done
 for entry in "${background[@]}"; do
   distro=${entry%%:*}
   wait "${entry#*:}" || failed=1
-  echo "---- test_ros2: $distro (run beside the others; build/ros2_$distro.log):"
+  echo "---- test_ros2: $distro's tests (run beside the others; build/ros2_$distro.log):"
   cat "$root/build/ros2_$distro.log"
 done
 
