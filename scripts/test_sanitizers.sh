@@ -117,8 +117,8 @@ run_cmake_build() {  # name dir RANGER_SANITIZE common_flags flags SELECT [ctest
 
 # ranger_base (and what it needs) with one sanitizer in a colcon workspace of its own, then its
 # tests: the gtests and every rostest but the nodelet's (the node itself runs instrumented).
-run_ros_build() {  # name workspace common_flags flags
-  local name=$1 ws=build/$2 install=build/${2%-ws}-install common_flags=$3 flags=$4
+run_ros_build() {  # name workspace common_flags flags ctest_exclude_regex
+  local name=$1 ws=build/$2 install=build/${2%-ws}-install common_flags=$3 flags=$4 exclude=$5
   local reports=$root/build/$2/sanitizer-reports start=$SECONDS rc=0
   echo "== $name: colcon build up to ranger_base ($ws)"
   (
@@ -155,7 +155,7 @@ run_ros_build() {  # name workspace common_flags flags
     # the node are one class, which the other rostests run instrumented.
     colcon --log-base "build/log-${2%-ws}" test --base-paths . --packages-select ranger_base \
       --build-base "$ws" --install-base "$install" --event-handlers console_cohesion- \
-      --executor sequential --return-code-on-test-failure --ctest-args -E node_nodelet
+      --executor sequential --return-code-on-test-failure --ctest-args -E "$exclude"
     test_rc=$?
     colcon test-result --test-result-base "$ws" --verbose
     rm -rf "${results:?}/$name" && mkdir -p "$results/$name"
@@ -185,11 +185,18 @@ for kind in "${kinds[@]}"; do
       ;;
     ros)
       name=asan-ros
-      run=(run_ros_build asan-ros asan-ws "$asan_common_flags" "$asan_flags")
+      run=(run_ros_build asan-ros asan-ws "$asan_common_flags" "$asan_flags" node_nodelet)
       ;;
     ros_thread)
       name=tsan-ros
-      run=(run_ros_build tsan-ros tsan-ws "$tsan_common_flags" "$tsan_flags")
+      # The suites that drive the node's threads: node_sim (every topic, service and the
+      # virtual chassis's thread), remote, faults, shutdown (signals, rosnode kill), namespaces,
+      # commissioning, bad parameters, answers, cmd_vel_stamped, and the gtests. Left to the
+      # plain and ASan builds: the chassis variants' suites (fault bits, identification,
+      # implausible feedback, MINI, vendor, adversarial), which run the same threads on other
+      # frames, and the rate tests (hz), which measure rates, not threads.
+      run=(run_ros_build tsan-ros tsan-ws "$tsan_common_flags" "$tsan_flags"
+        'node_nodelet|node_sim_(fault_bits|identify|implausible|mini_v|unidentified|vendor|adversarial|hz)')
       ;;
     *)
       echo "test_sanitizers.sh: unknown build '$kind' (expected address, thread, ros or ros_thread)" >&2
