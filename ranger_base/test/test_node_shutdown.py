@@ -26,7 +26,10 @@ import rostest
 from geometry_msgs.msg import Twist, TwistStamped
 from ranger_msgs.msg import SystemState
 
-EXIT_BOUND_S = 0.3  # exit within 0.3 s of Ctrl-C or rosnode kill
+# exit within 0.3 s of Ctrl-C or rosnode kill. A sanitizer's build scales it
+# (RANGER_EXIT_BOUND_SCALE, which scripts/test_sanitizers.sh sets for ThreadSanitizer: its runtime
+# makes every exit slower, 314-365 ms under load); the bound itself is the plain build's to hold.
+EXIT_BOUND_S = 0.3 * float(os.environ.get("RANGER_EXIT_BOUND_SCALE", "1"))
 ATTEMPTS = 3  # a measurement over the bound is repeated, said, this many times in all
 STOP_LOG = "stop sent to the chassis"
 
