@@ -53,8 +53,10 @@ def drive(d, vx=0.0, vy=0.0, wz=0.0, distance=None, angle=None, timeout=30.0):
         time.sleep(0.05)
     d.wait_until(lambda s: abs(d.ground_truth().vx) + abs(d.ground_truth().vy) < 1e-3
                  and abs(d.ground_truth().wz) < 1e-3, timeout=10)
-    # The odometry integrates the frames that reported the stop.
-    d.wait_snapshot(timeout=0.5)
+    # The odometry has integrated the frames that reported the stop once it says so itself (a
+    # wait on what the driver reports, not on a duration: a slow host only makes it later).
+    d.wait_until(lambda s: abs(s.odometry.vx) + abs(s.odometry.vy) < 1e-3
+                 and abs(s.odometry.wz) < 1e-3, timeout=10)
 
 
 def assert_odometry_follows(d):
