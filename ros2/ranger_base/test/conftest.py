@@ -9,6 +9,7 @@ import pytest
 import rclpy
 from geometry_msgs.msg import Twist
 
+import support
 from support import Client, Robot
 
 _ns = itertools.count(1)
@@ -49,3 +50,14 @@ def robots(client, tmp_path, request):
     yield start
     for r in started:
         r.stop()
+
+
+def pytest_terminal_summary(terminalreporter):
+    """The margins of the wall-clock bounds: the waits that came closest to theirs."""
+    if not support.waits:
+        return
+    closest = sorted(support.waits, reverse=True)[:3]
+    terminalreporter.write_line(
+        f"wall-clock waits: {len(support.waits)} ended in time; the closest to its bound: " +
+        "; ".join(f"{what} {seconds:.2f} s of {bound:g} s ({100 * used:.0f} %)"
+                  for used, seconds, bound, what in closest))
