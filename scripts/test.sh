@@ -329,12 +329,16 @@ done
 finish_lanes
 
 echo
+echo "==================== test reports ($results) ===================="
+python3 scripts/junit_summary.py "$results" --files
 echo "==================== summary ===================="
 echo "stages passed: ${passed[*]:-none}"
 echo "stages failed: ${failed[*]:-none}"
 echo "wall time per stage (a lane's beside the foreground's):"
 for s in "${timing_order[@]}"; do printf '  %-11s %s\n' "$s" "${stage_time[$s]}"; done
 printf '  %-11s %s s\n' total $((SECONDS - run_start))
+echo "wall-clock bounds and what the tests measured against them, under this run's load:"
+python3 scripts/junit_summary.py "$results" --measured
 ranger_ccache_summary
-python3 scripts/junit_summary.py "$results"
+python3 scripts/junit_summary.py "$results" --total
 [ ${#failed[@]} -eq 0 ]

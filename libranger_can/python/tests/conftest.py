@@ -6,6 +6,8 @@ import functools
 import inspect
 import time
 
+import pytest
+
 import ranger_can
 
 _waits = []
@@ -30,11 +32,27 @@ ranger_can.Driver.wait_until = _timed(ranger_can.Driver.wait_until)
 ranger_can.Driver.wait_ready = _timed(ranger_can.Driver.wait_ready)
 
 
-def pytest_terminal_summary(terminalreporter):
+def _closest_waits():
+    """The waits that came closest to their bounds, as one line (None before any)."""
     if not _waits:
-        return
+        return None
     closest = sorted(_waits, reverse=True)[:3]
-    terminalreporter.write_line(
-        f"wall-clock waits: {len(_waits)} ended in time; the closest to its bound: " +
-        "; ".join(f"{what} {seconds:.2f} s of {bound:g} s ({100 * used:.0f} %)"
-                  for used, seconds, bound, what in closest))
+    return (f"wall-clock waits: {len(_waits)} ended in time; the closest to its bound: " +
+            "; ".join(f"{what} {seconds:.2f} s of {bound:g} s ({100 * used:.0f} %)"
+                      for used, seconds, bound, what in closest))
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _wait_margins(record_testsuite_property):
+    """The closest waits in the JUnit report too (property `measured`: scripts/test.sh's summary
+    prints it)."""
+    yield
+    line = _closest_waits()
+    if line:
+        record_testsuite_property("measured", line)
+
+
+def pytest_terminal_summary(terminalreporter):
+    line = _closest_waits()
+    if line:
+        terminalreporter.write_line(line)

@@ -52,12 +52,27 @@ def robots(client, tmp_path, request):
         r.stop()
 
 
-def pytest_terminal_summary(terminalreporter):
-    """The margins of the wall-clock bounds: the waits that came closest to theirs."""
+def _closest_waits():
+    """The waits that came closest to their bounds, as one line (None before any)."""
     if not support.waits:
-        return
+        return None
     closest = sorted(support.waits, reverse=True)[:3]
-    terminalreporter.write_line(
-        f"wall-clock waits: {len(support.waits)} ended in time; the closest to its bound: " +
-        "; ".join(f"{what} {seconds:.2f} s of {bound:g} s ({100 * used:.0f} %)"
-                  for used, seconds, bound, what in closest))
+    return (f"wall-clock waits: {len(support.waits)} ended in time; the closest to its bound: " +
+            "; ".join(f"{what} {seconds:.2f} s of {bound:g} s ({100 * used:.0f} %)"
+                      for used, seconds, bound, what in closest))
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _wait_margins(record_testsuite_property):
+    """The closest waits in the JUnit report too (property `measured`: scripts/test.sh's summary
+    prints it)."""
+    yield
+    line = _closest_waits()
+    if line:
+        record_testsuite_property("measured", line)
+
+
+def pytest_terminal_summary(terminalreporter):
+    line = _closest_waits()
+    if line:
+        terminalreporter.write_line(line)
