@@ -22,18 +22,6 @@ DriverConfig driver_config_for(const std::string& variant) {
   return c;
 }
 
-std::string to_string(SwitchReportUnderTest report) {
-  switch (report) {
-    case SwitchReportUnderTest::kManual:
-      return "manual_report";
-    case SwitchReportUnderTest::kField:
-      return "field_report";
-    case SwitchReportUnderTest::kVariants:
-      break;
-  }
-  return "variants_report";
-}
-
 DriverSimRig::DriverSimRig(const std::string& variant, const DriverConfig& config,
                            sim::SimSourceOptions options, SwitchReportUnderTest report) {
   options.lock_step = true;

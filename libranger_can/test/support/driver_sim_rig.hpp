@@ -19,6 +19,7 @@
 #include "ranger_can/control/driver.hpp"
 #include "ranger_can/sim/sim_bus_source.hpp"
 #include "ranger_can/sim/switch_model.hpp"
+#include "ranger_can/text.hpp"
 
 namespace ranger::test {
 
@@ -28,7 +29,15 @@ DriverConfig driver_config_for(const std::string& variant);
 
 // Which report of a mode switch the chassis runs; kVariants: the variant's own.
 enum class SwitchReportUnderTest { kVariants, kManual, kField };
-std::string to_string(SwitchReportUnderTest report);
+inline constexpr auto kSwitchReportUnderTestNames = text::enum_names<SwitchReportUnderTest>({
+    {SwitchReportUnderTest::kVariants, "variants_report"},
+    {SwitchReportUnderTest::kManual, "manual_report"},
+    {SwitchReportUnderTest::kField, "field_report"},
+});
+// The name of a test's instance (a gtest parameter's name).
+inline std::string to_string(SwitchReportUnderTest report) {
+  return std::string(kSwitchReportUnderTestNames.name(report));
+}
 // The two a driver test of switching runs against.
 inline const std::vector<SwitchReportUnderTest> kBothSwitchReports = {
     SwitchReportUnderTest::kManual, SwitchReportUnderTest::kField};
