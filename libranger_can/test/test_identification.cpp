@@ -30,10 +30,7 @@ namespace {
 using namespace std::chrono_literals;
 using protocol::MotionMode;
 using test::IdentifyRig;
-
-ProtocolProfile preset(const char* name) {
-  return *protocol_preset(name);
-}
+using test::preset;
 
 // The identification has ended (the first snapshot, before the bus opens, has none yet).
 bool identification_done(const DriverSnapshot& s) {

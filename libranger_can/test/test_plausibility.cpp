@@ -24,10 +24,7 @@ namespace {
 using namespace std::chrono_literals;
 using protocol::MotionMode;
 using test::IdentifyRig;
-
-ProtocolProfile preset(const char* name) {
-  return *protocol_preset(name);
-}
+using test::preset;
 
 // ---- the plausibility monitors' decisions, as values -------------------------------------------
 

@@ -24,6 +24,10 @@ DriverConfig forced_config(const ProtocolProfile& profile) {
   return c;
 }
 
+ProtocolProfile preset(const char* name) {
+  return *protocol_preset(name);
+}
+
 namespace {
 
 DriverConfig validated(DriverConfig config) {

@@ -18,6 +18,8 @@ namespace ranger::test {
 
 DriverConfig auto_config();
 DriverConfig forced_config(const ProtocolProfile& profile);
+// A protocol preset by its name (one that exists: "manual", "agx_v2", "mini_v3").
+ProtocolProfile preset(const char* name);
 
 // Each step (1 ms): the commander, the chassis, then the driver.
 class IdentifyRig : public DriverSimRig {
