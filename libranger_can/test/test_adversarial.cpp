@@ -106,10 +106,10 @@ TEST_P(Adversarial, AfterAStopAZeroTwistAndFourSecondsOfMotionMoveNothingUntilRe
     SCOPED_TRACE(stop.cause);
     auto rig = ready_rig();
     rig->drive({0.5, 0, 0}, std::nullopt, 2s);
-    ASSERT_GT(rig->truth().speed, 0.4);
+    ASSERT_GT(rig->chassis().speed, 0.4);
     rig->sim().with_chassis([&](sim::VirtualChassis& c) { return stop.begin(c), 0; });
     rig->drive({0.5, 0, 0}, std::nullopt, 1s);  // the commander does not notice
-    ASSERT_TRUE(rig->run_until([&] { return rig->truth().speed == 0.0; }, 2s));
+    ASSERT_TRUE(rig->run_until([&] { return rig->chassis().speed == 0.0; }, 2s));
     rig->sim().with_chassis([&](sim::VirtualChassis& c) { return stop.end(c), 0; });
     rig->drive({0.5, 0, 0}, std::nullopt, 1s);
     ASSERT_EQ(rig->snapshot()->controller.refusal, MotionRefusal::kRearmRequired);
@@ -118,19 +118,19 @@ TEST_P(Adversarial, AfterAStopAZeroTwistAndFourSecondsOfMotionMoveNothingUntilRe
 
     // A zero twist (what a navigation stack publishes at a goal), then 0.5 m/s for 4 s.
     rig->drive({}, std::nullopt, 200ms);
-    const Pose2D at = rig->truth().pose;
+    const Pose2D at = rig->chassis().pose;
     double fastest = 0.0;
     rig->drive({0.5, 0, 0}, std::nullopt, 4s,
-               [&] { fastest = std::max(fastest, std::fabs(rig->truth().speed)); });
+               [&] { fastest = std::max(fastest, std::fabs(rig->chassis().speed)); });
     EXPECT_EQ(fastest, 0.0) << "moved without resume";
-    EXPECT_EQ(moved(rig->truth().pose, at), 0.0);
+    EXPECT_EQ(moved(rig->chassis().pose, at), 0.0);
     EXPECT_EQ(rig->snapshot()->controller.refusal, MotionRefusal::kRearmRequired);
 
     // resume: the twist that keeps coming drives.
     EXPECT_EQ(outcome(*rig, rig->driver().resume()).state, RequestOutcome::State::kAnswered);
     rig->drive({0.5, 0, 0}, std::nullopt, 2s);
-    EXPECT_GT(rig->truth().speed, 0.4);
-    EXPECT_GT(moved(rig->truth().pose, at), 0.3);
+    EXPECT_GT(rig->chassis().speed, 0.4);
+    EXPECT_GT(moved(rig->chassis().pose, at), 0.3);
   }
 }
 
@@ -149,12 +149,12 @@ TEST_P(Adversarial, NaNOrInfinityInAnyOfTheSixComponentsMovesNothingAndIsNamedWh
           std::string(names[field]) + (std::isnan(bad) ? " is NaN" : " is infinite");
       SCOPED_TRACE(named);
       EXPECT_EQ(rig->driver().command(request).error().code, Errc::kNotFinite);
-      const Pose2D at = rig->truth().pose;
+      const Pose2D at = rig->chassis().pose;
       int named_steps = 0, steps = 0;
       rig->command(request);  // a stream, every 50 ms, for 1 s
       rig->run_for(1ms);
-      const Timestamp end = rig->now() + 1s;
-      while (rig->now() < end) {
+      const Timestamp end = rig->clock().now() + 1s;
+      while (rig->clock().now() < end) {
         rig->step();
         ++steps;
         const auto snap = rig->snapshot();
@@ -162,32 +162,32 @@ TEST_P(Adversarial, NaNOrInfinityInAnyOfTheSixComponentsMovesNothingAndIsNamedWh
         if (c.refusal == MotionRefusal::kInvalidCommand && c.invalid_command == named) {
           ++named_steps;
         }
-        ASSERT_EQ(rig->truth().speed, 0.0);
+        ASSERT_EQ(rig->chassis().speed, 0.0);
       }
       EXPECT_EQ(named_steps, steps) << "named for as long as it lasts";
-      EXPECT_EQ(moved(rig->truth().pose, at), 0.0);
+      EXPECT_EQ(moved(rig->chassis().pose, at), 0.0);
       // The commander's next valid twist ends it (its own mistake: no re-arm).
       rig->drive({}, std::nullopt, 100ms);
       EXPECT_EQ(rig->snapshot()->controller.refusal, MotionRefusal::kNone);
     }
   }
   rig->drive({0.3, 0, 0}, std::nullopt, 2s);
-  EXPECT_NEAR(rig->truth().speed, 0.3, 0.01);
+  EXPECT_NEAR(rig->chassis().speed, 0.3, 0.01);
 }
 
 TEST_P(Adversarial, SignFlipsAtOneKilohertzGoNowhereAndTheBusLoadStaysBounded) {
   auto rig = ready_rig();
   rig->silence();
-  const Pose2D at = rig->truth().pose;
+  const Pose2D at = rig->chassis().pose;
   const std::size_t sent_before = rig->sent().size();
   double fastest = 0.0;
   for (int ms = 0; ms < 3000; ++ms) {
     ASSERT_TRUE(rig->driver().command(MotionRequest{BodyTwist{ms % 2 ? 0.5 : -0.5, 0, 0}}).ok());
     rig->step();
-    fastest = std::max(fastest, std::fabs(rig->truth().speed));
+    fastest = std::max(fastest, std::fabs(rig->chassis().speed));
   }
   EXPECT_LE(fastest, 0.5 + 1e-9);
-  EXPECT_LT(moved(rig->truth().pose, at), 0.05);
+  EXPECT_LT(moved(rig->chassis().pose, at), 0.05);
   const auto snap = rig->snapshot();
   const ControllerState& c = snap->controller;
   EXPECT_TRUE(c.faults.empty());
@@ -196,7 +196,7 @@ TEST_P(Adversarial, SignFlipsAtOneKilohertzGoNowhereAndTheBusLoadStaysBounded) {
             3000u / 5 + 3000u / 20 + 2);
   // Still obeying: the latest command drives.
   rig->drive({0.3, 0, 0}, std::nullopt, 2s);
-  EXPECT_NEAR(rig->truth().twist.vx, 0.3, 0.01);
+  EXPECT_NEAR(rig->chassis().twist.vx, 0.3, 0.01);
 }
 
 TEST_P(Adversarial, TwoPublishersFightingNeverDriveADirectionNeitherAsked) {
@@ -209,14 +209,14 @@ TEST_P(Adversarial, TwoPublishersFightingNeverDriveADirectionNeitherAsked) {
     if (ms % 50 == 0) ASSERT_TRUE(rig->driver().command(MotionRequest{BodyTwist{0.4, 0, 0}}).ok());
     if (ms % 50 == 25) ASSERT_TRUE(rig->driver().command(MotionRequest{BodyTwist{0, 0, 0.5}}).ok());
     rig->step();
-    truth.watch(rig->truth());
+    truth.watch(rig->chassis());
   }
   truth.expect_held();
   EXPECT_TRUE(rig->snapshot()->controller.faults.empty());
   // The selector's dwell bounds the mode switches (min_dwell 1 s).
   EXPECT_LE(sent_with_id(*rig, protocol::kMotionModeCommandId, sent_before), 11u);
   rig->drive({0.3, 0, 0}, std::nullopt, 3s);
-  EXPECT_NEAR(rig->truth().twist.vx, 0.3, 0.01);
+  EXPECT_NEAR(rig->chassis().twist.vx, 0.3, 0.01);
 }
 
 TEST_P(Adversarial, ModeThrashEveryHundredMillisecondsNeverDrivesWhileSwitching) {
@@ -229,7 +229,7 @@ TEST_P(Adversarial, ModeThrashEveryHundredMillisecondsNeverDrivesWhileSwitching)
         rig->driver().set_motion_mode(i % 2 ? MotionMode::kOblique : MotionMode::kAckermann).ok());
     for (int ms = 0; ms < 100; ++ms) {
       rig->step();
-      truth.watch(rig->truth());
+      truth.watch(rig->chassis());
     }
   }
   truth.expect_held();
@@ -238,14 +238,14 @@ TEST_P(Adversarial, ModeThrashEveryHundredMillisecondsNeverDrivesWhileSwitching)
       << "the thrash did reach the chassis";
   ASSERT_TRUE(rig->driver().set_motion_mode(std::nullopt).ok());
   rig->drive({0.3, 0, 0}, std::nullopt, 3s);
-  EXPECT_NEAR(rig->truth().twist.vx, 0.3, 0.01);
+  EXPECT_NEAR(rig->chassis().twist.vx, 0.3, 0.01);
 }
 
 TEST_P(Adversarial, BadRequestsAreRefusedByNameAndChangeNothing) {
   auto rig = ready_rig();
   // The manual's reading (sim:field_switch differs in its report of a switch only).
   const bool manual = std::string(GetParam()) != "sim:agx_v2";
-  const Pose2D at = rig->truth().pose;
+  const Pose2D at = rig->chassis().pose;
   const std::size_t sent_before = rig->sent().size();
   EXPECT_EQ(rig->driver().clear_errors(0x11).error().code, Errc::kInvalidArgument);
   EXPECT_EQ(rig->driver().clear_errors(0xFF).error().code, Errc::kInvalidArgument);
@@ -274,9 +274,9 @@ TEST_P(Adversarial, BadRequestsAreRefusedByNameAndChangeNothing) {
           << "a refused request sent something";
     }
   }
-  EXPECT_EQ(moved(rig->truth().pose, at), 0.0);
+  EXPECT_EQ(moved(rig->chassis().pose, at), 0.0);
   rig->drive({0.3, 0, 0}, std::nullopt, 2s);
-  EXPECT_NEAR(rig->truth().twist.vx, 0.3, 0.01);
+  EXPECT_NEAR(rig->chassis().twist.vx, 0.3, 0.01);
 }
 
 // 1e6 rad/s at standstill: a saturated rotation (spin at its limit), never "translation dropped"
@@ -296,8 +296,8 @@ TEST_P(Adversarial, AHugeRotationAtStandstillIsNamedASaturatedRotation) {
       describe_adjustments(c.adjustments, c.requested.twist, c.last_solution->achieved);
   EXPECT_EQ(words.find("spin_saturated: asked (vx, vy, wz) = (0 m/s, 0 m/s, 1e+06 rad/s)"), 0u)
       << words;
-  EXPECT_GT(std::fabs(rig->truth().twist.wz), 0.5);
-  EXPECT_LT(rig->truth().speed, 1.6);
+  EXPECT_GT(std::fabs(rig->chassis().twist.wz), 0.5);
+  EXPECT_LT(rig->chassis().speed, 1.6);
   // Stopped: nothing is adjusted any more.
   rig->drive({}, std::nullopt, 2s);
   EXPECT_EQ(rig->snapshot()->controller.adjustments, 0u);
@@ -328,7 +328,7 @@ TEST_P(Adversarial, OdometryAcrossASilenceSaysTheGapAndItsCovarianceHoldsTheTrut
     EXPECT_GE(o.pose_variance[0], before.pose_variance[0] + reach * reach - 1e-9);
     EXPECT_GE(o.pose_variance[1], before.pose_variance[1] + reach * reach - 1e-9);
     EXPECT_GT(o.pose_variance[2], before.pose_variance[2]);
-    const Pose2D truth = rig->truth().pose;
+    const Pose2D truth = rig->chassis().pose;
     const double dx = truth.x - o.pose.x, dy = truth.y - o.pose.y;
     EXPECT_GT(std::hypot(dx, dy), 0.01) << "the pose missed the coasting in the gap";
     EXPECT_LE(std::fabs(dx), 3.0 * std::sqrt(o.pose_variance[0]));
@@ -353,7 +353,7 @@ TEST(AdversarialMiniV3, TheChassissOwnOdometerCarriesThePoseThroughASilence) {
     IdentifyRig rig("sim:mini_v3", config);
     ASSERT_TRUE(rig.wait_ready()) << to_string(rig.snapshot()->controller.refusal);
     rig.drive(twist, std::nullopt, 3s);
-    const Pose2D truth_before = rig.truth().pose;
+    const Pose2D truth_before = rig.chassis().pose;
     rig.sim().with_chassis([](sim::VirtualChassis& c) { return c.silence_for(2s), 0; });
     rig.drive(twist, std::nullopt, 2s);
     ASSERT_TRUE(rig.run_until([&] { return rig.snapshot()->motion_known; }, 1s));
@@ -361,7 +361,7 @@ TEST(AdversarialMiniV3, TheChassissOwnOdometerCarriesThePoseThroughASilence) {
     const OdometryState o = rig.snapshot()->odometry;
     EXPECT_EQ(o.gaps, 1u);
     EXPECT_NEAR(seconds(o.last_gap), 2.0, 0.05);
-    const Pose2D truth = rig.truth().pose;
+    const Pose2D truth = rig.chassis().pose;
     const double coasted = std::hypot(truth.x - truth_before.x, truth.y - truth_before.y);
     EXPECT_GT(coasted, 0.05) << "the chassis rolled on in the silence";
     EXPECT_NEAR(o.last_gap_odometer_distance, coasted, 0.25 * coasted);

@@ -23,6 +23,7 @@ namespace {
 
 using namespace std::chrono_literals;
 using test::IdentifyRig;
+using test::preset;
 
 bool contains(const std::string& s, const std::string& part) {
   return s.find(part) != std::string::npos;
@@ -66,10 +67,6 @@ class Recorder {
   Driver& driver_;
   std::vector<DriverEvent> events_;
 };
-
-ProtocolProfile preset(const char* name) {
-  return *protocol_preset(name);
-}
 
 void inject(IdentifyRig& rig, const std::string& line) {
   auto action = sim::parse_chassis_command(line);

@@ -30,10 +30,7 @@ namespace {
 using namespace std::chrono_literals;
 using protocol::MotionMode;
 using test::IdentifyRig;
-
-ProtocolProfile preset(const char* name) {
-  return *protocol_preset(name);
-}
+using test::preset;
 
 // The identification has ended (the first snapshot, before the bus opens, has none yet).
 bool identification_done(const DriverSnapshot& s) {
@@ -190,7 +187,7 @@ TEST(DriverAuto, IdentifiesTheManualChassisThenDrivesTheRoute) {
   const auto s = rig.snapshot();
   ASSERT_TRUE(s->identification->decided_ok()) << s->identification->message;
   EXPECT_EQ(s->profile, preset("manual")) << describe(s->profile);
-  EXPECT_EQ(rig.truth().distance_travelled, 0.0) << "no wheel rolled while identifying";
+  EXPECT_EQ(rig.chassis().distance_travelled, 0.0) << "no wheel rolled while identifying";
   EXPECT_TRUE(rig.saw_refusal(MotionRefusal::kIdentifying));
   EXPECT_GE(rig.first_send(), rig.start() + IdentificationConfig{}.listen_time)
       << "nothing is sent while listening";
@@ -343,7 +340,7 @@ TEST_P(EveryVariant, AutoIdentifiesItAndDrivesTheRoute) {
   std::printf("[identify] variant=%s %s time=%.2f s confidence=%.3f profile=%s\n", v.c_str(),
               std::string(to_string(id.phase)).c_str(), seconds(id.elapsed()), id.confidence,
               describe(id.profile).c_str());
-  EXPECT_EQ(rig.truth().distance_travelled, 0.0) << "nothing rolled while identifying";
+  EXPECT_EQ(rig.chassis().distance_travelled, 0.0) << "nothing rolled while identifying";
   EXPECT_LE(id.elapsed(), IdentificationConfig{}.timeout);
   if (v == "undecidable") {
     EXPECT_EQ(id.phase, IdentificationPhase::kFailed);
@@ -353,7 +350,7 @@ TEST_P(EveryVariant, AutoIdentifiesItAndDrivesTheRoute) {
     EXPECT_NE(after->identification->message.find("ranger_can commission IFACE --wheels-lifted"),
               std::string::npos)
         << after->identification->message;
-    EXPECT_EQ(rig.truth().distance_travelled, 0.0) << "at rest";
+    EXPECT_EQ(rig.chassis().distance_travelled, 0.0) << "at rest";
     return;
   }
   ASSERT_TRUE(id.decided_ok()) << id.message;
@@ -513,7 +510,7 @@ TEST(IdentifyMiniV3, TheDriverInAutoDecidesMiniV3OnTheVirtualMini30AndDrives) {
   EXPECT_EQ(id.revision, "mini_v3");
   EXPECT_EQ(s->profile, *protocol_preset("mini_v3")) << describe(s->profile);
   EXPECT_TRUE(has_line(id.evidence, "0x312 (rear_odometer)")) << all_lines(id.evidence);
-  EXPECT_EQ(rig.truth().distance_travelled, 0.0) << "nothing rolled while identifying";
+  EXPECT_EQ(rig.chassis().distance_travelled, 0.0) << "nothing rolled while identifying";
   rig.expect_route("sim:mini_v3 auto");
 }
 

@@ -24,10 +24,7 @@ namespace {
 using namespace std::chrono_literals;
 using protocol::MotionMode;
 using test::IdentifyRig;
-
-ProtocolProfile preset(const char* name) {
-  return *protocol_preset(name);
-}
+using test::preset;
 
 // ---- the plausibility monitors' decisions, as values -------------------------------------------
 
@@ -104,7 +101,7 @@ TEST(Plausibility, RightSettingsNeverTripOverALongDriveInEveryMode) {
   EXPECT_FALSE(s->plausibility.stop) << s->plausibility.stop->text();
   EXPECT_EQ(warned, 0u);
   EXPECT_GT(s->plausibility.checks, 1000u) << "the monitors did judge";
-  EXPECT_GT(rig.truth().distance_travelled, 20.0);
+  EXPECT_GT(rig.chassis().distance_travelled, 20.0);
 }
 
 struct WrongSetting {
@@ -129,13 +126,13 @@ void expect_caught(const WrongSetting& w) {
   EXPECT_NE(s->controller.implausible_reason.find(w.expect_setting), std::string::npos)
       << s->controller.implausible_reason;
   rig.run_for(2s);
-  const double distance = rig.truth().distance_travelled;
-  const double turned = rig.truth().yaw_travelled * 180.0 / M_PI;
+  const double distance = rig.chassis().distance_travelled;
+  const double turned = rig.chassis().yaw_travelled * 180.0 / M_PI;
   std::printf("[stop] wrong=%s distance=%.3f m turned=%.1f deg caught_after=%.2f s reason=%s\n",
               w.name, distance, turned, seconds(rig.stopped_after()),
               s->controller.implausible_reason.c_str());
   EXPECT_LE(distance, w.max_distance);
-  EXPECT_EQ(rig.truth().speed, 0.0) << "at rest after the stop";
+  EXPECT_EQ(rig.chassis().speed, 0.0) << "at rest after the stop";
   ::testing::Test::RecordProperty("stop_distance_m", std::to_string(distance));
 }
 
@@ -235,19 +232,19 @@ TEST(Plausibility, AManualDriverOnAnAgxChassisIsCaught) {
       << "sim:agx_v2 is no variant of the library";
   IdentifyRig rig("sim:agx_v2", test::forced_config(preset("manual")));
   rig.command({0.6, 0.0, 0.3}, MotionMode::kAckermann);
-  const Timestamp began = rig.now();
+  const Timestamp began = rig.clock().now();
   ASSERT_TRUE(
       rig.run_until([&] { return !rig.snapshot()->controller.implausible_reason.empty(); }, 10s));
   const std::string reason = rig.snapshot()->controller.implausible_reason;
-  const double after = seconds(rig.now() - began);
+  const double after = seconds(rig.clock().now() - began);
   rig.run_for(2s);
-  const double distance = rig.truth().distance_travelled;
+  const double distance = rig.chassis().distance_travelled;
   std::printf("[stop] wrong=manual_on_agx_v2 distance=%.3f m caught_after=%.2f s reason=%s\n",
               distance, after, reason.c_str());
   EXPECT_NE(reason.find("error_word: try agx16"), std::string::npos) << reason;
   EXPECT_NE(rig.snapshot()->controller.refusal, MotionRefusal::kNone);
   EXPECT_LE(distance, 0.05);
-  EXPECT_EQ(rig.truth().speed, 0.0);
+  EXPECT_EQ(rig.chassis().speed, 0.0);
 }
 
 }  // namespace

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <utility>
+
 #include "ranger_can/control/model.hpp"
 
 namespace ranger::test {
@@ -22,21 +24,13 @@ DriverConfig driver_config_for(const std::string& variant) {
   return c;
 }
 
-std::string to_string(SwitchReportUnderTest report) {
-  switch (report) {
-    case SwitchReportUnderTest::kManual:
-      return "manual_report";
-    case SwitchReportUnderTest::kField:
-      return "field_report";
-    case SwitchReportUnderTest::kVariants:
-      break;
-  }
-  return "variants_report";
-}
-
 DriverSimRig::DriverSimRig(const std::string& variant, const DriverConfig& config,
-                           sim::SimSourceOptions options, SwitchReportUnderTest report) {
-  options.lock_step = true;
+                           sim::SimSourceOptions options, SwitchReportUnderTest report)
+    : DriverSimRig(sim_bus(variant, std::move(options), report), config) {}
+
+DriverSimRig::SimBus DriverSimRig::sim_bus(const std::string& variant,
+                                           sim::SimSourceOptions options,
+                                           SwitchReportUnderTest report) {
   std::string spec = variant == "manual" ? "sim" : "sim:" + variant;
   if (report != SwitchReportUnderTest::kVariants) {
     // The variant's chassis, then the report over it (the plain `sim` applies nothing more).
@@ -48,10 +42,15 @@ DriverSimRig::DriverSimRig(const std::string& variant, const DriverConfig& confi
                                        : sim::mode_left_switch_model();
     spec = "sim";
   }
-  auto source = sim::open_bus_source(spec, clock_, options);
-  EXPECT_TRUE(source.ok());
+  return {std::move(spec), std::move(options)};
+}
+
+DriverSimRig::DriverSimRig(SimBus bus, DriverConfig config) {
+  bus.options.lock_step = true;
+  auto source = sim::open_bus_source(bus.spec, clock_, bus.options);
+  EXPECT_TRUE(source.ok()) << (source ? "" : source.error().message);
   sim_ = std::static_pointer_cast<sim::SimBusSource>(*source);
-  driver_ = std::make_unique<Driver>(config, *source, clock_);
+  driver_ = std::make_unique<Driver>(std::move(config), *source, clock_);
   driver_->set_sent_observer([this](const SentEvent& e) {
     sent_.push_back(e);
     on_sent(e);

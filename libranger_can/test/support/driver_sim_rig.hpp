@@ -1,7 +1,9 @@
 // The driver and the virtual chassis (`sim` or `sim:VARIANT`) in lock-step under a ManualClock,
-// 1 ms a step (the chassis, then the driver), no thread and no sleeping: the rig of the driver's
-// tests (test_driver, test_driver_vendor) and of the field facts' (test_field_facts). A test that
-// watches each step derives from it (chassis_stepped, driver_stepped, on_sent).
+// 1 ms a step (the chassis, then the driver), no thread and no sleeping: the one rig of the
+// driver's tests (test_driver, test_driver_vendor), of the field facts' (test_field_facts) and,
+// through IdentifyRig (support/identify_rig.hpp: a commander, the route, the plausibility stop), of
+// the identification, plausibility, events and adversarial tests. A test that watches each step
+// derives from it (chassis_stepping, chassis_stepped, driver_stepped, on_sent).
 //
 // Every driver test of a mode switch runs against both reports of it (sim/switch_model.hpp):
 // the manual's (0x291 the mode being left, switching = 1 throughout) and the field's (the new mode
@@ -19,6 +21,7 @@
 #include "ranger_can/control/driver.hpp"
 #include "ranger_can/sim/sim_bus_source.hpp"
 #include "ranger_can/sim/switch_model.hpp"
+#include "ranger_can/text.hpp"
 
 namespace ranger::test {
 
@@ -28,7 +31,15 @@ DriverConfig driver_config_for(const std::string& variant);
 
 // Which report of a mode switch the chassis runs; kVariants: the variant's own.
 enum class SwitchReportUnderTest { kVariants, kManual, kField };
-std::string to_string(SwitchReportUnderTest report);
+inline constexpr auto kSwitchReportUnderTestNames = text::enum_names<SwitchReportUnderTest>({
+    {SwitchReportUnderTest::kVariants, "variants_report"},
+    {SwitchReportUnderTest::kManual, "manual_report"},
+    {SwitchReportUnderTest::kField, "field_report"},
+});
+// The name of a test's instance (a gtest parameter's name).
+inline std::string to_string(SwitchReportUnderTest report) {
+  return std::string(kSwitchReportUnderTestNames.name(report));
+}
 // The two a driver test of switching runs against.
 inline const std::vector<SwitchReportUnderTest> kBothSwitchReports = {
     SwitchReportUnderTest::kManual, SwitchReportUnderTest::kField};
@@ -65,12 +76,23 @@ class DriverSimRig {
   ManualClock& clock() { return clock_; }
 
  protected:
+  // The bus as sim::open_bus_source takes it (`sim`, `sim:VARIANT`) and its options.
+  struct SimBus {
+    std::string spec;
+    sim::SimSourceOptions options;
+  };
+  // The rig on `bus` as it is (lock-step set here); IdentifyRig's.
+  DriverSimRig(SimBus bus, DriverConfig config);
+
   virtual void chassis_stepping() {}               // the clock advanced, the chassis not yet
   virtual void chassis_stepped() {}                // after the chassis stepped to now
   virtual void driver_stepped() {}                 // after the driver stepped
   virtual void on_sent(const SentEvent& /*e*/) {}  // each frame the driver sent
 
  private:
+  static SimBus sim_bus(const std::string& variant, sim::SimSourceOptions options,
+                        SwitchReportUnderTest report);
+
   ManualClock clock_{Timestamp(std::chrono::seconds(1000))};
   std::shared_ptr<sim::SimBusSource> sim_;
   std::unique_ptr<Driver> driver_;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <utility>
 
 namespace ranger::test {
 
@@ -23,55 +24,42 @@ DriverConfig forced_config(const ProtocolProfile& profile) {
   return c;
 }
 
-IdentifyRig::IdentifyRig(const std::string& spec, DriverConfig config,
-                         sim::SimSourceOptions options) {
-  start_ = clock_.now();
-  options.lock_step = true;
-  auto source = sim::open_bus_source(spec, clock_, options);
-  EXPECT_TRUE(source.ok()) << (source ? "" : source.error().message);
-  sim_ = std::static_pointer_cast<sim::SimBusSource>(*source);
+ProtocolProfile preset(const char* name) {
+  return *protocol_preset(name);
+}
+
+namespace {
+
+DriverConfig validated(DriverConfig config) {
   EXPECT_TRUE(config.validate().ok());
-  driver_ = std::make_unique<Driver>(std::move(config), *source, clock_);
-  driver_->set_sent_observer([this](const SentEvent& e) { sent_.push_back(e); });
+  return config;
 }
 
-IdentifyRig::~IdentifyRig() {
-  driver_.reset();
-}
+}  // namespace
 
-void IdentifyRig::step() {
-  clock_.advance(1ms);
-  const Timestamp now = clock_.now();
-  const MotionRefusal before = driver_->snapshot()->controller.refusal;
+IdentifyRig::IdentifyRig(const std::string& spec, DriverConfig config,
+                         sim::SimSourceOptions options)
+    : DriverSimRig(SimBus{spec, std::move(options)}, validated(std::move(config))),
+      start_(clock().now()) {}
+
+void IdentifyRig::chassis_stepping() {
+  const Timestamp now = clock().now();
+  const MotionRefusal before = snapshot()->controller.refusal;
   if (rearm_ && before == MotionRefusal::kRearmRequired && !rearming_) {
-    (void)driver_->resume();  // the operator has seen the stop
+    (void)driver().resume();  // the operator has seen the stop
     rearming_ = true;
     ++rearms_;
     next_publish_ = now + 50ms;
   } else if (request_ && now >= next_publish_) {
-    (void)driver_->command(*request_);
+    (void)driver().command(*request_);
     next_publish_ = now + 50ms;
     rearming_ = false;
   }
-  sim_->step(now);
-  driver_->step(now);
-  const MotionRefusal r = driver_->snapshot()->controller.refusal;
+}
+
+void IdentifyRig::driver_stepped() {
+  const MotionRefusal r = snapshot()->controller.refusal;
   if (refusals_.empty() || refusals_.back() != r) refusals_.push_back(r);
-}
-
-void IdentifyRig::run_for(std::chrono::nanoseconds d) {
-  const Timestamp end = clock_.now() + d;
-  while (clock_.now() < end)
-    step();
-}
-
-bool IdentifyRig::run_until(const std::function<bool()>& done, std::chrono::nanoseconds timeout) {
-  const Timestamp end = clock_.now() + timeout;
-  while (!done()) {
-    if (clock_.now() >= end) return false;
-    step();
-  }
-  return true;
 }
 
 void IdentifyRig::command(const BodyTwist& twist, std::optional<MotionMode> mode) {
@@ -80,7 +68,7 @@ void IdentifyRig::command(const BodyTwist& twist, std::optional<MotionMode> mode
 
 void IdentifyRig::command(const MotionRequest& request) {
   request_ = request;
-  next_publish_ = clock_.now();
+  next_publish_ = clock().now();
 }
 
 bool IdentifyRig::wait_ready(bool allow_any_refusal) {
@@ -98,8 +86,8 @@ bool IdentifyRig::wait_ready(bool allow_any_refusal) {
 void IdentifyRig::drive(const BodyTwist& twist, std::optional<MotionMode> mode,
                         std::chrono::nanoseconds d, const std::function<void()>& each_step) {
   command(twist, mode);
-  const Timestamp end = clock_.now() + d;
-  while (clock_.now() < end) {
+  const Timestamp end = clock().now() + d;
+  while (clock().now() < end) {
     step();
     if (each_step) each_step();
   }
@@ -108,10 +96,10 @@ void IdentifyRig::drive(const BodyTwist& twist, std::optional<MotionMode> mode,
 bool IdentifyRig::drive_until_stopped(const BodyTwist& twist, std::optional<MotionMode> mode,
                                       std::chrono::nanoseconds timeout) {
   command(twist, mode);
-  const Timestamp began = clock_.now();
+  const Timestamp began = clock().now();
   const bool stopped = run_until(
       [&] { return snapshot()->controller.refusal == MotionRefusal::kImplausible; }, timeout);
-  stopped_after_ = clock_.now() - began;
+  stopped_after_ = clock().now() - began;
   return stopped;
 }
 
@@ -119,14 +107,14 @@ void IdentifyRig::expect_route(const std::string& label, double min_turns) {
   ASSERT_TRUE(wait_ready()) << to_string(snapshot()->controller.refusal) << ": "
                             << (snapshot()->identification ? snapshot()->identification->message
                                                            : std::string());
-  const Pose2D start_truth = truth().pose;
+  const Pose2D start_truth = chassis().pose;
   const Pose2D start_odo = snapshot()->odometry.pose;
   drive({0.8, 0.0, 0.3}, MotionMode::kAckermann, 10s);  // a left arc, r = 2.7 m
   drive({0.3, 0.4, 0.0}, MotionMode::kOblique, 8s);     // crab
   drive({0.0, 0.0, 0.9}, MotionMode::kSpin, 8s);        // more than a full turn
   drive({0.0, 0.0, 0.0}, std::nullopt, 2s);
   const auto s = snapshot();
-  const auto t = truth();
+  const auto t = chassis();
   EXPECT_FALSE(s->plausibility.stop) << s->plausibility.stop->text();
   EXPECT_TRUE(s->plausibility.warnings.empty()) << s->plausibility.warnings.front().text();
   EXPECT_EQ(s->controller.refusal, MotionRefusal::kNone) << to_string(s->controller.refusal);
@@ -160,7 +148,7 @@ bool IdentifyRig::saw_refusal(MotionRefusal r) const {
 }
 
 Timestamp IdentifyRig::first_send() const {
-  return sent_.empty() ? Timestamp::max() : sent_.front().sent.frame.stamp;
+  return sent().empty() ? Timestamp::max() : sent().front().sent.frame.stamp;
 }
 
 }  // namespace ranger::test
