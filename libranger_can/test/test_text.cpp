@@ -21,6 +21,7 @@
 #include "ranger_can/control/odometry.hpp"
 #include "ranger_can/control/parameters.hpp"
 #include "ranger_can/control/rearm.hpp"
+#include "ranger_can/frontend/cmd_vel_type.hpp"
 #include "ranger_can/frontend/node_parameters.hpp"
 #include "ranger_can/json.hpp"
 #include "ranger_can/sim/scenario.hpp"
@@ -125,6 +126,9 @@ TEST(EnumNames, EveryTableHoldsEveryEnumerator) {
   expect_table_complete(kEventKindNames, "EventKind");
   expect_table_complete(kDiagnosticLevelNames, "DiagnosticLevel");
   expect_table_complete(kCmdVelStampedNames, "CmdVelStamped");
+  expect_table_complete(kCmdVelTypeNames, "CmdVelType");
+  expect_table_complete(kTypeSpellingNames, "TypeSpelling");
+  expect_table_complete(kCmdVelTypeChangeNames, "CmdVelTypeChange");
 }
 
 // The finder itself: it sees a missing enumerator.

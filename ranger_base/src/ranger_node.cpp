@@ -225,61 +225,73 @@ void RangerNode::shutdown() {
 // -----------------------------------------------------------------------------------
 
 namespace {
-constexpr const char* kTwistType = "geometry_msgs/Twist";
-constexpr const char* kTwistStampedType = "geometry_msgs/TwistStamped";
+
+// The master's type of `topic` (its latest publisher's), as the rule takes the publishers' types:
+// none when nobody publishes it (or the master does not answer).
+std::vector<std::string> published_types(const std::string& topic) {
+  ros::master::V_TopicInfo topics;
+  if (!ros::master::getTopics(topics)) return {};
+  for (const auto& t : topics) {
+    if (t.name == topic) return {t.datatype};
+  }
+  return {};
+}
+
 }  // namespace
 
 void RangerNode::subscribe_cmd_vel() {
   // Latest command wins: a queue of one drops stale twists under a flood instead of replaying
   // them late; TCP_NODELAY keeps the latency down.
   const auto hints = ros::TransportHints().tcpNoDelay();
-  const char* taken = "";
-  switch (params_.cmd_vel_stamped) {
-    case ranger::CmdVelStamped::kPlain:
-      cmd_vel_sub_ = cmd_nh_.subscribe("cmd_vel", 1, &RangerNode::on_cmd_vel, this, hints);
-      taken = "geometry_msgs/Twist (cmd_vel_stamped false)";
-      break;
-    case ranger::CmdVelStamped::kStamped:
-      cmd_vel_sub_ = cmd_nh_.subscribe("cmd_vel", 1, &RangerNode::on_cmd_vel_stamped, this, hints);
-      taken = "geometry_msgs/TwistStamped (cmd_vel_stamped true)";
-      break;
-    case ranger::CmdVelStamped::kAuto:
-      // Any type: each message is read as the type its publisher declares, Twist or TwistStamped.
-      cmd_vel_sub_ = cmd_nh_.subscribe("cmd_vel", 1, &RangerNode::on_cmd_vel_any, this, hints);
-      cmd_vel_type_timer_ = service_nh_.createTimer(
-          ros::Duration(0.25), [this](const ros::TimerEvent&) { recheck_cmd_vel_type(); });
-      taken =
-          "the type of its publishers, geometry_msgs/Twist or geometry_msgs/TwistStamped "
-          "(cmd_vel_stamped auto: no publisher yet; said again when one appears)";
-      break;
+  ranger::CmdVelTypeRule rule(params_.cmd_vel_stamped, ranger::TypeSpelling::kRos1);
+  const auto start =
+      rule.start(rule.follows_publishers() ? published_types(cmd_nh_.resolveName("cmd_vel"))
+                                           : std::vector<std::string>{});
+  {
+    std::lock_guard<std::mutex> lock(cmd_vel_type_mutex_);
+    cmd_vel_type_ = rule;
   }
-  ROS_INFO("cmd_vel: taken as %s", taken);
+  if (!rule.follows_publishers()) {
+    cmd_vel_sub_ =
+        start.taken == ranger::CmdVelType::kTwistStamped
+            ? cmd_nh_.subscribe("cmd_vel", 1, &RangerNode::on_cmd_vel_stamped, this, hints)
+            : cmd_nh_.subscribe("cmd_vel", 1, &RangerNode::on_cmd_vel, this, hints);
+  } else {
+    // Any type: each message is read as the type its publisher declares, Twist or TwistStamped.
+    cmd_vel_sub_ = cmd_nh_.subscribe("cmd_vel", 1, &RangerNode::on_cmd_vel_any, this, hints);
+    cmd_vel_type_timer_ = service_nh_.createTimer(
+        ros::Duration(0.25), [this](const ros::TimerEvent&) { recheck_cmd_vel_type(); });
+  }
+  ROS_INFO("%s", start.line.c_str());
 }
 
 void RangerNode::recheck_cmd_vel_type() {
-  const int taken = cmd_vel_type_.load();
-  if (taken == 0) return;  // nothing taken yet: the first publisher's type is taken
-  // The type taken still comes (a subscription of any type keeps a link to a publisher of the
-  // other type, refused, so its publisher count says nothing).
-  const auto quiet = std::chrono::steady_clock::now().time_since_epoch() -
-                     std::chrono::nanoseconds(last_cmd_vel_ns_.load());
-  if (quiet < std::chrono::milliseconds(500)) return;
-  ros::master::V_TopicInfo topics;
-  if (!ros::master::getTopics(topics)) return;
-  const std::string topic = cmd_nh_.resolveName("cmd_vel");
-  const auto published =
-      std::find_if(topics.begin(), topics.end(), [&](const auto& t) { return t.name == topic; });
-  if (published == topics.end()) return;  // no publisher at all
-  const int other = taken == 1 ? 2 : 1;
-  if (published->datatype != (other == 1 ? kTwistType : kTwistStampedType)) return;
-  std::lock_guard<std::mutex> lock(cmd_vel_sub_mutex_);
-  if (cmd_vel_closed_) return;
-  // A subscription of any type again: the new publisher's type is taken (and said). The old one
-  // ends first: a second subscription of the topic would join its (typed) connection.
-  cmd_vel_type_ = 0;
-  cmd_vel_sub_.shutdown();
-  cmd_vel_sub_ = cmd_nh_.subscribe("cmd_vel", 1, &RangerNode::on_cmd_vel_any, this,
-                                   ros::TransportHints().tcpNoDelay());
+  // The master gives one type for the topic: the rule wants to know whether the type taken still
+  // comes (a subscription of any type keeps a link to a publisher of the other type, refused, so
+  // its publisher count says nothing).
+  const auto since_last =
+      std::chrono::steady_clock::now().time_since_epoch() - nanoseconds(last_cmd_vel_ns_.load());
+  {
+    std::lock_guard<std::mutex> lock(cmd_vel_type_mutex_);
+    if (!cmd_vel_type_.publishers_matter(since_last)) return;
+  }
+  const auto types = published_types(cmd_nh_.resolveName("cmd_vel"));
+  ranger::CmdVelTypeDecision d;
+  {
+    std::lock_guard<std::mutex> lock(cmd_vel_type_mutex_);
+    d = cmd_vel_type_.on_publishers(types, since_last);
+  }
+  if (d.change == ranger::CmdVelTypeChange::kSwitched) {
+    std::lock_guard<std::mutex> lock(cmd_vel_sub_mutex_);
+    if (cmd_vel_closed_) return;
+    // roscpp's subscription of any type keeps its first publisher's type: a subscription of any
+    // type again. The old one ends first: a second subscription of the topic would join its
+    // (typed) connection.
+    cmd_vel_sub_.shutdown();
+    cmd_vel_sub_ = cmd_nh_.subscribe("cmd_vel", 1, &RangerNode::on_cmd_vel_any, this,
+                                     ros::TransportHints().tcpNoDelay());
+  }
+  if (!d.line.empty()) ROS_INFO("%s", d.line.c_str());
 }
 
 void RangerNode::on_cmd_vel(const geometry_msgs::Twist::ConstPtr& msg) {
@@ -292,20 +304,22 @@ void RangerNode::on_cmd_vel_stamped(const geometry_msgs::TwistStamped::ConstPtr&
 
 void RangerNode::on_cmd_vel_any(const topic_tools::ShapeShifter::ConstPtr& msg) {
   const std::string& type = msg->getDataType();
-  const int kind = type == kTwistType ? 1 : type == kTwistStampedType ? 2 : 0;
-  if (kind == 0) {
-    ROS_WARN_THROTTLE(5.0, "cmd_vel: a %s is neither %s nor %s: not obeyed", type.c_str(),
-                      kTwistType, kTwistStampedType);
+  const auto kind = ranger::parse_cmd_vel_type(type);
+  if (!kind) {
+    ROS_WARN_THROTTLE(5.0, "%s",
+                      ranger::cmd_vel_type_refused_line(type, ranger::TypeSpelling::kRos1).c_str());
     return;
   }
   last_cmd_vel_ns_ = std::chrono::duration_cast<std::chrono::nanoseconds>(
                          std::chrono::steady_clock::now().time_since_epoch())
                          .count();
-  if (cmd_vel_type_.exchange(kind) != kind) {
-    ROS_INFO("cmd_vel: taken as %s (cmd_vel_stamped auto: the type of its publishers)",
-             type.c_str());
+  ranger::CmdVelTypeDecision d;
+  {
+    std::lock_guard<std::mutex> lock(cmd_vel_type_mutex_);
+    d = cmd_vel_type_.on_message(*kind);
   }
-  if (kind == 1) {
+  if (!d.line.empty()) ROS_INFO("%s", d.line.c_str());
+  if (*kind == ranger::CmdVelType::kTwist) {
     drive(*msg->instantiate<geometry_msgs::Twist>(), std::nullopt);
   } else {
     const auto stamped = msg->instantiate<geometry_msgs::TwistStamped>();

@@ -36,7 +36,8 @@ from ._ranger_can import (  # noqa: F401  (re-exported)
     light_modes, model_names, motion_mode_pinned, resume_answered, resume_refused_offline,
     clear_errors_answer, request_answer, ultrasonic_request_refused, lights_request_refused,
     drive_mode_request, answer_line, answer_event_kinds, pose_covariance, diagonal_covariance,
-    range_reading, BatteryReport, PublicationSchedule,
+    range_reading, BatteryReport, PublicationSchedule, CmdVelTypeRule, CmdVelTypeDecision,
+    cmd_vel_type_names,
     unknown_motion_mode_number, motion_mode_numbers, light_mode_numbers, drive_mode_numbers,
     motion_modes, parameters, protocol_names, refusal_names, steering_joint_names, variant_names,
     wheel_joint_names)

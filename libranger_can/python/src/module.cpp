@@ -22,6 +22,7 @@
 #include "ranger_can/control/rearm.hpp"
 #include "ranger_can/control/vocabulary.hpp"
 #include "ranger_can/frontend/answers.hpp"
+#include "ranger_can/frontend/cmd_vel_type.hpp"
 #include "ranger_can/frontend/publication.hpp"
 #include "ranger_can/sim/chassis_commands.hpp"
 #include "ranger_can/sim/sim_bus_source.hpp"
@@ -103,6 +104,18 @@ SteadyTime steady_time(double s) {
 double seconds_of(SteadyTime t) {
   return std::chrono::duration<double>(t.time_since_epoch()).count();
 }
+
+TypeSpelling parse_spelling(const std::string& text) {
+  if (auto s = kTypeSpellingNames.parse(text)) return *s;
+  invalid("type spelling \"" + text + "\" unknown: one of " +
+          text::join(kTypeSpellingNames.names()));
+}
+
+// A decision of the cmd_vel type rule, with the spelling of its rule for the type's name.
+struct CmdVelDecision {
+  CmdVelTypeDecision decision;
+  TypeSpelling spelling;
+};
 
 protocol::MotionMode parse_mode(const std::string& text) {
   if (auto m = protocol::kMotionModeNames.parse(text)) return *m;
@@ -587,6 +600,73 @@ PYBIND11_MODULE(_ranger_can, m) {
           py::arg("now"), py::arg("rate_hz") = py::none())
       .def_property_readonly("wake_at",
                              [](const PublicationSchedule& p) { return seconds_of(p.wake_at()); });
+  // Which message cmd_vel is taken as (frontend/cmd_vel_type.hpp): the rule and its lines; type
+  // names in `spelling`'s form ("ros2": geometry_msgs/msg/Twist, the ROS 2 graph's).
+  py::class_<CmdVelDecision>(m, "CmdVelTypeDecision")
+      .def_property_readonly("change",
+                             [](const CmdVelDecision& d) {
+                               return std::string(kCmdVelTypeChangeNames.name(d.decision.change));
+                             })
+      .def_property_readonly("taken",
+                             [](const CmdVelDecision& d) -> std::optional<std::string> {
+                               if (!d.decision.taken) return std::nullopt;
+                               return type_name(*d.decision.taken, d.spelling);
+                             })
+      .def_property_readonly("stamped",
+                             [](const CmdVelDecision& d) -> std::optional<bool> {
+                               if (!d.decision.taken) return std::nullopt;
+                               return *d.decision.taken == CmdVelType::kTwistStamped;
+                             })
+      .def_property_readonly("line", [](const CmdVelDecision& d) { return d.decision.line; });
+  py::class_<CmdVelTypeRule>(m, "CmdVelTypeRule")
+      .def(py::init([](const std::string& setting, const std::string& spelling) {
+             const auto s = kCmdVelStampedNames.parse(setting);
+             if (!s) {
+               invalid("cmd_vel_stamped \"" + setting + "\" unknown: one of " +
+                       text::join(kCmdVelStampedNames.names()));
+             }
+             return CmdVelTypeRule(*s, parse_spelling(spelling));
+           }),
+           py::arg("setting"), py::arg("spelling") = "ros2")
+      .def(
+          "start",
+          [](CmdVelTypeRule& r, const std::vector<std::string>& publisher_types) {
+            return CmdVelDecision{r.start(publisher_types), r.spelling()};
+          },
+          py::arg("publisher_types"))
+      .def(
+          "on_publishers",
+          [](CmdVelTypeRule& r, const std::vector<std::string>& publisher_types,
+             std::optional<double> since_last_message) {
+            std::optional<std::chrono::steady_clock::duration> since;
+            if (since_last_message) since = to_ns(*since_last_message);
+            return CmdVelDecision{r.on_publishers(publisher_types, since), r.spelling()};
+          },
+          py::arg("publisher_types"), py::arg("since_last_message") = py::none())
+      .def(
+          "on_message",
+          [](CmdVelTypeRule& r, const std::string& type) {
+            const auto t = parse_cmd_vel_type(type);
+            if (!t) invalid(cmd_vel_type_refused_line(type, r.spelling()));
+            return CmdVelDecision{r.on_message(*t), r.spelling()};
+          },
+          py::arg("type"))
+      .def_property_readonly("follows_publishers", &CmdVelTypeRule::follows_publishers)
+      .def_property_readonly(
+          "setting", [](const CmdVelTypeRule& r) { return std::string(to_string(r.setting())); })
+      .def_property_readonly("taken", [](const CmdVelTypeRule& r) -> std::optional<std::string> {
+        if (!r.taken()) return std::nullopt;
+        return type_name(*r.taken(), r.spelling());
+      });
+  m.def(
+      "cmd_vel_type_names",
+      [](const std::string& spelling) {
+        std::vector<std::string> out;
+        for (const CmdVelType t : kCmdVelTypeNames.values())
+          out.push_back(type_name(t, parse_spelling(spelling)));
+        return out;
+      },
+      py::arg("spelling") = "ros2");
   bind_tables(m);
   bind_wire(m);
   py::class_<CliResult>(m, "CliResult")

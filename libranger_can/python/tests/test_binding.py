@@ -283,6 +283,43 @@ def test_the_front_ends_words_are_the_librarys(sim):
         ranger_can.clear_errors_answer(256, sim.clear_errors(0), sim.snapshot())
 
 
+def test_the_cmd_vel_type_rule_is_the_librarys():
+    """cmd_vel's type (frontend/cmd_vel_type.hpp) as the ROS 2 node maps it: the graph's names,
+    the rule's decisions and its lines."""
+    twist, stamped = ranger_can.cmd_vel_type_names()
+    assert (twist, stamped) == ("geometry_msgs/msg/Twist", "geometry_msgs/msg/TwistStamped")
+    assert ranger_can.cmd_vel_type_names("ros1") == [
+        "geometry_msgs/Twist", "geometry_msgs/TwistStamped"]
+    fixed = ranger_can.CmdVelTypeRule("true")
+    d = fixed.start([twist])
+    assert (d.change, d.taken, d.stamped) == ("taken", stamped, True)
+    assert d.line == f"cmd_vel: taken as {stamped} (cmd_vel_stamped true)"
+    assert not fixed.follows_publishers and fixed.setting == "true"
+    assert fixed.on_publishers([twist]).line == ""
+    rule = ranger_can.CmdVelTypeRule("auto")
+    d = rule.start([])
+    assert (d.change, d.taken, d.stamped) == ("none", None, None)
+    assert "(cmd_vel_stamped auto: no publisher yet; said again when one appears)" in d.line
+    assert rule.follows_publishers and rule.taken is None
+    assert rule.on_publishers([twist, stamped]).change == "none"
+    d = rule.on_publishers([stamped])
+    assert (d.change, d.stamped) == ("taken", True)
+    assert d.line == (f"cmd_vel: taken as {stamped} "
+                      "(cmd_vel_stamped auto: the type of its publishers)")
+    assert rule.on_publishers([stamped]).line == ""
+    d = rule.on_publishers([twist], since_last_message=0.1)  # the type taken still comes
+    assert d.change == "none" and rule.taken == stamped
+    d = rule.on_publishers([twist])
+    assert (d.change, d.taken, d.stamped) == ("switched", twist, False)
+    assert rule.on_message(stamped).change == "switched"
+    with pytest.raises(RangerError, match="std_msgs/msg/String is neither"):
+        rule.on_message("std_msgs/msg/String")
+    with pytest.raises(RangerError, match="cmd_vel_stamped \"maybe\" unknown"):
+        ranger_can.CmdVelTypeRule("maybe")
+    with pytest.raises(RangerError, match="type spelling"):
+        ranger_can.CmdVelTypeRule("auto", spelling="ros3")
+
+
 def test_vendor_features_refused_by_name_on_the_manuals_chassis(sim):
     with pytest.raises(RequestFailed, match="unsupported by protocol"):
         sim.set_lights(front="on", rear="on")

@@ -251,9 +251,9 @@ void add_connection(std::vector<Binding>& out) {
           "ros2_control's drive controllers, twist_mux and the teleops' `stamped`) or Twist "
           "(`false`); `auto`: the type of the topic's publishers, once the first appears and "
           "whenever they all use the other (said in the log). A stamp older than "
-          "`cmd_vel_timeout` is not obeyed (`stale_command`); a zero stamp means now. Both nodes; "
-          "the ROS 1 node's `auto` reads each message as the type its publisher declares (said in "
-          "the log when it changes)")
+          "`cmd_vel_timeout` is not obeyed (`stale_command`); a zero stamp means now. Both nodes, "
+          "by the library's rule and in its words (`frontend/cmd_vel_type.hpp`); the ROS 1 node's "
+          "`auto` also reads each message as the type its publisher declares")
           .choices(kCmdVelStampedNames.names())
           .apply([](NodeParameters& p, const ParameterValue& v) {
             p.cmd_vel_stamped = kCmdVelStampedNames.parse(v.text).value_or(CmdVelStamped::kAuto);

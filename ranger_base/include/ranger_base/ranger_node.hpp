@@ -55,6 +55,7 @@
 
 #include <ranger_can/clock.hpp>
 #include <ranger_can/control/driver.hpp>
+#include <ranger_can/frontend/cmd_vel_type.hpp>
 #include <ranger_can/frontend/publication.hpp>
 #include <ranger_can/result.hpp>
 #include <ranger_can/sim/sim_bus_source.hpp>
@@ -93,16 +94,17 @@ class RangerNode {
   RangerNode(const ros::NodeHandle& nh, const ros::NodeHandle& private_nh, NodeParameters params,
              std::shared_ptr<ranger::BusSource> source);
 
-  // cmd_vel as cmd_vel_stamped has it: Twist (false), TwistStamped (true), or either (auto: each
-  // message as its publisher's type, said in the log when the type changes).
+  // cmd_vel as the library's rule has it (ranger_can/frontend/cmd_vel_type.hpp): Twist (false),
+  // TwistStamped (true), or either (auto: each message as its publisher's type; the rule says
+  // each change of type, logged here).
   void subscribe_cmd_vel();
   void on_cmd_vel(const geometry_msgs::Twist::ConstPtr& msg);
   void on_cmd_vel_stamped(const geometry_msgs::TwistStamped::ConstPtr& msg);
   void on_cmd_vel_any(const topic_tools::ShapeShifter::ConstPtr& msg);
-  // cmd_vel_stamped auto: a subscription of any type takes the first publisher's for good
-  // (roscpp); once none of that type came for 0.5 s and the master has cmd_vel published as the
-  // other (its latest publisher's), cmd_vel is subscribed afresh (the services' thread, every
-  // 0.25 s).
+  // cmd_vel_stamped auto: the master's type of cmd_vel (its latest publisher's) to the rule (the
+  // services' thread, every 0.25 s); a subscription of any type takes the first publisher's for
+  // good (roscpp), so when the rule switches to the other type (none of the type taken came for
+  // ranger::kCmdVelTypeSettle) cmd_vel is subscribed afresh.
   void recheck_cmd_vel_type();
   // A twist to the driver; `stamp` (TwistStamped's, zero: now) gives its age: one older than
   // cmd_vel_timeout is not obeyed (the driver's stale_command, said in system_state).
@@ -187,9 +189,11 @@ class RangerNode {
   std::uint64_t logged_event_ = 0;             // the sequence number of the last event logged
   std::vector<ranger::DriverEvent> events_;    // log_events' buffer
   bool shut_down_ = false;
-  // cmd_vel_stamped auto: the type of the last cmd_vel taken (0 none yet, 1 Twist, 2
-  // TwistStamped); any thread that delivers cmd_vel.
-  std::atomic<int> cmd_vel_type_{0};
+  // The type cmd_vel is taken as (the library's rule): any thread that delivers cmd_vel (auto),
+  // the services' thread (recheck_cmd_vel_type).
+  std::mutex cmd_vel_type_mutex_;
+  ranger::CmdVelTypeRule cmd_vel_type_{ranger::CmdVelStamped::kAuto,
+                                       ranger::TypeSpelling::kRos1};  // by cmd_vel_type_mutex_
   std::atomic<std::int64_t> last_cmd_vel_ns_{0};  // steady clock: the last cmd_vel taken (auto)
   ros::Timer cmd_vel_type_timer_;
   std::mutex cmd_vel_sub_mutex_;  // cmd_vel_sub_ (re)made or shut down

@@ -144,11 +144,6 @@ def twist_of(values) -> Twist:
     return msg
 
 
-# cmd_vel's two types, as the ROS graph names them.
-TWIST_TYPE = "geometry_msgs/msg/Twist"
-TWIST_STAMPED_TYPE = "geometry_msgs/msg/TwistStamped"
-
-
 def twist_values(msg: Twist):
     """(linear x, y, z, angular x, y, z): what ranger_can.read_twist gives."""
     return (msg.linear.x, msg.linear.y, msg.linear.z,

@@ -140,18 +140,15 @@ class RangerNode(Node):
         read_twist = conversions.twist_reader()
         self._read_raw = read_twist is not None
         self._twist_values = read_twist or conversions.twist_values
-        # Twist or TwistStamped (cmd_vel_stamped; auto: the publishers' type, looked at again
-        # while the publication thread runs, whenever every publisher uses the other type).
+        # Twist or TwistStamped: the library's rule (cmd_vel_stamped; auto: the publishers'
+        # type, the graph looked at again while the publication thread runs).
         self._cmd_lock = threading.Lock()
-        self._cmd_choice = self.params["cmd_vel_stamped"]
+        self._cmd_rule = ranger_can.CmdVelTypeRule(self.params["cmd_vel_stamped"], "ros2")
         self._cmd_topic = self.resolve_topic_name("cmd_vel")
         self.cmd_sub = self._cmd_thread = None
-        want = self._publishers_want_stamped() if self._cmd_choice == "auto" else None
-        self._cmd_seen_publishers = want is not None
-        self._subscribe_cmd_vel(self._cmd_choice == "true" or bool(want))
-        self._say_cmd_vel_type(self._cmd_choice if self._cmd_choice != "auto" else
-                               "auto: the type of its publishers" if want is not None else
-                               "auto: no publisher yet; looked at again when one appears")
+        taken = self._cmd_rule.start(self._cmd_publisher_types())
+        self._subscribe_cmd_vel(bool(taken.stamped))  # none taken yet: Twist until one is
+        self.get_logger().info(taken.line)
         joint_names = ranger_can.steering_joint_names() + ranger_can.wheel_joint_names()
         self.motion_messages = conversions.MotionMessages(self.params, joint_names)
         # odom, /tf and joint_states serialised in C++ where this rmw reads the bytes as the
@@ -187,15 +184,11 @@ class RangerNode(Node):
                                         daemon=True)
 
     # ---- cmd_vel: Twist or TwistStamped ----
-    def _publishers_want_stamped(self):
-        """True/False when cmd_vel's publishers all use TwistStamped/Twist; None when there are
-        none, or of both types (the rmw matches only those of the subscription's type)."""
-        types = {i.topic_type for i in self.get_publishers_info_by_topic(self._cmd_topic)}
-        if types == {conversions.TWIST_STAMPED_TYPE}:
-            return True
-        if types == {conversions.TWIST_TYPE}:
-            return False
-        return None
+    def _cmd_publisher_types(self):
+        """The types of cmd_vel's publishers, as the rule takes them (auto only: else none)."""
+        if not self._cmd_rule.follows_publishers:
+            return []
+        return [i.topic_type for i in self.get_publishers_info_by_topic(self._cmd_topic)]
 
     def _subscribe_cmd_vel(self, stamped):
         """(Re)subscribes cmd_vel with the type asked, on a thread of its own (started when the
@@ -218,22 +211,16 @@ class RangerNode(Node):
             if old_thread is not None:  # the node runs
                 self._cmd_thread.start()
 
-    def _say_cmd_vel_type(self, why):
-        kind = conversions.TWIST_STAMPED_TYPE if self._cmd_stamped else conversions.TWIST_TYPE
-        self.get_logger().info(f"cmd_vel: taken as {kind} (cmd_vel_stamped {why})")
-
     def _recheck_cmd_vel_type(self):
-        """cmd_vel_stamped auto: the publishers' type once the first appears, and again whenever
-        they all use the other type; said in the log."""
-        if self._cmd_choice != "auto":
+        """cmd_vel_stamped auto: the publishers to the rule; a change of type subscribed and said
+        (the rmw matches only the publishers of the subscription's type)."""
+        if not self._cmd_rule.follows_publishers:
             return
-        want = self._publishers_want_stamped()
-        if want is None or (want == self._cmd_stamped and self._cmd_seen_publishers):
-            return
-        self._cmd_seen_publishers = True
-        if want != self._cmd_stamped:
-            self._subscribe_cmd_vel(want)
-        self._say_cmd_vel_type("auto: the type of its publishers")
+        d = self._cmd_rule.on_publishers(self._cmd_publisher_types())
+        if d.stamped is not None and d.stamped != self._cmd_stamped:
+            self._subscribe_cmd_vel(d.stamped)
+        if d.line:  # a change, said once
+            self.get_logger().info(d.line)
 
     def _publisher(self, msg_type, topic, depth):
         # No QoS event handlers: each one is Python work in every executor wake-up.

@@ -54,10 +54,12 @@ def test_no_module_retypes_a_mode_name():
 
 # The library's words and numbers a module of ranger_base must not spell itself: the services'
 # checks and answers (frontend/answers.hpp), BatteryState's status and health (the library's
-# battery report), the Range of nothing seen (range_reading), the refusals and the link states.
+# battery report), the Range of nothing seen (range_reading), the refusals and the link states,
+# cmd_vel's types and the lines about them (frontend/cmd_vel_type.hpp: ranger_can.CmdVelTypeRule).
 RETYPED = ("nothing sent", "not confirmed", "set exactly one", "contradictory request",
            "POWER_SUPPLY_STATUS_", "POWER_SUPPLY_HEALTH_", "math.inf",
-           "re-armed", "motion mode pinned")
+           "re-armed", "motion mode pinned",
+           "geometry_msgs/", "cmd_vel: taken as", "no publisher yet", "type of its publishers")
 
 
 def test_no_module_retypes_the_librarys_words_or_numbers():

@@ -55,7 +55,7 @@ struct ProtocolParameters {
 // Which message `cmd_vel` is taken as (cmd_vel_stamped): geometry_msgs/Twist or TwistStamped
 // (Nav2 on Kilted, ros2_control's drive controllers, twist_mux and the teleops with `stamped`);
 // kAuto: the type the topic's publishers use, once the first appears and whenever they all use
-// the other.
+// the other. The rule and its log lines: frontend/cmd_vel_type.hpp (CmdVelTypeRule).
 enum class CmdVelStamped { kAuto, kStamped, kPlain };
 inline constexpr auto kCmdVelStampedNames = text::enum_names<CmdVelStamped>({
     {CmdVelStamped::kAuto, "auto"},
@@ -78,7 +78,7 @@ struct NodeParameters {
   double publish_rate = 50.0;        // Hz: odom, TF, joint_states (at most the feedback's 50 Hz)
   double state_publish_rate = 10.0;  // Hz: ranger_msgs states, battery, ultrasonic
   bool publish_cmd = false;          // cmd_vel_out: the twist each motion command realises
-  CmdVelStamped cmd_vel_stamped = CmdVelStamped::kAuto;  // the ROS 2 node's cmd_vel type
+  CmdVelStamped cmd_vel_stamped = CmdVelStamped::kAuto;  // cmd_vel's type
 
   // x, y, z, roll, pitch, yaw. The pose entries are a floor to which the odometry's growing
   // x/y/yaw variance is added (pose_covariance()); the twist entries are published as they are
