@@ -131,8 +131,17 @@ class PtyProcess:
             except OSError:
                 pass
             self.process.wait()
+        # The reader ends first (with the slave side closed everywhere, a read of the master side
+        # fails with EIO), and only then is the master's descriptor closed: closed under a reader
+        # still in its loop, its number would be the next pseudo-terminal's, and the old reader
+        # would read the next process's output away from it (a teleop that said nothing, seen
+        # once under load).
+        # A process that escaped its session would keep the slave side open and the reader
+        # reading: its descriptor is then left open (never reused) rather than closed.
         os.close(self.slave)
-        os.close(self.fd)
+        self.reader.join(timeout=10)
+        if not self.reader.is_alive():
+            os.close(self.fd)
 
 
 class TeleopProcess(PtyProcess):
