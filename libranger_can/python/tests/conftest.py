@@ -4,13 +4,16 @@ their bounds, under whatever load the run had. The waits themselves are the libr
 
 import functools
 import inspect
+import os
+import sys
 import time
-
-import pytest
 
 import ranger_can
 
-_waits = []
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "..", "scripts"))
+import pytest_wait_margins as wait_margins  # noqa: E402
+from pytest_wait_margins import pytest_terminal_summary  # noqa: E402,F401
+from pytest_wait_margins import wait_margins as _wait_margins_fixture  # noqa: E402,F401
 
 
 def _timed(method):
@@ -23,7 +26,7 @@ def _timed(method):
         start = time.monotonic()
         result = method(self, *args, **kwargs)
         seconds, bound = time.monotonic() - start, call.arguments["timeout"]
-        _waits.append((seconds / bound, seconds, bound, method.__name__))
+        wait_margins.record(method.__name__, seconds, bound)
         return result
     return wait
 
@@ -31,28 +34,3 @@ def _timed(method):
 ranger_can.Driver.wait_until = _timed(ranger_can.Driver.wait_until)
 ranger_can.Driver.wait_ready = _timed(ranger_can.Driver.wait_ready)
 
-
-def _closest_waits():
-    """The waits that came closest to their bounds, as one line (None before any)."""
-    if not _waits:
-        return None
-    closest = sorted(_waits, reverse=True)[:3]
-    return (f"wall-clock waits: {len(_waits)} ended in time; the closest to its bound: " +
-            "; ".join(f"{what} {seconds:.2f} s of {bound:g} s ({100 * used:.0f} %)"
-                      for used, seconds, bound, what in closest))
-
-
-@pytest.fixture(scope="session", autouse=True)
-def _wait_margins(record_testsuite_property):
-    """The closest waits in the JUnit report too (property `measured`: scripts/test.sh's summary
-    prints it)."""
-    yield
-    line = _closest_waits()
-    if line:
-        record_testsuite_property("measured", line)
-
-
-def pytest_terminal_summary(terminalreporter):
-    line = _closest_waits()
-    if line:
-        terminalreporter.write_line(line)

@@ -4,13 +4,16 @@ initialise it (they hold bytes and tables, no node), and test_parameters asks fo
 
 import itertools
 import os
+import sys
 
 import pytest
 import rclpy
 from geometry_msgs.msg import Twist
 
-import support
 from support import Client, Robot
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "..", "scripts"))
+from pytest_wait_margins import pytest_terminal_summary, wait_margins  # noqa: E402,F401
 
 _ns = itertools.count(1)
 
@@ -51,28 +54,3 @@ def robots(client, tmp_path, request):
     for r in started:
         r.stop()
 
-
-def _closest_waits():
-    """The waits that came closest to their bounds, as one line (None before any)."""
-    if not support.waits:
-        return None
-    closest = sorted(support.waits, reverse=True)[:3]
-    return (f"wall-clock waits: {len(support.waits)} ended in time; the closest to its bound: " +
-            "; ".join(f"{what} {seconds:.2f} s of {bound:g} s ({100 * used:.0f} %)"
-                      for used, seconds, bound, what in closest))
-
-
-@pytest.fixture(scope="session", autouse=True)
-def _wait_margins(record_testsuite_property):
-    """The closest waits in the JUnit report too (property `measured`: scripts/test.sh's summary
-    prints it)."""
-    yield
-    line = _closest_waits()
-    if line:
-        record_testsuite_property("measured", line)
-
-
-def pytest_terminal_summary(terminalreporter):
-    line = _closest_waits()
-    if line:
-        terminalreporter.write_line(line)

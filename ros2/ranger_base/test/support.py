@@ -7,6 +7,7 @@ import math
 import os
 import signal
 import subprocess
+import sys
 import threading
 import time
 
@@ -18,17 +19,11 @@ from rclpy.executors import SingleThreadedExecutor
 from ranger_msgs.msg import SystemState
 from std_msgs.msg import String
 
+# The margins of the waits below, reported at the end of the run (scripts/pytest_wait_margins.py).
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "..", "scripts"))
+import pytest_wait_margins as wait_margins  # noqa: E402
+
 _names = itertools.count(1)
-
-# Every wait that ended in time: (fraction of its bound used, seconds, bound, what). conftest.py
-# prints the closest ones at the end of the run: the margin each wall-clock bound had, measured
-# in every run (issue 34: the margins of the timing-dependent tests under load).
-waits = []
-
-
-def record_wait(what, seconds, bound):
-    waits.append((seconds / bound, seconds, bound, what))
-
 
 def node_executable():
     return os.path.join(get_package_prefix("ranger_base"), "lib", "ranger_base", "ranger_base_node")
@@ -116,7 +111,7 @@ class Client:
                 pace()
             try:
                 if predicate():
-                    record_wait(what, time.monotonic() - start, timeout)
+                    wait_margins.record(what, time.monotonic() - start, timeout)
                     return True
             except (AttributeError, TypeError):
                 pass
@@ -132,7 +127,7 @@ class Client:
         while not future.done():
             assert time.monotonic() < deadline, f"{name}: no response"
             time.sleep(0.02)
-        record_wait(f"{name} answered", time.monotonic() - start, timeout)
+        wait_margins.record(f"{name} answered", time.monotonic() - start, timeout)
         self.node.destroy_client(client)
         return future.result()
 
