@@ -44,6 +44,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <deque>
 #include <functional>
@@ -201,24 +202,30 @@ class NodeSim : public ::testing::Test {
     return "<missing>";
   }
 
-  // Publishes `cmd` `n` times, each time waiting for the node's next system_state: a teleop kept
-  // alive while the node may send no motion command at all.
+  // Publishes `cmd` every 50 ms (a teleop at 20 Hz) until the node has published `n` more
+  // system_states: a teleop kept alive while the node may send no motion command at all. The
+  // stream stays fresh however the states are paced (cmd_vel_timeout is 0.3 s in these
+  // fixtures; one twist per state let it lapse when a state came late). False when a state
+  // takes over 5 s.
   static bool drive_for_states(const geometry_msgs::Twist& cmd, int n) {
-    for (int i = 0; i < n; ++i) {
-      std::size_t seen = 0;
-      {
-        std::lock_guard<std::mutex> lock(commands_mutex_);
-        seen = states_.size();
+    std::size_t seen = 0;
+    {
+      std::lock_guard<std::mutex> lock(commands_mutex_);
+      seen = states_.size();
+    }
+    for (std::size_t want = seen + 1; want <= seen + static_cast<std::size_t>(n); ++want) {
+      const auto end = ros::WallTime::now() + ros::WallDuration(5.0);
+      bool arrived = false;
+      while (!arrived && ros::ok() && ros::WallTime::now() < end) {
+        cmd_pub_.publish(cmd);
+        arrived = wait_for(
+            [&] {
+              std::lock_guard<std::mutex> lock(commands_mutex_);
+              return states_.size() >= want;
+            },
+            0.05);
       }
-      cmd_pub_.publish(cmd);
-      if (!wait_for(
-              [&] {
-                std::lock_guard<std::mutex> lock(commands_mutex_);
-                return states_.size() > seen;
-              },
-              5.0)) {
-        return false;
-      }
+      if (!arrived) return false;
     }
     return true;
   }
@@ -1220,9 +1227,25 @@ TEST_F(Adversarial, ANonFiniteFieldMovesNothingAndIsNamedWhileItLasts) {
     vector.*(f.axis) = bad;
     const auto at = position();
     ASSERT_TRUE(drive_for_states(t, 2));
-    const std::size_t from = states_seen();
-    ASSERT_TRUE(drive_for_states(t, 8));
-    for (const auto& s : states_since(from)) {
+    // A state that says cmd_timeout means the stream itself lapsed (this process or the node
+    // not run for cmd_vel_timeout, 0.3 s: a busy host), and the driver is right to say so: the
+    // window is then repeated, and said, up to 3 times in all. Any other reason fails.
+    std::vector<SystemState> window;
+    for (int attempt = 1;; ++attempt) {
+      const std::size_t from = states_seen();
+      ASSERT_TRUE(drive_for_states(t, 8));
+      window = states_since(from);
+      const bool lapsed = std::any_of(window.begin(), window.end(), [](const SystemState& s) {
+        return s.motion_inhibited_reason == "cmd_timeout";
+      });
+      if (!lapsed || attempt == 3) break;
+      std::printf(
+          "[retry] %s: attempt %d saw cmd_timeout (the stream lapsed: a busy host?); "
+          "the window again\n",
+          named.c_str(), attempt);
+      std::fflush(stdout);
+    }
+    for (const auto& s : window) {
       EXPECT_EQ(s.motion_inhibited_reason, "invalid_command");
       EXPECT_NE(s.motion_inhibited_detail.find(named), std::string::npos)
           << s.motion_inhibited_detail;
